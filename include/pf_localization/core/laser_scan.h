@@ -1,0 +1,44 @@
+// A planar laser scan as the core sees it: ROS-free, with the sensor's pose on
+// the robot attached, because the filter needs both to place beam end points.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pf_localization/core/pose2.h"
+
+namespace pf {
+
+struct LaserScan {
+  std::vector<float> ranges;     // metres; NaN, inf, 0 and negatives mean "no reading"
+  double angle_min = 0.0;        // rad, angle of ranges[0] in the sensor frame
+  double angle_increment = 0.0;  // rad between consecutive beams (may be negative)
+  double range_min = 0.0;        // m
+  double range_max = 0.0;        // m
+  Pose2 sensor_pose;             // the laser frame in the robot's base frame
+};
+
+/// Why a scan cannot be used at all (as opposed to single bad beams, which are
+/// dropped quietly): an empty range array, a zero or non-finite angle
+/// increment, non-finite angles, range_max <= range_min, or a non-finite
+/// sensor pose. Empty when the scan is usable.
+std::optional<std::string> validateScan(const LaserScan& scan);
+
+/// One usable beam: its measured range and its bearing in the sensor frame.
+struct Beam {
+  float range;
+  float bearing;
+};
+
+/// The usable beams of a scan, evenly subsampled to at most `max_beams`.
+///
+/// Invalid beams (NaN, inf, <= 0, below range_min, at or above range_max) are
+/// dropped *before* subsampling: on a Neato a third of the beams can be
+/// dropouts, and subsampling first would waste the beam budget on them.
+/// `range_min`/`range_max` narrow the scan's own limits when they are tighter
+/// (pass a non-positive value to use the scan's). max_beams <= 0 keeps all.
+std::vector<Beam> selectBeams(const LaserScan& scan, int max_beams, double range_min = 0.0,
+                              double range_max = 0.0);
+
+}  // namespace pf

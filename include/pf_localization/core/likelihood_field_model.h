@@ -1,0 +1,76 @@
+// The likelihood-field beam model: weighs each particle by how well the scan's
+// end points, placed from that particle's pose, fall on the map's obstacles.
+//
+// Thrun, Burgard & Fox, "Probabilistic Robotics" (2005), table 6.3. For a beam
+// whose end point lies dist metres from the nearest obstacle:
+//   p = z_hit * N(dist; 0, sigma_hit) + z_rand / range_max
+// Beams are independent, so a particle's log-likelihood is the sum of the
+// beams' log p. Working in log space means no product of hundreds of small
+// numbers can underflow to zero.
+//
+// log p depends only on the cell an end point falls in, so it is precomputed
+// once per map (and per range_max) into a table with a one-cell border that
+// stands for "outside the map". The per-beam work is then: transform the end
+// point, clamp the cell index into the table, add.
+#pragma once
+
+#include <vector>
+
+#include "pf_localization/core/laser_scan.h"
+#include "pf_localization/core/likelihood_field.h"
+#include "pf_localization/core/particle_set.h"
+
+namespace pf {
+
+struct LikelihoodFieldModelParams {
+  double z_hit = 0.95;        // weight of the Gaussian hit component (unitless)
+  double z_rand = 0.05;       // weight of the uniform random component (unitless)
+  double sigma_hit = 0.2;     // std dev of the hit component (m)
+  double max_distance = 2.0;  // distance field cap (m)
+  int max_beams = 60;         // beams used per scan after dropping invalid ones
+  double range_min = 0.0;     // m; tighter lower limit than the scan's, 0 = scan's
+  double range_max = 0.0;     // m; tighter upper limit than the scan's, 0 = scan's
+};
+
+/// End points of the usable beams in the robot's base frame, computed once per scan.
+struct PreparedScan {
+  std::vector<float> x;    // m
+  std::vector<float> y;    // m
+  double range_max = 0.0;  // the range_max that scales z_rand
+  int dropped = 0;         // invalid beams dropped before subsampling
+  std::size_t size() const { return x.size(); }
+};
+
+class LikelihoodFieldModel {
+ public:
+  /// Throws std::invalid_argument naming the parameter when one is out of range.
+  LikelihoodFieldModel(const OccupancyGrid& grid, const LikelihoodFieldModelParams& params);
+
+  const LikelihoodFieldModelParams& params() const { return params_; }
+  const LikelihoodField& field() const { return field_; }
+
+  /// The usable beams' end points in the robot frame.
+  PreparedScan prepare(const LaserScan& scan) const;
+
+  /// log p(scan | pose) for one pose.
+  double logLikelihood(const PreparedScan& scan, const Pose2& pose) const;
+
+  /// log p(scan | particle) for every particle, into `log_likelihood`.
+  void logLikelihoods(const PreparedScan& scan, const ParticleSet& particles,
+                      std::vector<double>* log_likelihood) const;
+
+  /// log p of one beam whose end point is `distance` metres from an obstacle.
+  double beamLogLikelihood(double distance, double range_max) const;
+
+ private:
+  void buildTable(double range_max) const;
+
+  LikelihoodFieldModelParams params_;
+  LikelihoodField field_;
+  // The precomputed table: (width + 2) x (height + 2) with a border of
+  // "outside the map" cells, rebuilt only when range_max changes.
+  mutable std::vector<float> table_;
+  mutable double table_range_max_ = -1.0;
+};
+
+}  // namespace pf

@@ -1,0 +1,63 @@
+// Odometry motion model: moves every particle by the motion the wheel odometry
+// reports, with noise that grows with the motion.
+//
+// Differential drive: "sample_motion_model_odometry" of Thrun, Burgard & Fox,
+// "Probabilistic Robotics" (2005), table 5.6. The odometry step is split into
+// a rotation rot1 towards the direction of travel, a translation trans and a
+// final rotation rot2; each is perturbed with a standard deviation of
+//   rot:   sqrt(alpha1 * rot^2 + alpha2 * trans^2)
+//   trans: sqrt(alpha3 * trans^2 + alpha4 * (rot1^2 + rot2^2))
+// Two refinements over the textbook: a robot that drives backwards has
+// rot1 close to pi, which must not be mistaken for a large rotation, so the
+// rotation noise uses the smaller of |rot1| and |pi - rot1|; and for tiny
+// translations the direction of travel is meaningless, so rot1 is taken as 0.
+//
+// Omnidirectional: the step is a translation in the robot frame (forward and
+// strafe) plus a rotation; alpha5 scales the strafe noise.
+#pragma once
+
+#include "pf_localization/core/particle_set.h"
+#include "pf_localization/core/pose2.h"
+#include "pf_localization/core/random.h"
+
+namespace pf {
+
+struct OdometryMotionParams {
+  enum class Kind { kDifferential, kOmni };
+  Kind kind = Kind::kDifferential;
+  double alpha1 = 0.2;  // rotation noise from rotation      (rad^2/rad^2)
+  double alpha2 = 0.2;  // rotation noise from translation   (rad^2/m^2)
+  double alpha3 = 0.2;  // translation noise from translation (m^2/m^2)
+  double alpha4 = 0.2;  // translation noise from rotation   (m^2/rad^2)
+  double alpha5 = 0.2;  // strafe noise from translation, omni only (m^2/m^2)
+};
+
+/// The odometry step split into rotation, translation, rotation.
+struct OdometryStep {
+  double rot1;
+  double trans;
+  double rot2;
+};
+
+class OdometryMotionModel {
+ public:
+  /// Throws std::invalid_argument when an alpha is negative or not finite.
+  explicit OdometryMotionModel(const OdometryMotionParams& params);
+
+  const OdometryMotionParams& params() const { return params_; }
+
+  /// Decomposes the odometry motion from `from` to `to` (both in the odom frame).
+  static OdometryStep decompose(const Pose2& from, const Pose2& to);
+
+  /// Moves every particle by the noisy odometry motion from `from` to `to`.
+  void apply(const Pose2& from, const Pose2& to, ParticleSet* particles, Random* random) const;
+
+ private:
+  void applyDifferential(const Pose2& from, const Pose2& to, ParticleSet* particles,
+                         Random* random) const;
+  void applyOmni(const Pose2& from, const Pose2& to, ParticleSet* particles, Random* random) const;
+
+  OdometryMotionParams params_;
+};
+
+}  // namespace pf

@@ -1,0 +1,128 @@
+// Monte Carlo localization: the particle filter that composes the motion
+// model, the likelihood-field sensor model, the resampler and the pose
+// estimator.
+//
+// Thrun, Burgard & Fox, "Probabilistic Robotics" (2005), table 8.2 (MCL) with
+// the augmentation of table 8.3 (random particles injected when the short-term
+// average of the measurement likelihood falls below the long-term one), and
+// KLD-sampling (Fox 2003) to adapt the particle count.
+//
+// The filter runs an update only after the robot has moved update_min_d or
+// turned update_min_a since the last one, and on the first scan after an
+// initialisation: a robot standing still would otherwise keep multiplying
+// the same evidence into its weights and grow falsely confident.
+//
+// Deterministic: the same parameters (seed included) and the same calls give
+// the same particles, bit for bit.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pf_localization/core/laser_scan.h"
+#include "pf_localization/core/likelihood_field_model.h"
+#include "pf_localization/core/occupancy_grid.h"
+#include "pf_localization/core/odometry_motion_model.h"
+#include "pf_localization/core/particle_set.h"
+#include "pf_localization/core/pose_estimator.h"
+#include "pf_localization/core/random.h"
+#include "pf_localization/core/resampler.h"
+
+namespace pf {
+
+struct RecoveryParams {
+  double alpha_slow = 0.0;  // long-term likelihood average rate (0 disables recovery)
+  double alpha_fast = 0.0;  // short-term likelihood average rate
+};
+
+struct ParticleFilterParams {
+  KldParams kld;                       // particle count bounds and KLD-sampling
+  double update_min_d = 0.2;           // m of travel between updates
+  double update_min_a = M_PI / 6.0;    // rad of rotation between updates
+  double resample_ess_fraction = 0.5;  // resample when ESS < this * N (0..1]
+  uint64_t seed = 0;
+  OdometryMotionParams motion;
+  LikelihoodFieldModelParams sensor;
+  ClusterParams clusters;
+  RecoveryParams recovery;
+};
+
+/// Throws std::invalid_argument naming the first parameter out of range and its valid range.
+void validate(const ParticleFilterParams& params);
+
+/// What one call to ParticleFilter::update did.
+struct UpdateReport {
+  bool updated = false;     // motion and sensor update ran
+  std::string skip_reason;  // why not, when !updated
+  int beams_used = 0;
+  int beams_dropped = 0;
+  std::size_t particles = 0;
+  double ess = 0.0;  // before resampling
+  bool resampled = false;
+  double mean_beam_likelihood = 0.0;  // geometric mean over beams, weighted over particles
+  std::size_t injected = 0;           // random particles added by recovery
+};
+
+class ParticleFilter {
+ public:
+  /// Throws std::invalid_argument (see validate()).
+  explicit ParticleFilter(const ParticleFilterParams& params);
+
+  const ParticleFilterParams& params() const { return params_; }
+
+  /// Installs a map (rebuilding the likelihood field). If particles exist and
+  /// the current estimate lies in free space of the new map they are kept;
+  /// otherwise the filter becomes uninitialised. Returns whether they were kept.
+  /// Throws std::invalid_argument for an empty map.
+  bool setMap(const OccupancyGrid& grid);
+  bool hasMap() const { return static_cast<bool>(model_); }
+  const OccupancyGrid* map() const { return model_ ? &model_->field().grid() : nullptr; }
+
+  /// Particles drawn around `mean` from a Gaussian with covariance `cov`
+  /// (x, y, yaw). Throws std::invalid_argument for a non-finite pose or a
+  /// covariance that is not symmetric positive semi-definite.
+  void initializeGaussian(const Pose2& mean, const Eigen::Matrix3d& cov);
+  /// Particles spread uniformly over the map's free cells (global localization).
+  /// Throws std::logic_error without a map or when the map has no free cell.
+  void initializeUniform();
+  bool isInitialized() const { return !particles_.empty(); }
+
+  /// Feeds the odometry pose at the scan's time and the scan. Runs a filter
+  /// update when the robot moved enough, on the first scan after an
+  /// initialisation, or after requestNoMotionUpdate().
+  UpdateReport update(const Pose2& odom, const LaserScan& scan);
+
+  /// The next update() runs even without motion.
+  void requestNoMotionUpdate() { force_update_ = true; }
+
+  const ParticleSet& particles() const { return particles_; }
+  const PoseEstimate& estimate() const { return estimate_; }
+
+  /// map -> odom: the estimate composed with the inverse of the odometry pose
+  /// it was computed at. Empty until the first update after an initialisation.
+  std::optional<Pose2> mapToOdom() const;
+
+ private:
+  void weigh(const PreparedScan& scan, UpdateReport* report);
+  void resample(UpdateReport* report);
+  Pose2 randomFreePose();
+
+  ParticleFilterParams params_;
+  Random random_;
+  OdometryMotionModel motion_model_;
+  std::unique_ptr<LikelihoodFieldModel> model_;
+  ParticleSet particles_;
+  PoseEstimate estimate_;
+  std::optional<Pose2> odom_at_update_;
+  bool force_update_ = false;
+  bool has_estimate_ = false;
+  double w_slow_ = 0.0;
+  double w_fast_ = 0.0;
+  std::vector<double> scratch_;
+};
+
+}  // namespace pf

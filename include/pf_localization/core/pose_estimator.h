@@ -1,0 +1,43 @@
+// The pose estimate and its covariance, from a weighted particle cloud.
+//
+// Particles are binned on a coarse (x, y, yaw) grid and neighbouring occupied
+// bins are joined into clusters. The estimate is the weighted mean of the
+// heaviest cluster, with a circular mean for yaw, so that a cloud split between
+// two places reports one of them rather than a point between them. The
+// covariance is that cluster's weighted covariance; yaw deviations are taken
+// from the circular mean.
+#pragma once
+
+#include <Eigen/Core>
+#include <vector>
+
+#include "pf_localization/core/particle_set.h"
+
+namespace pf {
+
+struct ClusterParams {
+  double cell_xy = 0.5;      // bin size (m)
+  double cell_yaw = 0.5236;  // bin size (rad), 30 degrees
+};
+
+struct Cluster {
+  double weight = 0.0;  // summed particle weight
+  Pose2 mean;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // x, y, yaw
+  std::size_t count = 0;
+};
+
+struct PoseEstimate {
+  Pose2 pose;
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // of the heaviest cluster
+  std::vector<Cluster> clusters;                         // heaviest first
+};
+
+/// Weighted mean and covariance of a set of particles (indices into `particles`).
+Cluster summarize(const ParticleSet& particles, const std::vector<std::size_t>& indices);
+
+/// Clusters the cloud and summarises every cluster; the estimate is the heaviest.
+/// An empty set gives an estimate with no clusters.
+PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& params);
+
+}  // namespace pf

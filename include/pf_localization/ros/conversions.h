@@ -1,0 +1,44 @@
+// Conversions between ROS messages and the core's ROS-free types.
+#pragma once
+
+#include <geometry_msgs/Pose.h>
+#include <geometry_msgs/PoseArray.h>
+#include <geometry_msgs/PoseWithCovariance.h>
+#include <geometry_msgs/Transform.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <sensor_msgs/LaserScan.h>
+
+#include <Eigen/Core>
+
+#include "pf_localization/core/laser_scan.h"
+#include "pf_localization/core/occupancy_grid.h"
+#include "pf_localization/core/particle_set.h"
+#include "pf_localization/core/pose2.h"
+
+namespace pf_ros {
+
+/// Yaw of a quaternion (roll and pitch are ignored: we live in the plane).
+double yawOf(const geometry_msgs::Quaternion& q);
+geometry_msgs::Quaternion quaternionFromYaw(double yaw);
+
+pf::Pose2 toPose2(const geometry_msgs::Pose& p);
+pf::Pose2 toPose2(const geometry_msgs::Transform& t);
+geometry_msgs::Pose toPoseMsg(const pf::Pose2& p);
+geometry_msgs::Transform toTransformMsg(const pf::Pose2& p);
+
+/// The scan with the laser's pose on the robot attached.
+pf::LaserScan toCore(const sensor_msgs::LaserScan& msg, const pf::Pose2& sensor_pose);
+/// Throws std::invalid_argument for a malformed grid (size mismatch, zero size, bad resolution).
+pf::OccupancyGrid toCore(const nav_msgs::OccupancyGrid& msg);
+nav_msgs::OccupancyGrid toMsg(const pf::OccupancyGrid& grid);
+
+/// The 6x6 ROS covariance (x, y, z, roll, pitch, yaw) from the 3x3 (x, y, yaw)
+/// one; z, roll and pitch get zero variance.
+boost::array<double, 36> toRosCovariance(const Eigen::Matrix3d& cov);
+/// The (x, y, yaw) block of a ROS 6x6 covariance.
+Eigen::Matrix3d fromRosCovariance(const boost::array<double, 36>& cov);
+
+/// Every particle as a pose (weights are not part of a PoseArray).
+void toPoseArray(const pf::ParticleSet& particles, geometry_msgs::PoseArray* out);
+
+}  // namespace pf_ros

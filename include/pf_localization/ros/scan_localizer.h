@@ -1,0 +1,77 @@
+// The ROS-message-level localizer that every front door shares: pf_node
+// drives it from subscriptions, pf_bag_runner from a bag read as fast as the
+// CPU allows. It owns the particle filter, looks the laser's mounting and the
+// odometry at each scan's stamp up in a tf2::BufferCore, and says what to
+// publish.
+#pragma once
+
+#include <geometry_msgs/PoseArray.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <geometry_msgs/TransformStamped.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <nav_msgs/Odometry.h>
+#include <sensor_msgs/LaserScan.h>
+#include <tf2/buffer_core.h>
+
+#include <optional>
+#include <string>
+
+#include "pf_localization/core/particle_filter.h"
+#include "pf_localization/ros/localizer_config.h"
+
+namespace pf_ros {
+
+/// What processing one scan produced.
+struct ScanResult {
+  pf::UpdateReport report;  // report.updated: the filter ran
+  std::string error;        // non-empty: the scan was not used, and why (for the log)
+  // The odometry pose (odom -> base) at the scan's stamp, when it was found.
+  std::optional<pf::Pose2> odom;
+};
+
+class ScanLocalizer {
+ public:
+  /// `tf` must outlive the localizer; it is only read from. Throws
+  /// std::invalid_argument for an invalid configuration.
+  ScanLocalizer(const LocalizerConfig& config, const tf2::BufferCore* tf);
+
+  const LocalizerConfig& config() const { return config_; }
+  const pf::ParticleFilter& filter() const { return filter_; }
+  pf::ParticleFilter& filter() { return filter_; }
+
+  /// Installs or replaces the map. On the first map the filter is initialised
+  /// from the configured initial pose, or globally when there is none.
+  /// Returns an error message (empty on success).
+  std::string setMap(const nav_msgs::OccupancyGrid& map);
+
+  /// Re-initialises around a pose given in the global frame. A pose in
+  /// another frame must be transformed by the caller (pf_node does, via tf).
+  /// Returns an error message (empty on success).
+  std::string setInitialPose(const geometry_msgs::PoseWithCovarianceStamped& pose);
+
+  /// Global localization: particles spread over the map's free space.
+  std::string startGlobalLocalization();
+
+  /// Uses one scan: odometry and laser pose from tf at the scan's stamp, then
+  /// the filter update.
+  ScanResult processScan(const sensor_msgs::LaserScan& scan);
+
+  /// map -> odom to publish, stamped `stamp` (the caller adds transform_tolerance).
+  std::optional<geometry_msgs::TransformStamped> mapToOdom(const ros::Time& stamp) const;
+  /// The estimate with covariance, stamped `stamp`, in the global frame.
+  std::optional<geometry_msgs::PoseWithCovarianceStamped> estimate(const ros::Time& stamp) const;
+  /// The particles, stamped `stamp`, in the global frame.
+  geometry_msgs::PoseArray particleCloud(const ros::Time& stamp) const;
+
+ private:
+  LocalizerConfig config_;
+  const tf2::BufferCore* tf_;
+  pf::ParticleFilter filter_;
+  bool had_map_ = false;
+};
+
+/// A nav_msgs/Odometry as the odom -> base transform it describes, for a tf
+/// buffer that has no odometry on /tf (bags that only record /odom).
+geometry_msgs::TransformStamped odometryToTransform(const nav_msgs::Odometry& odom);
+
+}  // namespace pf_ros

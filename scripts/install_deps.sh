@@ -1,0 +1,43 @@
+#!/usr/bin/env bash
+# Installs every build, run and test dependency of pf_localization from Debian 12's
+# archive. rosdep cannot reach its database on our machines, so the Debian package
+# names are listed here by hand; keep them in step with package.xml.
+# Idempotent: packages already present are skipped by apt, and apt-get update runs
+# only when a package is actually missing.
+set -euo pipefail
+
+packages=(
+  # build tools
+  build-essential cmake catkin catkin-lint python3-catkin-pkg clang-format
+  # ROS 1 core, messages and tools
+  ros-base-dev libroscpp-dev rosbash python3-roslaunch python3-rostopic python3-rosnode
+  python3-rosservice python3-rosparam python3-rosmsg
+  libtf2-dev libtf2-ros-dev libtf2-geometry-msgs-dev libtf2-msgs-dev
+  libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev libstd-srvs-dev libdiagnostic-msgs-dev
+  librosbag-dev librosbag-storage-dev python3-rosbag
+  # libraries of the core
+  libeigen3-dev libyaml-cpp-dev
+  # tests and benchmarks
+  libgtest-dev libgmock-dev librostest-dev python3-rostest python3-rosunit libbenchmark-dev
+  python3-std-srvs python3-geometry-msgs python3-nav-msgs python3-sensor-msgs python3-tf2-msgs
+  python3-tf2-ros
+  # evaluation reports
+  python3-numpy python3-matplotlib python3-pil python3-yaml
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install_deps: all ${#packages[@]} packages already installed"
+  exit 0
+fi
+
+echo "install_deps: installing ${#missing[@]} packages: ${missing[*]}"
+SUDO=""
+[ "$(id -u)" -ne 0 ] && SUDO="sudo"
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
