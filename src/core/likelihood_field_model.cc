@@ -1,1 +1,121 @@
-// placeholder: being written
+#include "pf_localization/core/likelihood_field_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace pf {
+namespace {
+
+void require(bool ok, const std::string& what) {
+  if (!ok) throw std::invalid_argument("likelihood field model: " + what);
+}
+
+}  // namespace
+
+LikelihoodFieldModel::LikelihoodFieldModel(const OccupancyGrid& grid,
+                                           const LikelihoodFieldModelParams& params)
+    : params_(params), field_(grid, params.max_distance) {
+  require(params.z_hit >= 0.0 && std::isfinite(params.z_hit), "laser_z_hit must be >= 0");
+  require(params.z_rand >= 0.0 && std::isfinite(params.z_rand), "laser_z_rand must be >= 0");
+  require(params.z_hit + params.z_rand > 0.0,
+          "laser_z_hit + laser_z_rand must be positive, got " +
+              std::to_string(params.z_hit + params.z_rand));
+  require(params.sigma_hit > 0.0 && std::isfinite(params.sigma_hit),
+          "laser_sigma_hit must be positive, got " + std::to_string(params.sigma_hit));
+  require(params.max_beams >= 1,
+          "laser_max_beams must be >= 1, got " + std::to_string(params.max_beams));
+  require(params.range_min >= 0.0 && params.range_max >= 0.0,
+          "laser_min_range and laser_max_range must be >= 0");
+}
+
+double LikelihoodFieldModel::beamLogLikelihood(double distance, double range_max) const {
+  const double s = params_.sigma_hit;
+  const double gauss = std::exp(-0.5 * distance * distance / (s * s)) / (s * std::sqrt(2.0 * M_PI));
+  return std::log(params_.z_hit * gauss + params_.z_rand / range_max);
+}
+
+PreparedScan LikelihoodFieldModel::prepare(const LaserScan& scan) const {
+  std::size_t valid = 0;
+  const std::vector<Beam> beams =
+      selectBeams(scan, params_.max_beams, params_.range_min, params_.range_max, &valid);
+  PreparedScan out;
+  out.range_max = params_.range_max > 0.0 ? std::min(params_.range_max, scan.range_max)
+                                          : scan.range_max;
+  out.dropped = static_cast<int>(scan.ranges.size() - valid);
+  out.x.reserve(beams.size());
+  out.y.reserve(beams.size());
+  for (const Beam& b : beams) {
+    const Pose2 end = compose(scan.sensor_pose, {b.range * std::cos(b.bearing),
+                                                 b.range * std::sin(b.bearing), 0.0});
+    out.x.push_back(static_cast<float>(end.x));
+    out.y.push_back(static_cast<float>(end.y));
+  }
+  return out;
+}
+
+void LikelihoodFieldModel::buildTable(double range_max) const {
+  if (range_max == table_range_max_) return;
+  const OccupancyGrid& grid = field_.grid();
+  const int stride = grid.width() + 2;
+  const float outside = static_cast<float>(beamLogLikelihood(field_.maxDistance(), range_max));
+  table_.assign(static_cast<std::size_t>(stride) * (grid.height() + 2), outside);
+  const std::vector<float>& dist = field_.distances();
+  for (int y = 0; y < grid.height(); ++y) {
+    for (int x = 0; x < grid.width(); ++x) {
+      table_[static_cast<std::size_t>(y + 1) * stride + x + 1] = static_cast<float>(
+          beamLogLikelihood(dist[static_cast<std::size_t>(y) * grid.width() + x], range_max));
+    }
+  }
+  table_range_max_ = range_max;
+}
+
+double LikelihoodFieldModel::logLikelihood(const PreparedScan& scan, const Pose2& pose) const {
+  ParticleSet one;
+  one.resize(1);
+  one.setPose(0, pose);
+  std::vector<double> out;
+  logLikelihoods(scan, one, &out);
+  return out[0];
+}
+
+void LikelihoodFieldModel::logLikelihoods(const PreparedScan& scan, const ParticleSet& particles,
+                                          std::vector<double>* log_likelihood) const {
+  buildTable(scan.range_max);
+  const OccupancyGrid& grid = field_.grid();
+  const float inv_res = static_cast<float>(1.0 / grid.resolution());
+  const int stride = grid.width() + 2;
+  const float max_x = static_cast<float>(grid.width() + 1);
+  const float max_y = static_cast<float>(grid.height() + 1);
+  const float* table = table_.data();
+
+  // End points in cell units, so the inner loop needs no division.
+  const std::size_t n = scan.size();
+  std::vector<float> bx(n), by(n);
+  for (std::size_t b = 0; b < n; ++b) {
+    bx[b] = scan.x[b] * inv_res;
+    by[b] = scan.y[b] * inv_res;
+  }
+
+  log_likelihood->resize(particles.size());
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    // The particle in the grid's frame, in cells, shifted by the one-cell border.
+    const Pose2 local = between(grid.origin(), particles.pose(i));
+    const float px = static_cast<float>(local.x) * inv_res + 1.0f;
+    const float py = static_cast<float>(local.y) * inv_res + 1.0f;
+    const float c = static_cast<float>(std::cos(local.yaw));
+    const float s = static_cast<float>(std::sin(local.yaw));
+    float sum = 0.0f;
+    for (std::size_t b = 0; b < n; ++b) {
+      // Clamping before truncation sends every point outside the map to the
+      // border, and makes truncation equal floor for what remains.
+      const float gx = std::min(std::max(px + c * bx[b] - s * by[b], 0.0f), max_x);
+      const float gy = std::min(std::max(py + s * bx[b] + c * by[b], 0.0f), max_y);
+      sum += table[static_cast<int>(gy) * stride + static_cast<int>(gx)];
+    }
+    (*log_likelihood)[i] = sum;
+  }
+}
+
+}  // namespace pf

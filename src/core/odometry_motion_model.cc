@@ -1,1 +1,105 @@
-// placeholder: being written
+#include "pf_localization/core/odometry_motion_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace pf {
+namespace {
+
+// Below this translation (m) the direction of travel is noise, not motion.
+constexpr double kMinTranslationForHeading = 0.01;
+
+// A rotation of nearly pi before a straight move is a robot reversing, not
+// turning around: its noise must be that of the small angle it really turned.
+double rotationMagnitude(double rot) {
+  return std::min(std::fabs(rot), std::fabs(angleDiff(rot, M_PI)));
+}
+
+void checkAlpha(const char* name, double value) {
+  if (!(value >= 0.0) || !std::isfinite(value)) {
+    throw std::invalid_argument(std::string("motion model: ") + name +
+                                " must be a finite number >= 0, got " + std::to_string(value));
+  }
+}
+
+}  // namespace
+
+OdometryMotionModel::OdometryMotionModel(const OdometryMotionParams& params) : params_(params) {
+  checkAlpha("odom_alpha1", params.alpha1);
+  checkAlpha("odom_alpha2", params.alpha2);
+  checkAlpha("odom_alpha3", params.alpha3);
+  checkAlpha("odom_alpha4", params.alpha4);
+  checkAlpha("odom_alpha5", params.alpha5);
+}
+
+OdometryStep OdometryMotionModel::decompose(const Pose2& from, const Pose2& to) {
+  const double dx = to.x - from.x;
+  const double dy = to.y - from.y;
+  const double trans = std::hypot(dx, dy);
+  const double rot1 =
+      trans < kMinTranslationForHeading ? 0.0 : angleDiff(std::atan2(dy, dx), from.yaw);
+  const double rot2 = angleDiff(angleDiff(to.yaw, from.yaw), rot1);
+  return {rot1, trans, rot2};
+}
+
+void OdometryMotionModel::apply(const Pose2& from, const Pose2& to, ParticleSet* particles,
+                                Random* random) const {
+  if (params_.kind == OdometryMotionParams::Kind::kOmni) {
+    applyOmni(from, to, particles, random);
+  } else {
+    applyDifferential(from, to, particles, random);
+  }
+}
+
+void OdometryMotionModel::applyDifferential(const Pose2& from, const Pose2& to,
+                                            ParticleSet* particles, Random* random) const {
+  const OdometryStep step = decompose(from, to);
+  const double rot1 = rotationMagnitude(step.rot1);
+  const double rot2 = rotationMagnitude(step.rot2);
+  const double trans2 = step.trans * step.trans;
+  const double sigma_rot1 = std::sqrt(params_.alpha1 * rot1 * rot1 + params_.alpha2 * trans2);
+  const double sigma_trans =
+      std::sqrt(params_.alpha3 * trans2 + params_.alpha4 * (rot1 * rot1 + rot2 * rot2));
+  const double sigma_rot2 = std::sqrt(params_.alpha1 * rot2 * rot2 + params_.alpha2 * trans2);
+
+  ParticleSet& p = *particles;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double r1 = step.rot1 - random->gaussian(sigma_rot1);
+    const double t = step.trans - random->gaussian(sigma_trans);
+    const double r2 = step.rot2 - random->gaussian(sigma_rot2);
+    const double heading = p.yaw[i] + r1;
+    p.x[i] += t * std::cos(heading);
+    p.y[i] += t * std::sin(heading);
+    p.yaw[i] = normalizeAngle(heading + r2);
+  }
+}
+
+void OdometryMotionModel::applyOmni(const Pose2& from, const Pose2& to, ParticleSet* particles,
+                                    Random* random) const {
+  const double dx = to.x - from.x;
+  const double dy = to.y - from.y;
+  const double trans = std::hypot(dx, dy);
+  const double rot = angleDiff(to.yaw, from.yaw);
+  // Direction of travel relative to the heading: omni robots may move sideways.
+  const double bearing = trans < kMinTranslationForHeading
+                             ? 0.0
+                             : angleDiff(std::atan2(dy, dx), from.yaw);
+  const double trans2 = trans * trans, rot2 = rot * rot;
+  const double sigma_trans = std::sqrt(params_.alpha3 * trans2 + params_.alpha1 * rot2);
+  const double sigma_rot = std::sqrt(params_.alpha4 * rot2 + params_.alpha2 * trans2);
+  const double sigma_strafe = std::sqrt(params_.alpha1 * rot2 + params_.alpha5 * trans2);
+
+  ParticleSet& p = *particles;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    const double t = trans + random->gaussian(sigma_trans);
+    const double s = random->gaussian(sigma_strafe);
+    const double heading = p.yaw[i] + bearing;
+    p.x[i] += t * std::cos(heading) - s * std::sin(heading);
+    p.y[i] += t * std::sin(heading) + s * std::cos(heading);
+    p.yaw[i] = normalizeAngle(p.yaw[i] + rot + random->gaussian(sigma_rot));
+  }
+}
+
+}  // namespace pf

@@ -1,1 +1,250 @@
-// placeholder: being written
+#include "pf_localization/core/particle_filter.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace pf {
+namespace {
+
+void require(bool ok, const std::string& name, const std::string& range, double value) {
+  if (!ok) {
+    throw std::invalid_argument("invalid parameter " + name + " = " + std::to_string(value) +
+                                ": must be " + range);
+  }
+}
+
+bool finite(double v) { return std::isfinite(v); }
+
+}  // namespace
+
+void validate(const ParticleFilterParams& p) {
+  require(p.kld.min_particles >= 1, "min_particles", ">= 1", p.kld.min_particles);
+  require(p.kld.max_particles >= p.kld.min_particles, "max_particles",
+          ">= min_particles (" + std::to_string(p.kld.min_particles) + ")", p.kld.max_particles);
+  require(p.kld.kld_err > 0.0 && finite(p.kld.kld_err), "kld_err", "> 0", p.kld.kld_err);
+  require(p.kld.confidence > 0.0 && p.kld.confidence < 1.0, "kld_confidence", "in (0, 1)",
+          p.kld.confidence);
+  require(p.kld.bin_xy > 0.0 && finite(p.kld.bin_xy), "kld_bin_xy", "> 0", p.kld.bin_xy);
+  require(p.kld.bin_yaw > 0.0 && finite(p.kld.bin_yaw), "kld_bin_yaw", "> 0", p.kld.bin_yaw);
+  require(p.update_min_d >= 0.0 && finite(p.update_min_d), "update_min_d", ">= 0",
+          p.update_min_d);
+  require(p.update_min_a >= 0.0 && finite(p.update_min_a), "update_min_a", ">= 0",
+          p.update_min_a);
+  require(p.resample_ess_fraction > 0.0 && p.resample_ess_fraction <= 1.0,
+          "resample_ess_fraction", "in (0, 1]", p.resample_ess_fraction);
+  require(p.clusters.cell_xy > 0.0 && finite(p.clusters.cell_xy), "cluster_xy", "> 0",
+          p.clusters.cell_xy);
+  require(p.clusters.cell_yaw > 0.0 && finite(p.clusters.cell_yaw), "cluster_yaw", "> 0",
+          p.clusters.cell_yaw);
+  require(p.recovery.alpha_slow >= 0.0 && p.recovery.alpha_slow <= 1.0, "recovery_alpha_slow",
+          "in [0, 1]", p.recovery.alpha_slow);
+  require(p.recovery.alpha_fast >= 0.0 && p.recovery.alpha_fast <= 1.0, "recovery_alpha_fast",
+          "in [0, 1]", p.recovery.alpha_fast);
+  require(p.recovery.alpha_slow == 0.0 || p.recovery.alpha_fast > p.recovery.alpha_slow,
+          "recovery_alpha_fast", "> recovery_alpha_slow when recovery is on",
+          p.recovery.alpha_fast);
+  const auto& s = p.sensor;
+  require(s.z_hit >= 0.0 && finite(s.z_hit), "laser_z_hit", ">= 0", s.z_hit);
+  require(s.z_rand >= 0.0 && finite(s.z_rand), "laser_z_rand", ">= 0", s.z_rand);
+  require(s.z_hit + s.z_rand > 0.0, "laser_z_hit + laser_z_rand", "> 0", s.z_hit + s.z_rand);
+  require(s.sigma_hit > 0.0 && finite(s.sigma_hit), "laser_sigma_hit", "> 0", s.sigma_hit);
+  require(s.max_distance > 0.0 && finite(s.max_distance), "laser_likelihood_max_dist", "> 0",
+          s.max_distance);
+  require(s.max_beams >= 1, "laser_max_beams", ">= 1", s.max_beams);
+  require(s.range_min >= 0.0 && finite(s.range_min), "laser_min_range", ">= 0", s.range_min);
+  require(s.range_max >= 0.0 && finite(s.range_max), "laser_max_range", ">= 0", s.range_max);
+  const auto& m = p.motion;
+  const double alphas[] = {m.alpha1, m.alpha2, m.alpha3, m.alpha4, m.alpha5};
+  for (int i = 0; i < 5; ++i) {
+    require(alphas[i] >= 0.0 && finite(alphas[i]), "odom_alpha" + std::to_string(i + 1), ">= 0",
+            alphas[i]);
+  }
+}
+
+ParticleFilter::ParticleFilter(const ParticleFilterParams& params)
+    : params_((validate(params), params)), random_(params.seed), motion_model_(params.motion) {}
+
+bool ParticleFilter::setMap(const OccupancyGrid& grid) {
+  if (grid.empty()) throw std::invalid_argument("the map is empty");
+  model_ = std::make_unique<LikelihoodFieldModel>(grid, params_.sensor);
+  if (isInitialized() && grid.isFreeAt(estimate_.pose.x, estimate_.pose.y)) return true;
+  particles_ = ParticleSet();
+  estimate_ = PoseEstimate();
+  has_estimate_ = false;
+  return false;
+}
+
+void ParticleFilter::initializeGaussian(const Pose2& mean, const Eigen::Matrix3d& cov) {
+  if (!mean.isFinite()) throw std::invalid_argument("initial pose is not finite");
+  if (!cov.allFinite() || !cov.isApprox(cov.transpose(), 1e-9)) {
+    throw std::invalid_argument("initial covariance must be finite and symmetric");
+  }
+  // LDLT accepts semi-definite matrices (a zero yaw variance is legitimate).
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(cov);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().array() >= -1e-12).all()) {
+    throw std::invalid_argument("initial covariance must be positive semi-definite");
+  }
+  const Eigen::Matrix3d l = ldlt.matrixL();
+  const Eigen::Vector3d sqrt_d = ldlt.vectorD().cwiseMax(0.0).cwiseSqrt();
+  const Eigen::Matrix3d factor = ldlt.transpositionsP().transpose() * (l * sqrt_d.asDiagonal());
+
+  particles_.resize(params_.kld.max_particles);
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    const Eigen::Vector3d n(random_.gaussian(1.0), random_.gaussian(1.0), random_.gaussian(1.0));
+    const Eigen::Vector3d d = factor * n;
+    particles_.setPose(i, {mean.x + d.x(), mean.y + d.y(), normalizeAngle(mean.yaw + d.z())});
+  }
+  particles_.setUniformWeights();
+  estimate_ = estimatePose(particles_, params_.clusters);
+  restartAfterInitialization();
+}
+
+void ParticleFilter::initializeUniform() {
+  if (!model_) throw std::logic_error("global localization needs a map");
+  if (model_->field().grid().freeCells().empty()) {
+    throw std::logic_error("global localization needs a map with free cells");
+  }
+  particles_.resize(params_.kld.max_particles);
+  for (std::size_t i = 0; i < particles_.size(); ++i) particles_.setPose(i, randomFreePose());
+  particles_.setUniformWeights();
+  estimate_ = estimatePose(particles_, params_.clusters);
+  restartAfterInitialization();
+}
+
+void ParticleFilter::restartAfterInitialization() {
+  // The new particles describe the robot now: the odometry travelled since the
+  // last update must not move them again, so the next update skips motion.
+  restart_ = true;
+  has_estimate_ = false;
+  w_slow_ = w_fast_ = 0.0;
+}
+
+Pose2 ParticleFilter::randomFreePose() {
+  const OccupancyGrid& grid = model_->field().grid();
+  const std::vector<int>& free = grid.freeCells();
+  const int cell = free[random_.index(free.size())];
+  const CellIndex c{cell % grid.width(), cell / grid.width()};
+  // Anywhere inside the cell, not only its centre.
+  const Pose2 local{(c.x + random_.uniform()) * grid.resolution(),
+                    (c.y + random_.uniform()) * grid.resolution(), random_.uniform(-M_PI, M_PI)};
+  return compose(grid.origin(), local);
+}
+
+UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
+  UpdateReport report;
+  report.particles = particles_.size();
+  if (!model_) {
+    report.skip_reason = "no map yet";
+    return report;
+  }
+  if (!isInitialized()) {
+    report.skip_reason = "the filter is not initialised";
+    return report;
+  }
+  if (!odom.isFinite()) {
+    report.skip_reason = "the odometry pose is not finite";
+    return report;
+  }
+  if (const auto error = validateScan(scan)) {
+    report.skip_reason = "bad scan: " + *error;
+    return report;
+  }
+
+  const bool first = restart_ || !odom_at_update_;
+  if (!first && !force_update_) {
+    const Pose2 delta = between(*odom_at_update_, odom);
+    if (std::hypot(delta.x, delta.y) < params_.update_min_d &&
+        std::fabs(delta.yaw) < params_.update_min_a) {
+      report.skip_reason = "not moved enough since the last update";
+      return report;
+    }
+  }
+
+  const PreparedScan prepared = model_->prepare(scan);
+  report.beams_used = static_cast<int>(prepared.size());
+  report.beams_dropped = prepared.dropped;
+  if (prepared.size() == 0) {
+    // Without evidence the cloud would only be moved; keep the odometry
+    // reference so the motion is applied once a usable scan comes.
+    report.skip_reason = "no valid beam in the scan (" + std::to_string(prepared.dropped) +
+                         " of " + std::to_string(scan.ranges.size()) + " invalid)";
+    return report;
+  }
+
+  if (!first) motion_model_.apply(*odom_at_update_, odom, &particles_, &random_);
+  odom_at_update_ = odom;
+  restart_ = false;
+  force_update_ = false;
+
+  weigh(prepared, &report);
+  report.ess = effectiveSampleSize(particles_.weight);
+  resample(&report);
+  estimate_ = estimatePose(particles_, params_.clusters);
+  has_estimate_ = true;
+  report.updated = true;
+  report.particles = particles_.size();
+  return report;
+}
+
+void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
+  model_->logLikelihoods(scan, particles_, &scratch_);
+  const double beams = static_cast<double>(scan.size());
+  double max_log = -std::numeric_limits<double>::infinity();
+  double mean_beam = 0.0;
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    // The geometric mean of the beam likelihoods does not depend on the beam
+    // count, which makes it comparable across scans and robots.
+    mean_beam += particles_.weight[i] * std::exp(scratch_[i] / beams);
+    scratch_[i] += std::log(particles_.weight[i]);
+    max_log = std::max(max_log, scratch_[i]);
+  }
+  double total = 0.0;
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    particles_.weight[i] = std::exp(scratch_[i] - max_log);
+    total += particles_.weight[i];
+  }
+  for (double& w : particles_.weight) w /= total;
+  report->mean_beam_likelihood = mean_beam;
+
+  if (params_.recovery.alpha_slow > 0.0) {
+    if (w_slow_ == 0.0) {
+      w_slow_ = w_fast_ = mean_beam;
+    } else {
+      w_slow_ += params_.recovery.alpha_slow * (mean_beam - w_slow_);
+      w_fast_ += params_.recovery.alpha_fast * (mean_beam - w_fast_);
+    }
+  }
+}
+
+void ParticleFilter::resample(UpdateReport* report) {
+  const double inject_probability =
+      w_slow_ > 0.0 ? std::max(0.0, 1.0 - w_fast_ / w_slow_) : 0.0;
+  const std::size_t n = static_cast<std::size_t>(particles_.size());
+  if (report->ess >= params_.resample_ess_fraction * n && inject_probability < 0.01) return;
+
+  const std::size_t target = kldParticleCount(particles_, params_.kld);
+  const auto injected = static_cast<std::size_t>(
+      std::floor(inject_probability * target + random_.uniform()));
+  systematicResample(&particles_, target - std::min(injected, target), &random_);
+  for (std::size_t i = 0; i < injected && i < target; ++i) {
+    particles_.x.push_back(0.0);
+    particles_.y.push_back(0.0);
+    particles_.yaw.push_back(0.0);
+    particles_.setPose(particles_.size() - 1, randomFreePose());
+  }
+  particles_.weight.resize(particles_.size());
+  particles_.setUniformWeights();
+  if (injected > 0) w_slow_ = w_fast_ = 0.0;  // start the averages afresh, as amcl does
+  report->resampled = true;
+  report->injected = std::min(injected, target);
+}
+
+std::optional<Pose2> ParticleFilter::mapToOdom() const {
+  if (!has_estimate_ || !odom_at_update_) return std::nullopt;
+  return compose(estimate_.pose, inverse(*odom_at_update_));
+}
+
+}  // namespace pf

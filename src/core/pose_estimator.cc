@@ -1,1 +1,104 @@
-// placeholder: being written
+#include "pf_localization/core/pose_estimator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <unordered_map>
+
+namespace pf {
+namespace {
+
+struct BinKey {
+  int64_t x, y, yaw;
+  bool operator==(const BinKey& o) const { return x == o.x && y == o.y && yaw == o.yaw; }
+};
+
+struct BinKeyHash {
+  std::size_t operator()(const BinKey& k) const {
+    return static_cast<std::size_t>(k.x * 73856093) ^ static_cast<std::size_t>(k.y * 19349663) ^
+           static_cast<std::size_t>(k.yaw * 83492791);
+  }
+};
+
+int find(std::vector<int>& parent, int i) {
+  while (parent[i] != i) i = parent[i] = parent[parent[i]];
+  return i;
+}
+
+}  // namespace
+
+Cluster summarize(const ParticleSet& particles, const std::vector<std::size_t>& indices) {
+  Cluster c;
+  c.count = indices.size();
+  double sx = 0.0, sy = 0.0, ss = 0.0, sc = 0.0;
+  for (std::size_t i : indices) {
+    const double w = particles.weight[i];
+    c.weight += w;
+    sx += w * particles.x[i];
+    sy += w * particles.y[i];
+    ss += w * std::sin(particles.yaw[i]);
+    sc += w * std::cos(particles.yaw[i]);
+  }
+  if (!(c.weight > 0.0)) return c;
+  c.mean = {sx / c.weight, sy / c.weight, std::atan2(ss, sc)};
+  for (std::size_t i : indices) {
+    const Eigen::Vector3d d(particles.x[i] - c.mean.x, particles.y[i] - c.mean.y,
+                            angleDiff(particles.yaw[i], c.mean.yaw));
+    c.covariance += particles.weight[i] * d * d.transpose();
+  }
+  c.covariance /= c.weight;
+  return c;
+}
+
+PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& params) {
+  PoseEstimate estimate;
+  if (particles.empty()) return estimate;
+
+  // Bin every particle; yaw bins wrap around, so the last bin touches the first.
+  const int64_t yaw_bins = std::max<int64_t>(1, std::llround(2.0 * M_PI / params.cell_yaw));
+  std::unordered_map<BinKey, int, BinKeyHash> bin_of;
+  std::vector<BinKey> keys;
+  std::vector<int> particle_bin(particles.size());
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    const double yaw01 = (normalizeAngle(particles.yaw[i]) + M_PI) / (2.0 * M_PI);
+    const BinKey key{static_cast<int64_t>(std::floor(particles.x[i] / params.cell_xy)),
+                     static_cast<int64_t>(std::floor(particles.y[i] / params.cell_xy)),
+                     std::min(yaw_bins - 1, static_cast<int64_t>(yaw01 * yaw_bins))};
+    auto [it, inserted] = bin_of.try_emplace(key, static_cast<int>(keys.size()));
+    if (inserted) keys.push_back(key);
+    particle_bin[i] = it->second;
+  }
+
+  // Join occupied bins that touch (26-neighbourhood) into clusters.
+  std::vector<int> parent(keys.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  for (std::size_t b = 0; b < keys.size(); ++b) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dt = -1; dt <= 1; ++dt) {
+          const BinKey n{keys[b].x + dx, keys[b].y + dy, ((keys[b].yaw + dt) % yaw_bins + yaw_bins) % yaw_bins};
+          const auto it = bin_of.find(n);
+          if (it != bin_of.end()) parent[find(parent, static_cast<int>(b))] = find(parent, it->second);
+        }
+      }
+    }
+  }
+
+  std::unordered_map<int, std::vector<std::size_t>> members;
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    members[find(parent, particle_bin[i])].push_back(i);
+  }
+  for (const auto& m : members) estimate.clusters.push_back(summarize(particles, m.second));
+  // Heaviest first; ties broken by the mean so the order never depends on hashing.
+  std::sort(estimate.clusters.begin(), estimate.clusters.end(),
+            [](const Cluster& a, const Cluster& b) {
+              if (a.weight != b.weight) return a.weight > b.weight;
+              if (a.mean.x != b.mean.x) return a.mean.x < b.mean.x;
+              return a.mean.y < b.mean.y;
+            });
+  estimate.pose = estimate.clusters.front().mean;
+  estimate.covariance = estimate.clusters.front().covariance;
+  return estimate;
+}
+
+}  // namespace pf

@@ -1,1 +1,106 @@
-// placeholder: being written
+#include "pf_localization/core/resampler.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <unordered_map>
+
+namespace pf {
+
+double effectiveSampleSize(const std::vector<double>& weights) {
+  double sum_sq = 0.0;
+  for (double w : weights) sum_sq += w * w;
+  return sum_sq > 0.0 ? 1.0 / sum_sq : 0.0;
+}
+
+void systematicResample(ParticleSet* particles, std::size_t n, Random* random) {
+  const ParticleSet& in = *particles;
+  ParticleSet out;
+  out.resize(n);
+  if (in.empty() || n == 0) {
+    out.resize(0);
+    *particles = std::move(out);
+    return;
+  }
+  double total = 0.0;
+  for (double w : in.weight) total += w;
+  const double step = total / static_cast<double>(n);
+  double pointer = random->uniform() * step;
+  double cumulative = in.weight[0];
+  std::size_t j = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    // The last particle absorbs rounding in the cumulative sum.
+    while (pointer > cumulative && j + 1 < in.size()) cumulative += in.weight[++j];
+    out.x[i] = in.x[j];
+    out.y[i] = in.y[j];
+    out.yaw[i] = in.yaw[j];
+    pointer += step;
+  }
+  out.setUniformWeights();
+  *particles = std::move(out);
+}
+
+double normalQuantile(double p) {
+  if (!(p > 0.0 && p < 1.0)) throw std::invalid_argument("normalQuantile: p must be in (0, 1)");
+  // Acklam's rational approximation of the inverse normal CDF (relative error
+  // below 1.2e-9), refined by one Halley step against std::erfc.
+  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02,
+                             1.383577518672690e+02,  -3.066479806614716e+01, 2.506628277459239e+00};
+  static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
+                             6.680131188771972e+01, -1.328068155288572e+01};
+  static const double c[] = {-7.784894002430293e-03, -3.223964580411365e-01, -2.400758277161838e+00,
+                             -2.549732539343734e+00, 4.374664141464968e+00,  2.938163982698783e+00};
+  static const double d[] = {7.784695709041462e-03, 3.224671290700398e-01, 2.445134137142996e+00,
+                             3.754408661907416e+00};
+  const double p_low = 0.02425;
+  double x;
+  if (p < p_low) {
+    const double q = std::sqrt(-2.0 * std::log(p));
+    x = (((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+        ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
+  } else if (p <= 1.0 - p_low) {
+    const double q = p - 0.5, r = q * q;
+    x = (((((a[0] * r + a[1]) * r + a[2]) * r + a[3]) * r + a[4]) * r + a[5]) * q /
+        (((((b[0] * r + b[1]) * r + b[2]) * r + b[3]) * r + b[4]) * r + 1.0);
+  } else {
+    const double q = std::sqrt(-2.0 * std::log(1.0 - p));
+    x = -(((((c[0] * q + c[1]) * q + c[2]) * q + c[3]) * q + c[4]) * q + c[5]) /
+        ((((d[0] * q + d[1]) * q + d[2]) * q + d[3]) * q + 1.0);
+  }
+  const double e = 0.5 * std::erfc(-x / std::sqrt(2.0)) - p;
+  const double u = e * std::sqrt(2.0 * M_PI) * std::exp(x * x / 2.0);
+  return x - u / (1.0 + x * u / 2.0);
+}
+
+double kldBound(std::size_t k, double kld_err, double confidence) {
+  if (k <= 1) return 1.0;
+  const double z = normalQuantile(confidence);
+  const double a = 2.0 / (9.0 * static_cast<double>(k - 1));
+  const double b = 1.0 - a + std::sqrt(a) * z;
+  return static_cast<double>(k - 1) / (2.0 * kld_err) * b * b * b;
+}
+
+std::size_t kldParticleCount(const ParticleSet& particles, const KldParams& params) {
+  // A bin counts when its weight promises at least one survivor out of a
+  // resample of the current size: bins holding only negligible particles
+  // will be empty after resampling and must not inflate k.
+  const double threshold = particles.empty() ? 0.0 : 1.0 / static_cast<double>(particles.size());
+  std::unordered_map<uint64_t, double> bins;
+  bins.reserve(particles.size());
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    const auto bx = static_cast<int64_t>(std::floor(particles.x[i] / params.bin_xy));
+    const auto by = static_cast<int64_t>(std::floor(particles.y[i] / params.bin_xy));
+    const auto bt = static_cast<int64_t>(std::floor(particles.yaw[i] / params.bin_yaw));
+    const uint64_t key = (static_cast<uint64_t>(bx & 0x1FFFFF) << 42) |
+                         (static_cast<uint64_t>(by & 0x1FFFFF) << 21) |
+                         static_cast<uint64_t>(bt & 0x1FFFFF);
+    bins[key] += particles.weight[i];
+  }
+  std::size_t k = 0;
+  for (const auto& bin : bins) k += bin.second >= threshold ? 1 : 0;
+  const double n = std::ceil(kldBound(k, params.kld_err, params.confidence));
+  const double lo = params.min_particles, hi = params.max_particles;
+  return static_cast<std::size_t>(std::clamp(n, lo, hi));
+}
+
+}  // namespace pf

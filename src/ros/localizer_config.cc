@@ -1,1 +1,164 @@
-// placeholder: being written
+#include "pf_localization/ros/localizer_config.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace pf_ros {
+namespace {
+
+class YamlParamSource : public ParamSource {
+ public:
+  YamlParamSource(YAML::Node root, std::string path)
+      : root_(std::move(root)), path_(std::move(path)) {}
+  bool get(const std::string& key, double* value) const override { return read(key, value); }
+  bool get(const std::string& key, int* value) const override { return read(key, value); }
+  bool get(const std::string& key, bool* value) const override { return read(key, value); }
+  bool get(const std::string& key, std::string* value) const override { return read(key, value); }
+
+ private:
+  template <typename T>
+  bool read(const std::string& key, T* value) const {
+    const YAML::Node node = root_[key];
+    if (!node || node.IsNull()) return false;
+    try {
+      *value = node.as<T>();
+    } catch (const YAML::Exception&) {
+      throw std::invalid_argument(path_ + ": parameter " + key + " has the wrong type");
+    }
+    return true;
+  }
+
+  YAML::Node root_;
+  std::string path_;
+};
+
+class RosParamSource : public ParamSource {
+ public:
+  explicit RosParamSource(const ros::NodeHandle& nh) : nh_(nh) {}
+  bool get(const std::string& key, double* value) const override { return read(key, value); }
+  bool get(const std::string& key, int* value) const override { return read(key, value); }
+  bool get(const std::string& key, bool* value) const override { return read(key, value); }
+  bool get(const std::string& key, std::string* value) const override { return read(key, value); }
+
+ private:
+  template <typename T>
+  bool read(const std::string& key, T* value) const {
+    if (!nh_.hasParam(key)) return false;
+    if (!nh_.getParam(key, *value)) {
+      throw std::invalid_argument("parameter " + nh_.resolveName(key) + " has the wrong type");
+    }
+    return true;
+  }
+
+  ros::NodeHandle nh_;
+};
+
+void require(bool ok, const std::string& name, const std::string& range) {
+  if (!ok) throw std::invalid_argument("invalid parameter " + name + ": must be " + range);
+}
+
+}  // namespace
+
+std::unique_ptr<ParamSource> yamlParamSource(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(path + ": cannot read parameters: " + e.what());
+  }
+  if (!root.IsMap() && !root.IsNull()) throw std::runtime_error(path + ": not a YAML mapping");
+  return std::make_unique<YamlParamSource>(root, path);
+}
+
+std::unique_ptr<ParamSource> rosParamSource(const ros::NodeHandle& nh) {
+  return std::make_unique<RosParamSource>(nh);
+}
+
+LocalizerConfig readConfig(const ParamSource& p) {
+  LocalizerConfig c;
+  p.get("global_frame", &c.global_frame);
+  p.get("odom_frame", &c.odom_frame);
+  p.get("base_frame", &c.base_frame);
+  p.get("tf_broadcast", &c.tf_broadcast);
+  p.get("transform_tolerance", &c.transform_tolerance);
+  p.get("tf_publish_rate", &c.tf_publish_rate);
+
+  pf::Pose2 initial{std::nan(""), std::nan(""), 0.0};
+  p.get("initial_pose_x", &initial.x);
+  p.get("initial_pose_y", &initial.y);
+  p.get("initial_pose_a", &initial.yaw);
+  if (std::isfinite(initial.x) && std::isfinite(initial.y)) {
+    require(std::isfinite(initial.yaw), "initial_pose_a", "a finite angle in rad");
+    c.initial_pose = initial;
+  }
+  double cov_xx = c.initial_cov(0, 0), cov_yy = c.initial_cov(1, 1), cov_aa = c.initial_cov(2, 2);
+  p.get("initial_cov_xx", &cov_xx);
+  p.get("initial_cov_yy", &cov_yy);
+  p.get("initial_cov_aa", &cov_aa);
+  require(cov_xx >= 0.0 && std::isfinite(cov_xx), "initial_cov_xx", ">= 0 (m^2)");
+  require(cov_yy >= 0.0 && std::isfinite(cov_yy), "initial_cov_yy", ">= 0 (m^2)");
+  require(cov_aa >= 0.0 && std::isfinite(cov_aa), "initial_cov_aa", ">= 0 (rad^2)");
+  c.initial_cov = Eigen::Vector3d(cov_xx, cov_yy, cov_aa).asDiagonal();
+
+  pf::ParticleFilterParams& f = c.filter;
+  p.get("min_particles", &f.kld.min_particles);
+  p.get("max_particles", &f.kld.max_particles);
+  p.get("kld_err", &f.kld.kld_err);
+  p.get("kld_confidence", &f.kld.confidence);
+  p.get("kld_bin_xy", &f.kld.bin_xy);
+  p.get("kld_bin_yaw", &f.kld.bin_yaw);
+  p.get("update_min_d", &f.update_min_d);
+  p.get("update_min_a", &f.update_min_a);
+  p.get("resample_ess_fraction", &f.resample_ess_fraction);
+  int seed = 0;
+  if (p.get("seed", &seed)) {
+    require(seed >= 0, "seed", ">= 0");
+    f.seed = static_cast<uint64_t>(seed);
+  }
+  p.get("cluster_xy", &f.clusters.cell_xy);
+  p.get("cluster_yaw", &f.clusters.cell_yaw);
+  p.get("recovery_alpha_slow", &f.recovery.alpha_slow);
+  p.get("recovery_alpha_fast", &f.recovery.alpha_fast);
+
+  std::string odom_model = "diff";
+  p.get("odom_model_type", &odom_model);
+  // amcl's "-corrected" variants fixed bugs of its own; the models here are the corrected ones.
+  if (odom_model == "diff" || odom_model == "diff-corrected") {
+    f.motion.kind = pf::OdometryMotionParams::Kind::kDifferential;
+  } else if (odom_model == "omni" || odom_model == "omni-corrected") {
+    f.motion.kind = pf::OdometryMotionParams::Kind::kOmni;
+  } else {
+    require(false, "odom_model_type", "diff or omni, got '" + odom_model + "'");
+  }
+  p.get("odom_alpha1", &f.motion.alpha1);
+  p.get("odom_alpha2", &f.motion.alpha2);
+  p.get("odom_alpha3", &f.motion.alpha3);
+  p.get("odom_alpha4", &f.motion.alpha4);
+  p.get("odom_alpha5", &f.motion.alpha5);
+
+  p.get("laser_max_beams", &f.sensor.max_beams);
+  p.get("laser_z_hit", &f.sensor.z_hit);
+  p.get("laser_z_rand", &f.sensor.z_rand);
+  p.get("laser_sigma_hit", &f.sensor.sigma_hit);
+  p.get("laser_likelihood_max_dist", &f.sensor.max_distance);
+  p.get("laser_min_range", &f.sensor.range_min);
+  p.get("laser_max_range", &f.sensor.range_max);
+  // amcl spells "use the scan's own limit" as -1; accept that spelling too.
+  f.sensor.range_min = std::max(f.sensor.range_min, 0.0);
+  f.sensor.range_max = std::max(f.sensor.range_max, 0.0);
+
+  require(!c.global_frame.empty(), "global_frame", "a frame name");
+  require(!c.odom_frame.empty(), "odom_frame", "a frame name");
+  require(!c.base_frame.empty(), "base_frame", "a frame name");
+  require(c.transform_tolerance >= 0.0 && std::isfinite(c.transform_tolerance),
+          "transform_tolerance", ">= 0 (s)");
+  require(c.tf_publish_rate > 0.0 && std::isfinite(c.tf_publish_rate), "tf_publish_rate",
+          "> 0 (Hz)");
+  pf::validate(f);
+  return c;
+}
+
+}  // namespace pf_ros

@@ -1,1 +1,160 @@
-// placeholder: being written
+#include "pf_localization/ros/scan_localizer.h"
+
+#include <tf2/exceptions.h>
+
+#include <cmath>
+#include <sstream>
+
+#include "pf_localization/ros/conversions.h"
+
+namespace pf_ros {
+namespace {
+
+std::string describe(const ros::Time& t) {
+  std::ostringstream s;
+  s.precision(3);
+  s << std::fixed << t.toSec();
+  return s.str();
+}
+
+}  // namespace
+
+ScanLocalizer::ScanLocalizer(const LocalizerConfig& config, const tf2::BufferCore* tf)
+    : config_(config), tf_(tf), filter_(config.filter) {}
+
+std::string ScanLocalizer::setMap(const nav_msgs::OccupancyGrid& map) {
+  pf::OccupancyGrid grid;
+  try {
+    grid = toCore(map);
+  } catch (const std::invalid_argument& e) {
+    return std::string("ignoring the map: ") + e.what();
+  }
+  if (grid.freeCells().empty()) {
+    return "ignoring the map: it has no free cell, so no pose on it is possible";
+  }
+  if (!map.header.frame_id.empty() && map.header.frame_id != config_.global_frame) {
+    return "ignoring the map: its frame '" + map.header.frame_id + "' is not the global frame '" +
+           config_.global_frame + "'";
+  }
+  const bool kept = filter_.setMap(grid);
+  const bool first = !had_map_;
+  had_map_ = true;
+  if (kept) return "";
+  // A first map starts from the configured pose; a replaced map whose free
+  // space no longer holds the estimate leaves nothing to track from.
+  if (first && config_.initial_pose) {
+    filter_.initializeGaussian(*config_.initial_pose, config_.initial_cov);
+    return "";
+  }
+  return startGlobalLocalization();
+}
+
+std::string ScanLocalizer::setInitialPose(const geometry_msgs::PoseWithCovarianceStamped& msg) {
+  const pf::Pose2 pose = toPose2(msg.pose.pose);
+  if (!pose.isFinite()) return "ignoring the initial pose: it is not finite (NaN or inf)";
+  const auto& q = msg.pose.pose.orientation;
+  if (!std::isfinite(q.x + q.y + q.z + q.w) ||
+      q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w < 1e-9) {
+    return "ignoring the initial pose: its orientation is not a valid quaternion";
+  }
+  Eigen::Matrix3d cov = fromRosCovariance(msg.pose.covariance);
+  if (!cov.allFinite()) return "ignoring the initial pose: its covariance is not finite";
+  // rviz sends a fixed covariance; an all-zero one means "no opinion".
+  if (cov.isZero()) cov = config_.initial_cov;
+  config_.initial_pose = pose;
+  config_.initial_cov = cov;
+  if (!filter_.hasMap()) return "";  // used when the map arrives
+  try {
+    filter_.initializeGaussian(pose, cov);
+  } catch (const std::invalid_argument& e) {
+    return std::string("ignoring the initial pose: ") + e.what();
+  }
+  return "";
+}
+
+std::string ScanLocalizer::startGlobalLocalization() {
+  if (!filter_.hasMap()) return "global localization needs a map; none has arrived yet";
+  try {
+    filter_.initializeUniform();
+  } catch (const std::logic_error& e) {
+    return std::string("global localization failed: ") + e.what();
+  }
+  return "";
+}
+
+ScanResult ScanLocalizer::processScan(const sensor_msgs::LaserScan& scan) {
+  ScanResult result;
+  if (!filter_.hasMap()) {
+    result.error = "no map received yet: waiting for one on the map topic";
+    return result;
+  }
+  if (scan.header.frame_id.empty()) {
+    result.error = "the scan has an empty frame_id: cannot place the laser on the robot";
+    return result;
+  }
+  geometry_msgs::TransformStamped laser, odom;
+  try {
+    // The mounting is rigid: the newest transform is as good as one at the
+    // stamp, and does not fail on a mount published at a low rate.
+    laser = tf_->lookupTransform(config_.base_frame, scan.header.frame_id, ros::Time(0));
+  } catch (const tf2::TransformException& e) {
+    result.error = "cannot place the laser on the robot: tf lookup " + config_.base_frame + " -> " +
+                   scan.header.frame_id + " failed: " + e.what();
+    return result;
+  }
+  try {
+    odom = tf_->lookupTransform(config_.odom_frame, config_.base_frame, scan.header.stamp);
+  } catch (const tf2::TransformException& e) {
+    result.error = "no odometry at the scan's stamp " + describe(scan.header.stamp) +
+                   ": tf lookup " + config_.odom_frame + " -> " + config_.base_frame +
+                   " failed: " + e.what();
+    return result;
+  }
+  result.odom = toPose2(odom.transform);
+  result.report = filter_.update(*result.odom, toCore(scan, toPose2(laser.transform)));
+  return result;
+}
+
+std::optional<geometry_msgs::TransformStamped> ScanLocalizer::mapToOdom(
+    const ros::Time& stamp) const {
+  const auto m2o = filter_.mapToOdom();
+  if (!m2o) return std::nullopt;
+  geometry_msgs::TransformStamped t;
+  t.header.stamp = stamp;
+  t.header.frame_id = config_.global_frame;
+  t.child_frame_id = config_.odom_frame;
+  t.transform = toTransformMsg(*m2o);
+  return t;
+}
+
+std::optional<geometry_msgs::PoseWithCovarianceStamped> ScanLocalizer::estimate(
+    const ros::Time& stamp) const {
+  if (!filter_.isInitialized()) return std::nullopt;
+  geometry_msgs::PoseWithCovarianceStamped msg;
+  msg.header.stamp = stamp;
+  msg.header.frame_id = config_.global_frame;
+  msg.pose.pose = toPoseMsg(filter_.estimate().pose);
+  msg.pose.covariance = toRosCovariance(filter_.estimate().covariance);
+  return msg;
+}
+
+geometry_msgs::PoseArray ScanLocalizer::particleCloud(const ros::Time& stamp) const {
+  geometry_msgs::PoseArray msg;
+  msg.header.stamp = stamp;
+  msg.header.frame_id = config_.global_frame;
+  toPoseArray(filter_.particles(), &msg);
+  return msg;
+}
+
+geometry_msgs::TransformStamped odometryToTransform(const nav_msgs::Odometry& odom) {
+  geometry_msgs::TransformStamped t;
+  t.header = odom.header;
+  t.child_frame_id = odom.child_frame_id;
+  t.transform.translation.x = odom.pose.pose.position.x;
+  t.transform.translation.y = odom.pose.pose.position.y;
+  t.transform.translation.z = odom.pose.pose.position.z;
+  t.transform.rotation = odom.pose.pose.orientation;
+  return t;
+}
+
+}  // namespace pf_ros

@@ -1,1 +1,157 @@
-// placeholder: being written
+#include "pf_localization/sim/building_map.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pf::sim {
+
+MapCanvas::MapCanvas(const Box& extent, double resolution)
+    : extent_(extent),
+      resolution_(resolution),
+      width_(static_cast<int>(std::lround((extent.x1 - extent.x0) / resolution))),
+      height_(static_cast<int>(std::lround((extent.y1 - extent.y0) / resolution))),
+      data_(static_cast<std::size_t>(width_) * height_, kUnknown) {}
+
+template <typename Inside>
+void MapCanvas::paint(const Box& bounds, int8_t value, Inside inside) {
+  const auto first = [&](double lo, double origin) {
+    return std::max(0, static_cast<int>(std::floor((lo - origin) / resolution_)));
+  };
+  const int i0 = first(bounds.x0, extent_.x0), j0 = first(bounds.y0, extent_.y0);
+  for (int j = j0; j < height_; ++j) {
+    const double y = extent_.y0 + (j + 0.5) * resolution_;
+    if (y > bounds.y1) break;
+    for (int i = i0; i < width_; ++i) {
+      const double x = extent_.x0 + (i + 0.5) * resolution_;
+      if (x > bounds.x1) break;
+      if (x >= bounds.x0 && y >= bounds.y0 && inside(x, y)) data_[j * width_ + i] = value;
+    }
+  }
+}
+
+void MapCanvas::fill(const Box& box, int8_t value) {
+  paint(box, value, [](double, double) { return true; });
+}
+
+void MapCanvas::disc(double cx, double cy, double radius, int8_t value) {
+  paint({cx - radius, cy - radius, cx + radius, cy + radius}, value,
+        [&](double x, double y) { return std::hypot(x - cx, y - cy) <= radius; });
+}
+
+void MapCanvas::segment(double x0, double y0, double x1, double y1, double thickness,
+                        int8_t value) {
+  const double h = 0.5 * thickness;
+  const double dx = x1 - x0, dy = y1 - y0;
+  const double length2 = dx * dx + dy * dy;
+  const Box bounds{std::min(x0, x1) - h, std::min(y0, y1) - h, std::max(x0, x1) + h,
+                   std::max(y0, y1) + h};
+  paint(bounds, value, [&](double x, double y) {
+    const double t = std::clamp(((x - x0) * dx + (y - y0) * dy) / length2, 0.0, 1.0);
+    return std::hypot(x - (x0 + t * dx), y - (y0 + t * dy)) <= h;
+  });
+}
+
+void MapCanvas::triangle(double ax, double ay, double bx, double by, double cx, double cy,
+                         int8_t value) {
+  // Inside when the point is on the same side of all three edges.
+  const auto side = [](double px, double py, double qx, double qy, double x, double y) {
+    return (qx - px) * (y - py) - (qy - py) * (x - px);
+  };
+  const Box bounds{std::min({ax, bx, cx}), std::min({ay, by, cy}), std::max({ax, bx, cx}),
+                   std::max({ay, by, cy})};
+  paint(bounds, value, [&](double x, double y) {
+    const double s1 = side(ax, ay, bx, by, x, y), s2 = side(bx, by, cx, cy, x, y),
+                 s3 = side(cx, cy, ax, ay, x, y);
+    return (s1 >= 0 && s2 >= 0 && s3 >= 0) || (s1 <= 0 && s2 <= 0 && s3 <= 0);
+  });
+}
+
+OccupancyGrid MapCanvas::grid() const {
+  return OccupancyGrid(width_, height_, resolution_, {extent_.x0, extent_.y0, 0.0}, data_);
+}
+
+namespace {
+
+constexpr double kResolution = 0.05;
+constexpr int8_t kFree = MapCanvas::kFree;
+constexpr int8_t kWall = MapCanvas::kOccupied;
+constexpr int8_t kUnknown = MapCanvas::kUnknown;
+
+// Everything in a twin room is placed relative to its south-west interior
+// corner, so that the two rooms cannot differ.
+void drawTwinRoom(MapCanvas* c, double x0) {
+  const double y0 = kTwinRoomA.y0;
+  const auto rel = [&](double ax, double ay, double bx, double by) {
+    return Box{x0 + ax, y0 + ay, x0 + bx, y0 + by};
+  };
+  c->fill(rel(0.0, 0.0, 4.6, 6.05), kFree);
+  c->fill(rel(1.6, -0.15, 2.6, 0.0), kFree);  // door to the corridor
+  c->fill(rel(2.4, 3.4, 3.6, 4.2), kWall);    // table
+  c->fill(rel(0.0, 1.0, 0.5, 2.2), kWall);    // cabinet
+  c->fill(rel(0.6, 5.25, 2.6, 6.05), kWall);  // sofa
+}
+
+}  // namespace
+
+OccupancyGrid makeBuildingMap() {
+  MapCanvas c({-1.0, -1.0, 21.0, 16.0}, kResolution);
+  // The outline, solid; the north-east notch stays unknown.
+  c.fill({0.0, 0.0, 20.0, 11.5}, kWall);
+  c.fill({0.0, 11.5, 15.5, 15.0}, kWall);
+
+  // Corridor and its doorways (walls at y 6.5-6.65 and 8.5-8.65).
+  c.fill({0.3, 6.65, 19.7, 8.5}, kFree);
+  c.fill({11.6, 8.5, 12.6, 8.65}, kFree);   // lab
+  c.fill({17.0, 8.5, 18.0, 8.65}, kFree);   // office
+  c.fill({2.5, 6.5, 3.5, 6.65}, kFree);     // kitchen
+  c.fill({8.4, 6.5, 10.8, 6.65}, kFree);    // lobby, a wide opening
+  c.fill({15.3, 6.5, 16.3, 6.65}, kFree);   // storage
+
+  drawTwinRoom(&c, kTwinRoomA.x0);
+  drawTwinRoom(&c, kTwinRoomB.x0);
+
+  // Lab: four pillars and a long desk.
+  c.fill({9.8, 8.65, 15.2, 14.7}, kFree);
+  for (double px : {11.1, 13.5}) {
+    for (double py : {10.4, 12.7}) c.fill({px, py, px + 0.4, py + 0.4}, kWall);
+  }
+  c.fill({10.2, 14.0, 12.6, 14.7}, kWall);
+
+  // Office under the notch.
+  c.fill({15.5, 8.65, 19.7, 11.2}, kFree);
+  c.fill({18.4, 9.6, 19.7, 10.8}, kWall);  // desk
+
+  // Kitchen: island, counter, and a wall stub from the west wall.
+  c.fill({0.3, 0.3, 6.0, 6.5}, kFree);
+  c.fill({2.0, 2.4, 4.0, 3.4}, kWall);
+  c.fill({0.3, 0.3, 3.5, 0.9}, kWall);
+  c.fill({0.3, 4.5, 1.5, 4.65}, kWall);
+
+  // Lobby: a diagonal wall cuts off the south-west corner (never seen, so
+  // unknown behind it), a round column, a bench.
+  c.fill({6.15, 0.3, 13.0, 6.5}, kFree);
+  c.triangle(6.15, 0.3, 8.3, 0.3, 6.15, 2.3, kUnknown);
+  c.segment(6.15, 2.3, 8.3, 0.3, 0.2, kWall);
+  c.disc(10.0, 3.2, 0.35, kWall);
+  c.fill({11.0, 0.3, 12.6, 0.8}, kWall);
+
+  // Storage: two shelves, and a locked closet in the south-east corner.
+  c.fill({13.15, 0.3, 19.7, 6.5}, kFree);
+  c.fill({14.0, 1.2, 14.4, 4.8}, kWall);
+  c.fill({16.6, 1.2, 17.0, 4.8}, kWall);
+  c.fill({17.85, 0.3, 19.7, 2.65}, kWall);
+  c.fill({18.0, 0.3, 19.7, 2.5}, kUnknown);
+  return c.grid();
+}
+
+OccupancyGrid makeSmallMap() {
+  MapCanvas c({-0.5, -0.5, 6.5, 4.5}, kResolution);
+  c.fill({0.0, 0.0, 6.0, 4.0}, kWall);
+  c.fill({0.15, 0.15, 5.85, 3.85}, kFree);
+  c.fill({4.4, 3.05, 5.85, 3.85}, kWall);  // cabinet in the north-east corner
+  c.disc(1.8, 1.2, 0.25, kWall);           // column
+  c.fill({3.5, 0.15, 3.65, 1.5}, kWall);   // wall stub from the south wall
+  return c.grid();
+}
+
+}  // namespace pf::sim

@@ -1,1 +1,214 @@
-// placeholder: being written
+#include "pf_localization/sim/path_script.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <sstream>
+
+#include "pf_localization/sim/diff_drive_robot.h"
+
+namespace pf::sim {
+
+void Person::positionAt(double t, double* x, double* y) const {
+  const double length = std::hypot(x2 - x1, y2 - y1);
+  double s = 0.0;
+  if (length > 0.0 && speed > 0.0) {
+    s = std::fmod(speed * t, 2.0 * length);
+    if (s > length) s = 2.0 * length - s;  // on the way back
+    s /= length;
+  }
+  *x = x1 + s * (x2 - x1);
+  *y = y1 + s * (y2 - y1);
+}
+
+double PathScript::duration() const {
+  double total = 0.0;
+  for (const Motion& m : motions) total += m.duration;
+  return total;
+}
+
+namespace {
+
+// Parses one script line's arguments and reports errors with file:line.
+class LineParser {
+ public:
+  LineParser(const std::string& file, int line, std::vector<std::string> words)
+      : file_(file), line_(line), words_(std::move(words)) {}
+
+  [[noreturn]] void fail(const std::string& message) const {
+    throw PathScriptError(file_ + ":" + std::to_string(line_) + ": " + message);
+  }
+
+  const std::string& command() const { return words_[0]; }
+
+  /// The arguments as numbers; exactly `count` of them, named in `usage`.
+  std::vector<double> numbers(std::size_t count, const std::string& usage) const {
+    if (words_.size() != count + 1) {
+      fail("'" + command() + "' takes " + std::to_string(count) + " number(s): " + usage);
+    }
+    std::vector<double> out;
+    for (std::size_t i = 1; i < words_.size(); ++i) {
+      const char* begin = words_[i].c_str();
+      char* end = nullptr;
+      const double value = std::strtod(begin, &end);
+      if (end == begin || *end != '\0' || !std::isfinite(value)) {
+        fail("'" + words_[i] + "' is not a number (in '" + command() + "')");
+      }
+      out.push_back(value);
+    }
+    return out;
+  }
+
+  void requirePositive(double value, const std::string& what) const {
+    if (!(value > 0.0)) fail(what + " must be positive, got " + std::to_string(value));
+  }
+
+ private:
+  const std::string& file_;
+  int line_;
+  std::vector<std::string> words_;
+};
+
+}  // namespace
+
+PathScript parsePathScript(std::istream& in, const std::string& file) {
+  PathScript script;
+  script.file = file;
+  bool started = false;
+  double speed_v = 0.25, speed_w = 0.8;
+  Pose2 pose;  // where the robot will be after the motions so far
+
+  std::string text;
+  for (int line = 1; std::getline(in, text); ++line) {
+    std::istringstream words_in(text.substr(0, text.find('#')));
+    std::vector<std::string> words;
+    for (std::string w; words_in >> w;) words.push_back(w);
+    if (words.empty()) continue;
+
+    const LineParser p(file, line, words);
+    const std::string& cmd = p.command();
+    if (!started && cmd != "start" && cmd != "person") {
+      p.fail("'start x y yaw' must come before '" + cmd + "'");
+    }
+    const auto drive = [&](double v, double w, double duration) {
+      if (duration <= 0.0) return;
+      script.motions.push_back({false, v, w, duration, {}, line});
+      pose = integrateArc(pose, v * duration, w * duration);
+    };
+    const auto turnBy = [&](double angle) {
+      drive(0.0, std::copysign(speed_w, angle), std::abs(angle) / speed_w);
+    };
+
+    if (cmd == "start") {
+      if (started) p.fail("'start' given twice");
+      const auto a = p.numbers(3, "start x y yaw");
+      script.start = pose = {a[0], a[1], normalizeAngle(a[2])};
+      script.start_line = line;
+      started = true;
+    } else if (cmd == "speed") {
+      const auto a = p.numbers(2, "speed v w");
+      p.requirePositive(a[0], "speed v");
+      p.requirePositive(a[1], "speed w");
+      speed_v = a[0];
+      speed_w = a[1];
+    } else if (cmd == "goto") {
+      const auto a = p.numbers(2, "goto x y");
+      const double dx = a[0] - pose.x, dy = a[1] - pose.y;
+      const double distance = std::hypot(dx, dy);
+      if (distance > 1e-9) {
+        const double heading = std::atan2(dy, dx);
+        turnBy(angleDiff(heading, pose.yaw));
+        drive(speed_v, 0.0, distance / speed_v);
+        // Land exactly on the target, so rounding never builds up over a long script.
+        pose = {a[0], a[1], heading};
+      }
+    } else if (cmd == "turn") {
+      const auto a = p.numbers(1, "turn yaw");
+      const double target = normalizeAngle(a[0]);
+      turnBy(angleDiff(target, pose.yaw));
+      pose.yaw = target;
+    } else if (cmd == "wait") {
+      const auto a = p.numbers(1, "wait seconds");
+      p.requirePositive(a[0], "wait time");
+      drive(0.0, 0.0, a[0]);
+    } else if (cmd == "velocity") {
+      const auto a = p.numbers(3, "velocity v w seconds");
+      p.requirePositive(a[2], "velocity duration");
+      drive(a[0], a[1], a[2]);
+    } else if (cmd == "teleport") {
+      const auto a = p.numbers(3, "teleport x y yaw");
+      pose = {a[0], a[1], normalizeAngle(a[2])};
+      script.motions.push_back({true, 0.0, 0.0, 0.0, pose, line});
+    } else if (cmd == "person") {
+      const auto a = p.numbers(5, "person x1 y1 x2 y2 speed");
+      if (a[4] < 0.0) p.fail("person speed must not be negative");
+      script.people.push_back({a[0], a[1], a[2], a[3], a[4]});
+    } else {
+      p.fail("unknown command '" + cmd +
+             "' (expected start, speed, goto, turn, wait, velocity, teleport or person)");
+    }
+  }
+  if (!started) throw PathScriptError(file + ": no 'start x y yaw' line");
+  return script;
+}
+
+PathScript loadPathScript(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw PathScriptError(path + ": cannot open");
+  return parsePathScript(in, path);
+}
+
+namespace {
+
+// True when every cell whose centre lies within `radius` of (x, y), and the
+// cell holding (x, y) itself, is free.
+bool footprintFree(const OccupancyGrid& grid, double x, double y, double radius) {
+  if (!grid.isFreeAt(x, y)) return false;
+  const int reach = static_cast<int>(std::ceil(radius / grid.resolution()));
+  const CellIndex c = grid.worldToCell(x, y);
+  for (int dy = -reach; dy <= reach; ++dy) {
+    for (int dx = -reach; dx <= reach; ++dx) {
+      const CellIndex n{c.x + dx, c.y + dy};
+      double cx, cy;
+      grid.cellToWorld(n, &cx, &cy);
+      if (std::hypot(cx - x, cy - y) > radius) continue;
+      if (grid.state(n) != CellState::kFree) return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
+std::optional<std::string> checkClearance(const PathScript& script, const OccupancyGrid& grid,
+                                          double radius) {
+  constexpr double kSampleStep = 0.01;  // m
+  const auto blocked = [&](int line, const Pose2& at) {
+    char message[128];
+    std::snprintf(message, sizeof(message), ":%d: the robot (radius %.2f m) leaves free space at (%.2f, %.2f)",
+                  line, radius, at.x, at.y);
+    return script.file + message;
+  };
+  Pose2 pose = script.start;
+  if (!footprintFree(grid, pose.x, pose.y, radius)) return blocked(script.start_line, pose);
+  for (const Motion& m : script.motions) {
+    if (m.teleport) {
+      pose = m.target;
+      if (!footprintFree(grid, pose.x, pose.y, radius)) return blocked(m.line, pose);
+      continue;
+    }
+    const double length = std::abs(m.v) * m.duration;
+    const int samples = std::max(1, static_cast<int>(std::ceil(length / kSampleStep)));
+    for (int i = 1; i <= samples; ++i) {
+      const double t = m.duration * i / samples;
+      const Pose2 at = integrateArc(pose, m.v * t, m.w * t);
+      if (!footprintFree(grid, at.x, at.y, radius)) return blocked(m.line, at);
+    }
+    pose = integrateArc(pose, m.v * m.duration, m.w * m.duration);
+  }
+  return std::nullopt;
+}
+
+}  // namespace pf::sim

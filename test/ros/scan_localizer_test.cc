@@ -1,1 +1,203 @@
-// placeholder: being written
+// ScanLocalizer: the ROS-message layer shared by pf_node and pf_bag_runner.
+// A 4 x 3 m walled room, scans ray-cast from a known pose, tf fed by hand.
+#include "pf_localization/ros/scan_localizer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "pf_localization/ros/conversions.h"
+
+namespace pf_ros {
+namespace {
+
+constexpr double kRes = 0.05;
+constexpr int kW = 80, kH = 60;  // 4 x 3 m
+
+// Walls around the room and a 0.5 x 0.5 m pillar off-centre, so that no pose
+// has a mirror twin.
+nav_msgs::OccupancyGrid room() {
+  nav_msgs::OccupancyGrid map;
+  map.header.frame_id = "map";
+  map.info.width = kW;
+  map.info.height = kH;
+  map.info.resolution = kRes;
+  map.info.origin.orientation.w = 1.0;
+  map.data.assign(kW * kH, 0);
+  for (int y = 0; y < kH; ++y) {
+    for (int x = 0; x < kW; ++x) {
+      const bool wall = x == 0 || y == 0 || x == kW - 1 || y == kH - 1;
+      const bool pillar = x >= 50 && x < 60 && y >= 10 && y < 20;
+      if (wall || pillar) map.data[y * kW + x] = 100;
+    }
+  }
+  return map;
+}
+
+// Marches along each beam until it enters an occupied cell.
+sensor_msgs::LaserScan scanFrom(const nav_msgs::OccupancyGrid& map, const pf::Pose2& laser,
+                                const ros::Time& stamp) {
+  sensor_msgs::LaserScan scan;
+  scan.header.frame_id = "laser";
+  scan.header.stamp = stamp;
+  scan.angle_min = -M_PI;
+  scan.angle_increment = M_PI / 180.0;
+  scan.angle_max = M_PI - scan.angle_increment;
+  scan.range_min = 0.02;
+  scan.range_max = 5.0;
+  for (int i = 0; i < 360; ++i) {
+    const double a = laser.yaw + scan.angle_min + i * scan.angle_increment;
+    float range = std::numeric_limits<float>::infinity();
+    for (double r = 0.0; r < scan.range_max; r += 0.005) {
+      const int cx = static_cast<int>(std::floor((laser.x + r * std::cos(a)) / kRes));
+      const int cy = static_cast<int>(std::floor((laser.y + r * std::sin(a)) / kRes));
+      if (cx < 0 || cy < 0 || cx >= kW || cy >= kH || map.data[cy * kW + cx] == 100) {
+        range = static_cast<float>(r);
+        break;
+      }
+    }
+    scan.ranges.push_back(range);
+  }
+  return scan;
+}
+
+geometry_msgs::TransformStamped transform(const std::string& parent, const std::string& child,
+                                          const pf::Pose2& pose, const ros::Time& stamp) {
+  geometry_msgs::TransformStamped t;
+  t.header.frame_id = parent;
+  t.header.stamp = stamp;
+  t.child_frame_id = child;
+  t.transform = toTransformMsg(pose);
+  return t;
+}
+
+class ScanLocalizerTest : public ::testing::Test {
+ protected:
+  ScanLocalizerTest() {
+    config_.filter.kld.min_particles = 300;
+    config_.filter.kld.max_particles = 1000;
+    config_.filter.seed = 7;
+    config_.filter.update_min_d = 0.0;
+    config_.filter.update_min_a = 0.0;
+    // The laser is mounted backwards, as on the AC109 Neato.
+    mount_ = {-0.1, 0.0, M_PI};
+    tf_.setTransform(transform("base_link", "laser", mount_, ros::Time(0)), "test", true);
+  }
+
+  // Robot at `truth` in the map; odometry says `odom`; both stamped `t`.
+  sensor_msgs::LaserScan observe(const pf::Pose2& truth, const pf::Pose2& odom, double t) {
+    const ros::Time stamp(t);
+    tf_.setTransform(transform("odom", "base_link", odom, stamp), "test");
+    tf_.setTransform(transform("odom", "base_link", odom, stamp + ros::Duration(0.01)), "test");
+    return scanFrom(map_, pf::compose(truth, mount_), stamp);
+  }
+
+  LocalizerConfig config_;
+  tf2::BufferCore tf_;
+  pf::Pose2 mount_;
+  nav_msgs::OccupancyGrid map_ = room();
+};
+
+TEST_F(ScanLocalizerTest, ScanBeforeMapIsRejectedWithAClearReason) {
+  ScanLocalizer localizer(config_, &tf_);
+  const ScanResult r = localizer.processScan(observe({1, 1, 0}, {0, 0, 0}, 10.0));
+  EXPECT_NE(r.error.find("no map"), std::string::npos) << r.error;
+  EXPECT_FALSE(localizer.mapToOdom(ros::Time(10)).has_value());
+}
+
+TEST_F(ScanLocalizerTest, MissingLaserFrameNamesTheFrame) {
+  ScanLocalizer localizer(config_, &tf_);
+  ASSERT_EQ(localizer.setMap(map_), "");
+  sensor_msgs::LaserScan scan = observe({1, 1, 0}, {0, 0, 0}, 10.0);
+  scan.header.frame_id = "tilted_laser";
+  const ScanResult r = localizer.processScan(scan);
+  EXPECT_NE(r.error.find("tilted_laser"), std::string::npos) << r.error;
+  EXPECT_NE(r.error.find("base_link"), std::string::npos) << r.error;
+}
+
+TEST_F(ScanLocalizerTest, MissingOdometryIsReported) {
+  ScanLocalizer localizer(config_, &tf_);
+  ASSERT_EQ(localizer.setMap(map_), "");
+  const sensor_msgs::LaserScan scan = scanFrom(map_, {1, 1, 0}, ros::Time(10));
+  const ScanResult r = localizer.processScan(scan);
+  EXPECT_NE(r.error.find("no odometry"), std::string::npos) << r.error;
+}
+
+TEST_F(ScanLocalizerTest, TracksFromTheConfiguredInitialPose) {
+  const pf::Pose2 start{1.0, 1.0, 0.3};
+  config_.initial_pose = pf::Pose2{1.2, 0.9, 0.4};  // 0.22 m and 0.1 rad off
+  ScanLocalizer localizer(config_, &tf_);
+  ASSERT_EQ(localizer.setMap(map_), "");
+  // Odometry starts at its own origin: map -> odom is the start pose.
+  for (int k = 0; k < 10; ++k) {
+    const pf::Pose2 motion{0.1 * k, 0.0, 0.05 * k};
+    const ScanResult r =
+        localizer.processScan(observe(pf::compose(start, motion), motion, 10.0 + k));
+    ASSERT_EQ(r.error, "");
+    ASSERT_TRUE(r.report.updated) << r.report.skip_reason;
+  }
+  const auto m2o = localizer.mapToOdom(ros::Time(20));
+  ASSERT_TRUE(m2o.has_value());
+  const pf::Pose2 est = toPose2(m2o->transform);
+  EXPECT_NEAR(est.x, start.x, 0.05);
+  EXPECT_NEAR(est.y, start.y, 0.05);
+  EXPECT_NEAR(pf::angleDiff(est.yaw, start.yaw), 0.0, 0.03);
+  EXPECT_EQ(m2o->header.frame_id, "map");
+  EXPECT_EQ(m2o->child_frame_id, "odom");
+}
+
+TEST_F(ScanLocalizerTest, InitialPoseBeforeTheMapIsUsedWhenTheMapArrives) {
+  ScanLocalizer localizer(config_, &tf_);
+  geometry_msgs::PoseWithCovarianceStamped pose;
+  pose.header.frame_id = "map";
+  pose.pose.pose = toPoseMsg({2.0, 1.5, 1.0});
+  ASSERT_EQ(localizer.setInitialPose(pose), "");
+  ASSERT_EQ(localizer.setMap(map_), "");
+  const auto est = localizer.estimate(ros::Time(1));
+  ASSERT_TRUE(est.has_value());
+  EXPECT_NEAR(est->pose.pose.position.x, 2.0, 0.1);
+  EXPECT_NEAR(est->pose.pose.position.y, 1.5, 0.1);
+}
+
+TEST_F(ScanLocalizerTest, NanInitialPoseIsRejected) {
+  ScanLocalizer localizer(config_, &tf_);
+  ASSERT_EQ(localizer.setMap(map_), "");
+  geometry_msgs::PoseWithCovarianceStamped pose;
+  pose.header.frame_id = "map";
+  pose.pose.pose = toPoseMsg({std::nan(""), 1.0, 0.0});
+  EXPECT_NE(localizer.setInitialPose(pose).find("not finite"), std::string::npos);
+}
+
+TEST_F(ScanLocalizerTest, MapWithoutFreeCellsIsRejected) {
+  ScanLocalizer localizer(config_, &tf_);
+  nav_msgs::OccupancyGrid full = map_;
+  full.data.assign(full.data.size(), 100);
+  EXPECT_NE(localizer.setMap(full).find("no free cell"), std::string::npos);
+  EXPECT_FALSE(localizer.filter().hasMap());
+}
+
+TEST_F(ScanLocalizerTest, MalformedMapIsRejected) {
+  ScanLocalizer localizer(config_, &tf_);
+  nav_msgs::OccupancyGrid bad = map_;
+  bad.data.pop_back();
+  EXPECT_NE(localizer.setMap(bad).find("ignoring the map"), std::string::npos);
+}
+
+TEST_F(ScanLocalizerTest, OdometryMessageBecomesOdomToBaseTransform) {
+  nav_msgs::Odometry odom;
+  odom.header.frame_id = "odom";
+  odom.header.stamp = ros::Time(3.5);
+  odom.child_frame_id = "base_link";
+  odom.pose.pose = toPoseMsg({1.0, -2.0, 0.5});
+  const geometry_msgs::TransformStamped t = odometryToTransform(odom);
+  EXPECT_EQ(t.header.frame_id, "odom");
+  EXPECT_EQ(t.child_frame_id, "base_link");
+  EXPECT_EQ(t.header.stamp, ros::Time(3.5));
+  EXPECT_DOUBLE_EQ(t.transform.translation.x, 1.0);
+  EXPECT_DOUBLE_EQ(t.transform.translation.y, -2.0);
+  EXPECT_NEAR(yawOf(t.transform.rotation), 0.5, 1e-12);
+}
+
+}  // namespace
+}  // namespace pf_ros

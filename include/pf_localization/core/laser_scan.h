@@ -38,7 +38,8 @@ struct Beam {
 /// dropouts, and subsampling first would waste the beam budget on them.
 /// `range_min`/`range_max` narrow the scan's own limits when they are tighter
 /// (pass a non-positive value to use the scan's). max_beams <= 0 keeps all.
+/// `valid_count`, when given, receives the number of valid beams before subsampling.
 std::vector<Beam> selectBeams(const LaserScan& scan, int max_beams, double range_min = 0.0,
-                              double range_max = 0.0);
+                              double range_max = 0.0, std::size_t* valid_count = nullptr);
 
 }  // namespace pf

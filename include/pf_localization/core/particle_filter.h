@@ -110,6 +110,7 @@ class ParticleFilter {
   void weigh(const PreparedScan& scan, UpdateReport* report);
   void resample(UpdateReport* report);
   Pose2 randomFreePose();
+  void restartAfterInitialization();
 
   ParticleFilterParams params_;
   Random random_;
@@ -119,6 +120,7 @@ class ParticleFilter {
   PoseEstimate estimate_;
   std::optional<Pose2> odom_at_update_;
   bool force_update_ = false;
+  bool restart_ = false;  // the next update follows an initialisation
   bool has_estimate_ = false;
   double w_slow_ = 0.0;
   double w_fast_ = 0.0;

@@ -4,8 +4,10 @@
 // config/pf.yaml.
 #pragma once
 
+#include <ros/node_handle.h>
+
 #include <Eigen/Core>
-#include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -39,6 +41,9 @@ class ParamSource {
 /// A ParamSource over a flat YAML mapping (config/pf.yaml's format).
 /// Throws std::runtime_error naming the file when it cannot be read.
 std::unique_ptr<ParamSource> yamlParamSource(const std::string& path);
+
+/// A ParamSource over a node's (usually private) namespace.
+std::unique_ptr<ParamSource> rosParamSource(const ros::NodeHandle& nh);
 
 /// Reads every parameter (absent ones keep their defaults) and validates the
 /// result. Throws std::invalid_argument naming the parameter and its valid range.

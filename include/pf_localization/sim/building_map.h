@@ -1,0 +1,82 @@
+// The package's own maps, drawn procedurally so that they can be regenerated
+// bit for bit (pf_make_map writes them to maps/).
+//
+// A map is drawn on a canvas that starts unknown: free boxes for rooms and
+// corridors are carved out of occupied blocks, then doorways, furniture and
+// pillars are added. Coordinates are map-frame metres on the 0.05 m grid, so
+// every box edge falls on a cell boundary and no cell is half inside.
+//
+// The building (20 x 15 m, an L-shaped outline with unknown space around it):
+//
+//   y=15 +-----------+-----------+-------------+
+//        | twin      | twin      | lab with    |      (unknown notch)
+//        | room A    | room B    | 4 pillars   +---------+
+//        |           |           |             | office  |
+//        +--door-----+--door-----+---door------+--door---+ y=8.5
+//        |            east-west corridor, 1.8 m wide     |
+//        +--door-----+----wide opening---+--door---------+ y=6.5
+//        | kitchen   | lobby: diagonal   | storage:      |
+//        | island,   | wall, round column| shelves,      |
+//        | wall stub |                   | locked closet |
+//   y=0  +-----------+-------------------+---------------+
+//       x=0                                             x=20
+//
+// The twin rooms are identical cell for cell, and the corridor offers long
+// stretches that look alike, so a robot in one of them cannot tell where it
+// is; the lab, the lobby and the storage room are each unlike anything else,
+// which is what lets global localization converge once the robot sees them.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "pf_localization/core/occupancy_grid.h"
+
+namespace pf::sim {
+
+/// An axis-aligned rectangle in metres.
+struct Box {
+  double x0, y0, x1, y1;
+};
+
+/// Draws a map cell by cell. A cell belongs to a shape when its centre does.
+class MapCanvas {
+ public:
+  static constexpr int8_t kFree = 0;
+  static constexpr int8_t kOccupied = 100;
+  static constexpr int8_t kUnknown = -1;
+
+  /// A canvas covering `extent`, all unknown.
+  MapCanvas(const Box& extent, double resolution);
+
+  void fill(const Box& box, int8_t value);
+  void disc(double cx, double cy, double radius, int8_t value);
+  /// A straight wall of the given thickness between two points.
+  void segment(double x0, double y0, double x1, double y1, double thickness, int8_t value);
+
+  void triangle(double ax, double ay, double bx, double by, double cx, double cy, int8_t value);
+
+  OccupancyGrid grid() const;
+
+ private:
+  template <typename Inside>
+  void paint(const Box& bounds, int8_t value, Inside inside);
+
+  Box extent_;
+  double resolution_;
+  int width_, height_;
+  std::vector<int8_t> data_;
+};
+
+/// Interiors of the two identical rooms of the building.
+inline constexpr Box kTwinRoomA{0.3, 8.65, 4.9, 14.7};
+inline constexpr Box kTwinRoomB{5.05, 8.65, 9.65, 14.7};
+
+/// The building map (0.05 m cells).
+OccupancyGrid makeBuildingMap();
+
+/// A small asymmetric room, 6 x 4 m, with a cabinet, a column and a wall stub
+/// (0.05 m cells), for fast tests.
+OccupancyGrid makeSmallMap();
+
+}  // namespace pf::sim

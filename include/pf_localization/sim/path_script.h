@@ -1,0 +1,85 @@
+// The path scripts that tell pf_simulator where the robot drives.
+//
+// A script is plain text, one command per line; '#' starts a comment, blank
+// lines are ignored. Lengths are metres, angles radians, times seconds, all in
+// the map frame:
+//
+//   start x y yaw          where the robot is at t = 0 (required, first, once)
+//   speed v w              linear (m/s) and turning (rad/s) speed used by goto
+//                          and turn from here on; default 0.25 and 0.8
+//   goto x y               turn in place towards (x, y), then drive straight there
+//   turn yaw               turn in place to the absolute heading yaw
+//   wait t                 stand still for t seconds
+//   velocity v w t         drive at v m/s turning at w rad/s for t seconds (an arc)
+//   teleport x y yaw       move the true pose instantly, wheels still (a kidnapping)
+//   person x1 y1 x2 y2 v   a person walking to and fro between two points at
+//                          v m/s, from t = 0 and for the whole run
+//
+// A script compiles to a list of constant-velocity motions. The true pose
+// follows them exactly, so whether the robot stays in free space can be
+// checked on the map before anything is simulated (checkClearance).
+#pragma once
+
+#include <istream>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "pf_localization/core/occupancy_grid.h"
+#include "pf_localization/core/pose2.h"
+
+namespace pf::sim {
+
+/// A malformed script. what() is "file:line: message".
+class PathScriptError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// One compiled step: drive at (v, w) for `duration`, or teleport to `target`.
+struct Motion {
+  bool teleport = false;
+  double v = 0.0;         // m/s
+  double w = 0.0;         // rad/s
+  double duration = 0.0;  // s
+  Pose2 target;           // teleports only
+  int line = 0;           // script line that produced it
+};
+
+/// A circular obstacle that is not on the map, walking back and forth.
+struct Person {
+  double x1 = 0.0, y1 = 0.0, x2 = 0.0, y2 = 0.0;  // m
+  double speed = 0.0;                              // m/s
+  double radius = 0.2;                             // m
+  /// Centre at time t (s): a triangle wave between the two end points.
+  void positionAt(double t, double* x, double* y) const;
+};
+
+struct PathScript {
+  std::string file;  // for error messages
+  Pose2 start;
+  int start_line = 0;
+  std::vector<Motion> motions;
+  std::vector<Person> people;
+
+  /// Total duration of the motions (s).
+  double duration() const;
+};
+
+/// Parses a script; `file` only names it in errors. Throws PathScriptError
+/// for an unknown command, a wrong argument count, a bad number, a
+/// non-positive speed or duration, or a missing or repeated `start`.
+PathScript parsePathScript(std::istream& in, const std::string& file);
+
+/// Reads and parses a script file. Throws PathScriptError (also when the file
+/// cannot be opened).
+PathScript loadPathScript(const std::string& path);
+
+/// Checks that a robot of `radius` metres stays in free cells of `grid` along
+/// the whole true path (sampled every 1 cm), teleport targets included.
+/// Returns "file:line: ..." naming the first motion that leaves free space.
+std::optional<std::string> checkClearance(const PathScript& script, const OccupancyGrid& grid,
+                                          double radius);
+
+}  // namespace pf::sim

@@ -1,0 +1,65 @@
+#!/usr/bin/env bash
+# Installs the dependencies, builds the package and runs every test: the
+# GoogleTest unit tests, the rostest integration tests on the bundled bags,
+# the Python unit tests and the source checks (clang-format, a ROS-free core).
+# Ends with one line "N passed, N failed"; exits non-zero when anything failed
+# or when no test ran at all.
+set -uo pipefail
+repo=$(cd "$(dirname "$0")/.." && pwd)
+ws=${PF_WS:-$repo/.ws}
+export PATH=/usr/bin:$PATH
+cd "$repo"
+
+bash scripts/install_deps.sh || { echo "install failed"; echo "0 passed, 1 failed"; exit 1; }
+rm -rf "$ws/build/test_results"
+if ! bash scripts/build.sh; then
+  echo "build failed"; echo "0 passed, 1 failed"; exit 1
+fi
+
+passed=0 failed=0
+check() {  # check NAME COMMAND...: a source check counted as one test
+  local name=$1; shift
+  if "$@"; then echo "[check] $name: ok"; passed=$((passed + 1));
+  else echo "[check] $name: FAILED"; failed=$((failed + 1)); fi
+}
+
+# --- GoogleTest and rostest, through catkin ---------------------------------
+bash scripts/build.sh run_tests -j1 2>&1 | tee "$ws/run_tests.log" | grep -E "^\[ *(OK|FAILED|PASSED) *\]|^\[ROSTEST\]|^\[Testcase|FAILURE|Error" || true
+# shellcheck disable=SC1091
+source "$ws/devel/setup.bash"
+summary=$(catkin_test_results --all "$ws/build/test_results" 2>&1)
+echo "$summary" | grep -vE "^Skipping" | tail -n 30
+line=$(echo "$summary" | grep -E "^Summary:" | tail -n 1)
+if [ -n "$line" ]; then
+  total=$(echo "$line" | sed -E 's/Summary: ([0-9]+) tests.*/\1/')
+  errors=$(echo "$line" | sed -E 's/.* ([0-9]+) errors.*/\1/')
+  failures=$(echo "$line" | sed -E 's/.* ([0-9]+) failures.*/\1/')
+  skipped=$(echo "$line" | sed -E 's/.* ([0-9]+) skipped.*/\1/')
+  passed=$((passed + total - errors - failures - skipped))
+  failed=$((failed + errors + failures))
+else
+  echo "catkin_test_results found no results"; failed=$((failed + 1))
+fi
+
+# --- Python unit tests (pf_evaluate's metrics) ------------------------------
+if [ -d test/python ]; then
+  py_out=$(/usr/bin/python3 -m unittest discover -s test/python -p 'test_*.py' 2>&1)
+  echo "$py_out" | tail -n 5
+  ran=$(echo "$py_out" | sed -nE 's/^Ran ([0-9]+) tests?.*/\1/p')
+  bad=$(echo "$py_out" | sed -nE 's/^FAILED \((.*)\)/\1/p' | grep -oE '[0-9]+' | awk '{s += $1} END {print s + 0}')
+  passed=$((passed + ${ran:-0} - ${bad:-0}))
+  failed=$((failed + ${bad:-0}))
+  [ -z "$ran" ] && failed=$((failed + 1))
+fi
+
+# --- Source checks ------------------------------------------------------------
+core_is_ros_free() { ! grep -rnE '#include [<"](ros|tf2|sensor_msgs|nav_msgs|geometry_msgs|rosbag)/' include/pf_localization/core src/core include/pf_localization/sim src/sim; }
+clang_format_clean() {
+  git ls-files '*.h' '*.cc' | xargs -r clang-format --dry-run -Werror 2>&1 | head -n 20 | grep . && return 1
+  return 0
+}
+check "the core and the simulator include no ROS header" core_is_ros_free
+check "clang-format clean" clang_format_clean
+
+echo "$passed passed, $failed failed"
+[ "$failed" -eq 0 ] && [ "$passed" -gt 0 ]
