@@ -156,7 +156,7 @@ class PnmParser {
       if (buf_.compare(0, 4, "\x89PNG") == 0) {
         fail("PNG images are not supported; convert it to PGM (e.g. 'convert map.png map.pgm')");
       }
-      fail("unsupported image format (magic number '" + printable(buf_.substr(0, 3)) +
+      fail("unsupported image format (magic number '" + printable(magic) +
            "'); expected PGM (P2, P5) or PPM (P3, P6)");
     }
     pos_ = 2;

@@ -187,6 +187,17 @@ int main(int argc, char** argv) {
     }
   }
 
+  // Odometry comes from /tf when the bag has it there, else from the odometry
+  // topic; never both, or tf2 would see every odometry stamp twice.
+  bool odom_on_tf = false;
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery("/tf"))) {
+    const auto msg = m.instantiate<tf2_msgs::TFMessage>();
+    for (const auto& t : msg ? msg->transforms : std::vector<geometry_msgs::TransformStamped>()) {
+      odom_on_tf |= t.header.frame_id == config.odom_frame && t.child_frame_id == config.base_frame;
+    }
+    if (odom_on_tf) break;
+  }
+
   tf2::BufferCore tf(ros::Duration(600.0));
   pf_ros::ScanLocalizer localizer(config, &tf);
   try {
@@ -267,9 +278,7 @@ int main(int argc, char** argv) {
         }
       } else if (m.getTopic() == opt.odom_topic) {
         const auto odom = m.instantiate<nav_msgs::Odometry>();
-        if (odom && !tf.canTransform(config.odom_frame, config.base_frame, odom->header.stamp)) {
-          tf.setTransform(pf_ros::odometryToTransform(*odom), "odom_topic");
-        }
+        if (odom && !odom_on_tf) tf.setTransform(pf_ros::odometryToTransform(*odom), "odom_topic");
       } else if (const auto scan = m.instantiate<sensor_msgs::LaserScan>()) {
         ++scans;
         pending.push_back(scan);
@@ -278,8 +287,10 @@ int main(int argc, char** argv) {
       // message filter would, or when it has waited too long.
       while (!pending.empty()) {
         const auto& s = pending.front();
-        if (!tf.canTransform(config.odom_frame, config.base_frame, s->header.stamp) &&
-            now - s->header.stamp.toSec() < kMaxTfWait) {
+        const bool ready =
+            tf.canTransform(config.odom_frame, config.base_frame, s->header.stamp) &&
+            tf.canTransform(config.base_frame, s->header.frame_id, ros::Time(0));
+        if (!ready && now - s->header.stamp.toSec() < kMaxTfWait) {
           break;
         }
         process(*s);

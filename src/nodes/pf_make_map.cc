@@ -1,1 +1,35 @@
-int main() { return 0; }  // placeholder: being written
+// pf_make_map: writes the package's own maps (building and small, see
+// pf_localization/sim/building_map.h) in the map_server format.
+//
+//   pf_make_map --out-dir maps
+//
+// The maps are drawn by code, not from a seed, so the output is the same
+// bytes every time.
+#include <cstring>
+#include <iostream>
+#include <string>
+
+#include "pf_localization/core/map_loader.h"
+#include "pf_localization/sim/building_map.h"
+
+int main(int argc, char** argv) {
+  std::string out_dir = "maps";
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "--out-dir") == 0 && i + 1 < argc) {
+      out_dir = argv[++i];
+    } else {
+      std::cerr << "usage: pf_make_map [--out-dir DIR]   (default: maps)\n"
+                   "writes DIR/building.yaml/.pgm and DIR/small.yaml/.pgm\n";
+      return 2;
+    }
+  }
+  try {
+    pf::saveMap(pf::sim::makeBuildingMap(), out_dir + "/building.yaml");
+    pf::saveMap(pf::sim::makeSmallMap(), out_dir + "/small.yaml");
+  } catch (const std::exception& e) {
+    std::cerr << "pf_make_map: " << e.what() << "\n";
+    return 1;
+  }
+  std::cout << "wrote " << out_dir << "/building.yaml and " << out_dir << "/small.yaml\n";
+  return 0;
+}

@@ -12,6 +12,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
 #include <std_srvs/Empty.h>
+#include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/message_filter.h>
 #include <tf2_ros/transform_broadcaster.h>
@@ -58,6 +59,10 @@ std::string failureText(tf2_ros::filter_failure_reasons::FilterFailureReason rea
   }
 }
 
+// s of odometry messages to wait for odom -> base on /tf before the odometry
+// topic is taken as the source instead.
+constexpr double kOdomSourceGrace = 0.5;
+
 class PfNode {
  public:
   PfNode(const LocalizerConfig& config, ros::NodeHandle nh)
@@ -75,6 +80,7 @@ class PfNode {
           onScanDropped(scan, reason);
         });
     odom_sub_ = nh_.subscribe("odom", 50, &PfNode::onOdom, this);
+    tf_watch_sub_ = nh_.subscribe("/tf", 100, &PfNode::onTf, this);
     map_sub_ = nh_.subscribe("map", 1, &PfNode::onMap, this);
     initial_pose_sub_ = nh_.subscribe("initialpose", 2, &PfNode::onInitialPose, this);
     pose_pub_ = nh_.advertise<geometry_msgs::PoseWithCovarianceStamped>("pf_pose", 2, true);
@@ -107,18 +113,35 @@ class PfNode {
 
   void onOdom(const nav_msgs::OdometryConstPtr& msg) {
     // Robots that publish odometry only as a topic get it into the tf buffer
-    // here; when tf already has it (the usual case) this adds nothing.
+    // here. When tf carries it too (the usual case) the topic is ignored:
+    // tf2 would otherwise see every odometry stamp twice.
     if (msg->header.frame_id.empty() || msg->child_frame_id.empty()) {
       warn("odom frames", "odometry message with an empty frame_id or child_frame_id: ignored");
       return;
     }
-    if (buffer_.canTransform(config_.odom_frame, config_.base_frame, msg->header.stamp)) return;
+    if (odom_on_tf_) return;
+    // Give /tf a moment to show its odometry before taking the topic's.
+    if (first_odom_stamp_.isZero()) first_odom_stamp_ = msg->header.stamp;
+    if ((msg->header.stamp - first_odom_stamp_).toSec() < kOdomSourceGrace) return;
     const geometry_msgs::TransformStamped t = odometryToTransform(*msg);
     if (!toPose2(t.transform).isFinite()) {
       warn("odom nan", "odometry message with a non-finite pose: ignored");
       return;
     }
     buffer_.setTransform(t, "odom_topic");
+  }
+
+  // Watches /tf only until it shows whether odometry travels there.
+  void onTf(const tf2_msgs::TFMessageConstPtr& msg) {
+    for (const auto& t : msg->transforms) {
+      if (t.header.frame_id == config_.odom_frame && t.child_frame_id == config_.base_frame) {
+        odom_on_tf_ = true;
+        tf_watch_sub_.shutdown();
+        ROS_INFO("pf_node: odometry %s -> %s comes from tf", config_.odom_frame.c_str(),
+                 config_.base_frame.c_str());
+        return;
+      }
+    }
   }
 
   void onScan(const sensor_msgs::LaserScanConstPtr& scan) {
@@ -240,7 +263,9 @@ class PfNode {
   ScanLocalizer localizer_;
   message_filters::Subscriber<sensor_msgs::LaserScan> scan_sub_;
   tf2_ros::MessageFilter<sensor_msgs::LaserScan> scan_filter_;
-  ros::Subscriber odom_sub_, map_sub_, initial_pose_sub_;
+  ros::Subscriber odom_sub_, map_sub_, initial_pose_sub_, tf_watch_sub_;
+  bool odom_on_tf_ = false;
+  ros::Time first_odom_stamp_;
   ros::Publisher pose_pub_, cloud_pub_;
   ros::ServiceServer global_srv_, nomotion_srv_;
   ros::Timer tf_timer_;

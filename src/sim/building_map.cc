@@ -101,11 +101,11 @@ OccupancyGrid makeBuildingMap() {
 
   // Corridor and its doorways (walls at y 6.5-6.65 and 8.5-8.65).
   c.fill({0.3, 6.65, 19.7, 8.5}, kFree);
-  c.fill({11.6, 8.5, 12.6, 8.65}, kFree);   // lab
-  c.fill({17.0, 8.5, 18.0, 8.65}, kFree);   // office
-  c.fill({2.5, 6.5, 3.5, 6.65}, kFree);     // kitchen
-  c.fill({8.4, 6.5, 10.8, 6.65}, kFree);    // lobby, a wide opening
-  c.fill({15.3, 6.5, 16.3, 6.65}, kFree);   // storage
+  c.fill({11.6, 8.5, 12.6, 8.65}, kFree);  // lab
+  c.fill({17.0, 8.5, 18.0, 8.65}, kFree);  // office
+  c.fill({2.5, 6.5, 3.5, 6.65}, kFree);    // kitchen
+  c.fill({8.4, 6.5, 10.8, 6.65}, kFree);   // lobby, a wide opening
+  c.fill({15.3, 6.5, 16.3, 6.65}, kFree);  // storage
 
   drawTwinRoom(&c, kTwinRoomA.x0);
   drawTwinRoom(&c, kTwinRoomB.x0);

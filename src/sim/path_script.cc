@@ -162,18 +162,20 @@ PathScript loadPathScript(const std::string& path) {
 
 namespace {
 
-// True when every cell whose centre lies within `radius` of (x, y), and the
-// cell holding (x, y) itself, is free.
+// True when every cell that a disc of `radius` at (x, y) touches is free.
 bool footprintFree(const OccupancyGrid& grid, double x, double y, double radius) {
-  if (!grid.isFreeAt(x, y)) return false;
-  const int reach = static_cast<int>(std::ceil(radius / grid.resolution()));
+  const double half = 0.5 * grid.resolution();
+  const int reach = static_cast<int>(std::ceil(radius / grid.resolution())) + 1;
   const CellIndex c = grid.worldToCell(x, y);
   for (int dy = -reach; dy <= reach; ++dy) {
     for (int dx = -reach; dx <= reach; ++dx) {
       const CellIndex n{c.x + dx, c.y + dy};
       double cx, cy;
       grid.cellToWorld(n, &cx, &cy);
-      if (std::hypot(cx - x, cy - y) > radius) continue;
+      // Distance from the disc's centre to the nearest point of the cell.
+      const double gap_x = std::max(0.0, std::abs(cx - x) - half);
+      const double gap_y = std::max(0.0, std::abs(cy - y) - half);
+      if (std::hypot(gap_x, gap_y) >= radius) continue;
       if (grid.state(n) != CellState::kFree) return false;
     }
   }
@@ -187,8 +189,9 @@ std::optional<std::string> checkClearance(const PathScript& script, const Occupa
   constexpr double kSampleStep = 0.01;  // m
   const auto blocked = [&](int line, const Pose2& at) {
     char message[128];
-    std::snprintf(message, sizeof(message), ":%d: the robot (radius %.2f m) leaves free space at (%.2f, %.2f)",
-                  line, radius, at.x, at.y);
+    std::snprintf(message, sizeof(message),
+                  ":%d: the robot (radius %g m) leaves free space at (%.2f, %.2f)", line, radius,
+                  at.x, at.y);
     return script.file + message;
   };
   Pose2 pose = script.start;

@@ -66,8 +66,8 @@ std::vector<float> neatoReadings(const std::vector<double>& ideal, const NeatoLa
     if (burst_left == 0 && random->uniform() < params.burst_rate) {
       // Geometric length with the given mean, at least one beam.
       const double p = 1.0 / params.burst_mean;
-      burst_left = 1 + static_cast<int>(std::floor(std::log(1.0 - random->uniform()) /
-                                                   std::log(1.0 - p)));
+      burst_left =
+          1 + static_cast<int>(std::floor(std::log(1.0 - random->uniform()) / std::log(1.0 - p)));
     }
     if (burst_left > 0) {
       --burst_left;

@@ -1,1 +1,334 @@
-// placeholder: being written
+#include "pf_localization/core/odometry_motion_model.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace pf {
+namespace {
+
+constexpr double kTol = 1e-12;
+
+void expectPoseNear(const Pose2& expected, const Pose2& actual, double tol = kTol) {
+  EXPECT_NEAR(expected.x, actual.x, tol);
+  EXPECT_NEAR(expected.y, actual.y, tol);
+  EXPECT_NEAR(0.0, angleDiff(expected.yaw, actual.yaw), tol)
+      << "yaw " << actual.yaw << ", expected " << expected.yaw;
+  EXPECT_GT(actual.yaw, -M_PI);
+  EXPECT_LE(actual.yaw, M_PI);
+}
+
+void expectStep(const OdometryStep& expected, const OdometryStep& actual) {
+  EXPECT_NEAR(expected.rot1, actual.rot1, kTol);
+  EXPECT_NEAR(expected.trans, actual.trans, kTol);
+  EXPECT_NEAR(expected.rot2, actual.rot2, kTol);
+}
+
+OdometryMotionParams noiseless(OdometryMotionParams::Kind kind) {
+  OdometryMotionParams p;
+  p.kind = kind;
+  p.alpha1 = p.alpha2 = p.alpha3 = p.alpha4 = p.alpha5 = 0.0;
+  return p;
+}
+
+ParticleSet particlesAt(const std::vector<Pose2>& poses) {
+  ParticleSet set;
+  set.resize(poses.size());
+  for (std::size_t i = 0; i < poses.size(); ++i) set.setPose(i, poses[i]);
+  set.setUniformWeights();
+  return set;
+}
+
+ParticleSet manyAt(const Pose2& pose, std::size_t n) {
+  return particlesAt(std::vector<Pose2>(n, pose));
+}
+
+struct Stats {
+  double mean;
+  double stddev;
+};
+
+template <typename F>
+Stats stats(std::size_t n, F value) {
+  double sum = 0.0, sum_sq = 0.0;
+  for (std::size_t i = 0; i < n; ++i) sum += value(i);
+  const double mean = sum / n;
+  for (std::size_t i = 0; i < n; ++i) sum_sq += (value(i) - mean) * (value(i) - mean);
+  return {mean, std::sqrt(sum_sq / n)};
+}
+
+// --- decompose ---------------------------------------------------------------
+
+TEST(Decompose, StraightAhead) {
+  expectStep({0.0, 1.0, 0.0}, OdometryMotionModel::decompose({0, 0, 0}, {1, 0, 0}));
+  // Facing +y and moving +y is still straight ahead.
+  expectStep({0.0, 2.0, 0.0},
+             OdometryMotionModel::decompose({1, 1, M_PI / 2}, {1, 3, M_PI / 2}));
+}
+
+TEST(Decompose, TurnMoveTurn) {
+  // To (1, 1) facing +y: turn pi/4 towards it, go sqrt(2), turn the other pi/4.
+  expectStep({M_PI / 4, std::sqrt(2.0), M_PI / 4},
+             OdometryMotionModel::decompose({0, 0, 0}, {1, 1, M_PI / 2}));
+  // Sideways to the right, ending with the original heading.
+  expectStep({-M_PI / 2, 0.5, M_PI / 2},
+             OdometryMotionModel::decompose({0, 0, 0}, {0, -0.5, 0}));
+}
+
+TEST(Decompose, BackwardsIsAHalfTurnEachWay) {
+  // Reversing 1 m: the direction of travel is behind, so rot1 = pi, and the
+  // heading is unchanged, so rot2 = -pi, reported as +pi.
+  const OdometryStep back = OdometryMotionModel::decompose({0, 0, 0}, {-1, 0, 0});
+  EXPECT_EQ(M_PI, back.rot1);
+  EXPECT_EQ(1.0, back.trans);
+  EXPECT_EQ(M_PI, back.rot2);
+  // Facing +y and reversing 0.5 m towards -y.
+  expectStep({M_PI, 0.5, M_PI},
+             OdometryMotionModel::decompose({2, 1, M_PI / 2}, {2, 0.5, M_PI / 2}));
+  // Reversing 1 m along an arc that turns 0.2 rad left: the chord points
+  // atan2(-sin(0.1), -cos(0.1)) = -pi + 0.1, and rot2 = 0.2 - (-pi + 0.1)
+  // = pi + 0.1, which wraps to -pi + 0.1.
+  const OdometryStep turning =
+      OdometryMotionModel::decompose({0, 0, 0}, {-std::cos(0.1), -std::sin(0.1), 0.2});
+  expectStep({-M_PI + 0.1, 1.0, -M_PI + 0.1}, turning);
+}
+
+TEST(Decompose, RotationAcrossPi) {
+  // In place, from just below +pi to just above -pi: a 0.2 rad left turn.
+  expectStep({0.0, 0.0, 0.2},
+             OdometryMotionModel::decompose({0, 0, M_PI - 0.1}, {0, 0, -M_PI + 0.1}));
+  // Moving 1 m along -x while facing pi - 0.1 and ending at -pi + 0.1:
+  // rot1 = pi - (pi - 0.1) = 0.1, rot2 = 0.2 - 0.1 = 0.1.
+  expectStep({0.1, 1.0, 0.1},
+             OdometryMotionModel::decompose({0, 0, M_PI - 0.1}, {-1, 0, -M_PI + 0.1}));
+}
+
+TEST(Decompose, TinyTranslationHasNoDirection) {
+  // Below 1 cm the direction of travel is noise: all rotation goes to rot2.
+  expectStep({0.0, std::hypot(0.005, 0.005), 1.0},
+             OdometryMotionModel::decompose({0, 0, 0}, {0.005, 0.005, 1.0}));
+  expectStep({0.0, 0.0, 0.0}, OdometryMotionModel::decompose({3, 4, 1}, {3, 4, 1}));
+}
+
+// --- apply without noise -----------------------------------------------------
+
+TEST(ApplyNoiseless, ForwardMovesEveryParticleAlongItsHeading) {
+  const OdometryMotionModel model(noiseless(OdometryMotionParams::Kind::kDifferential));
+  ParticleSet p = particlesAt({{0, 0, 0}, {1, 1, M_PI / 2}, {-2, 3, M_PI}, {0.5, -0.5, -M_PI / 2}});
+  Random random(1);
+  // The odometry frame differs from the map frame: only the relative motion
+  // (1 m forward) matters.
+  model.apply({10, 10, 0}, {11, 10, 0}, &p, &random);
+  expectPoseNear({1, 0, 0}, p.pose(0));
+  expectPoseNear({1, 2, M_PI / 2}, p.pose(1));
+  expectPoseNear({-3, 3, M_PI}, p.pose(2));
+  expectPoseNear({0.5, -1.5, -M_PI / 2}, p.pose(3));
+  // Weights are not the motion model's business.
+  for (double w : p.weight) EXPECT_EQ(0.25, w);
+}
+
+TEST(ApplyNoiseless, BackwardMovesEveryParticleBackwards) {
+  const OdometryMotionModel model(noiseless(OdometryMotionParams::Kind::kDifferential));
+  ParticleSet p = particlesAt({{0, 0, 0}, {1, 1, M_PI / 2}, {-2, 3, M_PI}});
+  Random random(1);
+  model.apply({0, 0, 0}, {-1, 0, 0}, &p, &random);
+  expectPoseNear({-1, 0, 0}, p.pose(0));
+  expectPoseNear({1, 0, M_PI / 2}, p.pose(1));
+  expectPoseNear({-1, 3, M_PI}, p.pose(2));
+}
+
+TEST(ApplyNoiseless, PureRotationAcrossPi) {
+  const OdometryMotionModel model(noiseless(OdometryMotionParams::Kind::kDifferential));
+  ParticleSet p = particlesAt({{1, 2, M_PI - 0.05}, {-1, 0, 0}});
+  Random random(1);
+  model.apply({5, 5, M_PI - 0.1}, {5, 5, -M_PI + 0.1}, &p, &random);
+  // +0.2 rad: pi - 0.05 + 0.2 wraps to -pi + 0.15. Positions do not move.
+  EXPECT_EQ(1.0, p.x[0]);
+  EXPECT_EQ(2.0, p.y[0]);
+  EXPECT_NEAR(-M_PI + 0.15, p.yaw[0], kTol);
+  EXPECT_EQ(-1.0, p.x[1]);
+  EXPECT_EQ(0.0, p.y[1]);
+  EXPECT_NEAR(0.2, p.yaw[1], kTol);
+}
+
+TEST(ApplyNoiseless, EqualsComposingTheOdometryDelta) {
+  // Without noise a particle p moves to p (+) (from^-1 (+) to), for any motion
+  // of at least 1 cm, forwards, backwards or sideways, in either model.
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> coord(-5.0, 5.0), angle(-M_PI, M_PI), step(-1.0, 1.0);
+  for (auto kind : {OdometryMotionParams::Kind::kDifferential, OdometryMotionParams::Kind::kOmni}) {
+    const OdometryMotionModel model(noiseless(kind));
+    Random random(1);
+    for (int trial = 0; trial < 100; ++trial) {
+      const Pose2 from{coord(rng), coord(rng), angle(rng)};
+      Pose2 delta{step(rng), step(rng), angle(rng)};
+      if (std::hypot(delta.x, delta.y) < 0.02) delta.x = 0.5;
+      const Pose2 to = compose(from, delta);
+      const Pose2 start{coord(rng), coord(rng), angle(rng)};
+      ParticleSet p = particlesAt({start});
+      model.apply(from, to, &p, &random);
+      expectPoseNear(compose(start, delta), p.pose(0), 1e-9);
+    }
+  }
+}
+
+TEST(ApplyNoiseless, OmniMovesSideways) {
+  const OdometryMotionModel model(noiseless(OdometryMotionParams::Kind::kOmni));
+  ParticleSet p = particlesAt({{1, 1, M_PI / 2}, {0, 0, 0}});
+  Random random(1);
+  // 1 m to the robot's left without turning: for a particle facing +y that is
+  // 1 m towards -x.
+  model.apply({0, 0, 0}, {0, 1, 0}, &p, &random);
+  expectPoseNear({0, 1, M_PI / 2}, p.pose(0));
+  expectPoseNear({0, 1, 0}, p.pose(1));
+  // Diagonally while turning a quarter: (1, 1) in the robot frame.
+  model.apply({0, 0, 0}, {1, 1, M_PI / 2}, &p, &random);
+  expectPoseNear({-1, 2, M_PI}, p.pose(0));
+  expectPoseNear({1, 2, M_PI / 2}, p.pose(1));
+  // In-place rotation across pi.
+  model.apply({0, 0, M_PI - 0.1}, {0, 0, -M_PI + 0.1}, &p, &random);
+  expectPoseNear({-1, 2, -M_PI + 0.2}, p.pose(0));
+}
+
+// --- apply with noise ---------------------------------------------------------
+
+constexpr std::size_t kSamples = 40000;
+
+OdometryMotionParams noisy() {
+  OdometryMotionParams p;
+  p.alpha1 = 0.1;   // rot from rot
+  p.alpha2 = 0.01;  // rot from trans
+  p.alpha3 = 0.04;  // trans from trans
+  p.alpha4 = 0.02;  // trans from rot
+  p.alpha5 = 0.09;  // strafe (omni)
+  return p;
+}
+
+TEST(ApplyNoisy, ForwardSpreadMatchesTheModel) {
+  const OdometryMotionModel model(noisy());
+  ParticleSet p = manyAt({0, 0, 0}, kSamples);
+  Random random(11);
+  model.apply({0, 0, 0}, {1, 0, 0}, &p, &random);
+  // rot1 = rot2 = 0, trans = 1:
+  //   sigma_rot1 = sigma_rot2 = sqrt(alpha2 * 1) = 0.1, sigma_trans = sqrt(alpha3) = 0.2.
+  // The travelled distance and its direction recover trans and rot1; the
+  // final heading less that direction recovers rot2.
+  const Stats trans = stats(kSamples, [&](std::size_t i) { return std::hypot(p.x[i], p.y[i]); });
+  const Stats rot1 = stats(kSamples, [&](std::size_t i) { return std::atan2(p.y[i], p.x[i]); });
+  const Stats rot2 = stats(kSamples, [&](std::size_t i) {
+    return angleDiff(p.yaw[i], std::atan2(p.y[i], p.x[i]));
+  });
+  EXPECT_NEAR(1.0, trans.mean, 0.005);
+  EXPECT_NEAR(0.2, trans.stddev, 0.01);
+  EXPECT_NEAR(0.0, rot1.mean, 0.003);
+  EXPECT_NEAR(0.1, rot1.stddev, 0.005);
+  EXPECT_NEAR(0.0, rot2.mean, 0.003);
+  EXPECT_NEAR(0.1, rot2.stddev, 0.005);
+  // The final heading: the sum of both, sqrt(0.01 + 0.01).
+  const Stats yaw = stats(kSamples, [&](std::size_t i) { return p.yaw[i]; });
+  EXPECT_NEAR(0.0, yaw.mean, 0.003);
+  EXPECT_NEAR(std::sqrt(0.02), yaw.stddev, 0.007);
+}
+
+TEST(ApplyNoisy, RotationInPlaceSpreadMatchesTheModel) {
+  const OdometryMotionModel model(noisy());
+  ParticleSet p = manyAt({0, 0, 0}, kSamples);
+  Random random(12);
+  model.apply({0, 0, 0}, {0, 0, 1.0}, &p, &random);
+  // rot1 = 0, trans = 0, rot2 = 1: sigma_rot1 = 0, so every particle slides
+  // along its unchanged heading (+x) by the translation noise
+  // sqrt(alpha4 * 1) = 0.141, and turns by 1 with sqrt(alpha1 * 1) = 0.316.
+  for (std::size_t i = 0; i < kSamples; ++i) ASSERT_EQ(0.0, p.y[i]);
+  const Stats x = stats(kSamples, [&](std::size_t i) { return p.x[i]; });
+  const Stats yaw = stats(kSamples, [&](std::size_t i) { return p.yaw[i]; });
+  EXPECT_NEAR(0.0, x.mean, 0.003);
+  EXPECT_NEAR(std::sqrt(0.02), x.stddev, 0.007);
+  EXPECT_NEAR(1.0, yaw.mean, 0.006);
+  EXPECT_NEAR(std::sqrt(0.1), yaw.stddev, 0.016);
+}
+
+TEST(ApplyNoisy, DrivingBackwardsIsNotTurningAround) {
+  const OdometryMotionModel model(noisy());
+  ParticleSet p = manyAt({0, 0, 0}, kSamples);
+  Random random(13);
+  model.apply({0, 0, 0}, {-1, 0, 0}, &p, &random);
+  // rot1 = rot2 = pi would give the textbook model a rotation noise of
+  // sqrt(alpha1 pi^2 + alpha2) = 1.0 rad and a translation noise of
+  // sqrt(alpha3 + alpha4 2 pi^2) = 0.89 m. Reversing 1 m is really a 1 m
+  // move: the same 0.1 rad, 0.2 m and 0.1 rad as forwards.
+  const Stats trans = stats(kSamples, [&](std::size_t i) { return std::hypot(p.x[i], p.y[i]); });
+  const Stats rot1 = stats(kSamples, [&](std::size_t i) {
+    return angleDiff(std::atan2(p.y[i], p.x[i]), M_PI);  // deviation from straight back
+  });
+  const Stats yaw = stats(kSamples, [&](std::size_t i) { return p.yaw[i]; });
+  EXPECT_NEAR(1.0, trans.mean, 0.005);
+  EXPECT_NEAR(0.2, trans.stddev, 0.01);
+  EXPECT_NEAR(0.0, rot1.mean, 0.003);
+  EXPECT_NEAR(0.1, rot1.stddev, 0.005);
+  EXPECT_NEAR(0.0, yaw.mean, 0.003);
+  EXPECT_NEAR(std::sqrt(0.02), yaw.stddev, 0.007);
+  const Stats x = stats(kSamples, [&](std::size_t i) { return p.x[i]; });
+  EXPECT_NEAR(-1.0, x.mean, 0.01);
+}
+
+TEST(ApplyNoisy, OmniSpreadMatchesTheModel) {
+  OdometryMotionParams params = noisy();
+  params.kind = OdometryMotionParams::Kind::kOmni;
+  const OdometryMotionModel model(params);
+  ParticleSet p = manyAt({0, 0, 0}, kSamples);
+  Random random(14);
+  model.apply({0, 0, 0}, {1, 0, 0}, &p, &random);
+  // trans = 1, rot = 0: forward sqrt(alpha3) = 0.2, strafe sqrt(alpha5) = 0.3,
+  // heading sqrt(alpha2) = 0.1.
+  const Stats x = stats(kSamples, [&](std::size_t i) { return p.x[i]; });
+  const Stats y = stats(kSamples, [&](std::size_t i) { return p.y[i]; });
+  const Stats yaw = stats(kSamples, [&](std::size_t i) { return p.yaw[i]; });
+  EXPECT_NEAR(1.0, x.mean, 0.005);
+  EXPECT_NEAR(0.2, x.stddev, 0.01);
+  EXPECT_NEAR(0.0, y.mean, 0.008);
+  EXPECT_NEAR(0.3, y.stddev, 0.015);
+  EXPECT_NEAR(0.0, yaw.mean, 0.003);
+  EXPECT_NEAR(0.1, yaw.stddev, 0.005);
+}
+
+TEST(ApplyNoisy, SameSeedSameParticles) {
+  const OdometryMotionModel model(noisy());
+  ParticleSet a = manyAt({1, 2, 3}, 100), b = a;
+  Random ra(5), rb(5);
+  model.apply({0, 0, 0}, {0.3, 0.1, 0.4}, &a, &ra);
+  model.apply({0, 0, 0}, {0.3, 0.1, 0.4}, &b, &rb);
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.y, b.y);
+  EXPECT_EQ(a.yaw, b.yaw);
+}
+
+// --- parameters ---------------------------------------------------------------
+
+TEST(OdometryMotionModel, RejectsNegativeOrNonFiniteAlphas) {
+  const double bad[] = {-0.1, std::numeric_limits<double>::quiet_NaN(),
+                        std::numeric_limits<double>::infinity()};
+  for (int i = 0; i < 5; ++i) {
+    for (double value : bad) {
+      OdometryMotionParams params;
+      double* alphas[] = {&params.alpha1, &params.alpha2, &params.alpha3, &params.alpha4,
+                          &params.alpha5};
+      *alphas[i] = value;
+      const std::string name = "odom_alpha" + std::to_string(i + 1);
+      try {
+        OdometryMotionModel model(params);
+        ADD_FAILURE() << name << " = " << value << " accepted";
+      } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string::npos, std::string(e.what()).find(name)) << e.what();
+      }
+    }
+  }
+  EXPECT_NO_THROW(OdometryMotionModel(noiseless(OdometryMotionParams::Kind::kDifferential)));
+}
+
+}  // namespace
+}  // namespace pf

@@ -8,6 +8,7 @@ import importlib.machinery
 import importlib.util
 import math
 import os
+import sys
 import tempfile
 import unittest
 
@@ -17,6 +18,7 @@ _PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'sc
 _loader = importlib.machinery.SourceFileLoader('pf_evaluate', _PATH)
 _spec = importlib.util.spec_from_loader('pf_evaluate', _loader)
 pfe = importlib.util.module_from_spec(_spec)
+sys.dont_write_bytecode = True  # no __pycache__ next to scripts/pf_evaluate
 _loader.exec_module(pfe)
 
 

@@ -1,1 +1,131 @@
-// placeholder: being written
+#include "pf_localization/sim/path_script.h"
+
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+namespace pf::sim {
+namespace {
+
+PathScript parse(const std::string& text) {
+  std::istringstream in(text);
+  return parsePathScript(in, "test.path");
+}
+
+// The message parsePathScript throws for `text`, or "" when it parses.
+std::string errorOf(const std::string& text) {
+  try {
+    parse(text);
+  } catch (const PathScriptError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+void expectMotion(const Motion& m, double v, double w, double duration, int line) {
+  EXPECT_FALSE(m.teleport);
+  EXPECT_DOUBLE_EQ(m.v, v);
+  EXPECT_DOUBLE_EQ(m.w, w);
+  EXPECT_DOUBLE_EQ(m.duration, duration);
+  EXPECT_EQ(m.line, line);
+}
+
+TEST(PathScriptTest, CompilesEveryCommand) {
+  const PathScript s = parse(
+      "# a comment line\n"
+      "\n"
+      "start 1 2 0      # trailing comment\n"
+      "speed 0.5 1.0\n"
+      "goto 3 2\n"  // straight ahead: 2 m, no turn
+      "goto 3 4\n"  // a quarter turn left, then 2 m
+      "turn 0\n"
+      "wait 1.5\n"
+      "velocity 0.2 -0.1 3\n"
+      "teleport 0 0 3.5\n"
+      "person 0 0 1 0 0.5\n");
+  EXPECT_EQ(s.file, "test.path");
+  EXPECT_EQ(s.start_line, 3);
+  EXPECT_DOUBLE_EQ(s.start.x, 1.0);
+  EXPECT_DOUBLE_EQ(s.start.y, 2.0);
+  ASSERT_EQ(s.motions.size(), 7u);
+  expectMotion(s.motions[0], 0.5, 0.0, 4.0, 5);
+  expectMotion(s.motions[1], 0.0, 1.0, M_PI / 2, 6);
+  expectMotion(s.motions[2], 0.5, 0.0, 4.0, 6);
+  expectMotion(s.motions[3], 0.0, -1.0, M_PI / 2, 7);
+  expectMotion(s.motions[4], 0.0, 0.0, 1.5, 8);
+  expectMotion(s.motions[5], 0.2, -0.1, 3.0, 9);
+  EXPECT_TRUE(s.motions[6].teleport);
+  EXPECT_DOUBLE_EQ(s.motions[6].target.yaw, 3.5 - 2 * M_PI);
+  EXPECT_DOUBLE_EQ(s.duration(), 4.0 + M_PI / 2 + 4.0 + M_PI / 2 + 1.5 + 3.0);
+  ASSERT_EQ(s.people.size(), 1u);
+  EXPECT_DOUBLE_EQ(s.people[0].speed, 0.5);
+}
+
+TEST(PathScriptTest, GotoTakesTheShorterTurn) {
+  const PathScript s = parse("start 0 0 3\ngoto -1 0\n");  // pi - 3 to the left
+  ASSERT_EQ(s.motions.size(), 2u);
+  EXPECT_DOUBLE_EQ(s.motions[0].w, 0.8);
+  EXPECT_NEAR(s.motions[0].duration, (M_PI - 3.0) / 0.8, 1e-12);
+}
+
+TEST(PersonTest, WalksToAndFro) {
+  const Person p{0.0, 0.0, 2.0, 0.0, 0.5};
+  double x, y;
+  p.positionAt(1.0, &x, &y);
+  EXPECT_DOUBLE_EQ(x, 0.5);
+  p.positionAt(5.0, &x, &y);  // 2.5 m walked: at the far end and half a metre back
+  EXPECT_DOUBLE_EQ(x, 1.5);
+  EXPECT_DOUBLE_EQ(y, 0.0);
+}
+
+TEST(PathScriptTest, ErrorsNameFileAndLine) {
+  EXPECT_EQ(errorOf("start 0 0 0\n\nfly 1 2\n"),
+            "test.path:3: unknown command 'fly' (expected start, speed, goto, turn, wait, "
+            "velocity, teleport or person)");
+  EXPECT_EQ(errorOf("start 0 0 0\ngoto 1 x\n"), "test.path:2: 'x' is not a number (in 'goto')");
+  EXPECT_EQ(errorOf("start 0 0 0\ngoto 1 2e\n"), "test.path:2: '2e' is not a number (in 'goto')");
+  EXPECT_EQ(errorOf("start 0 0 0\ngoto 1\n"), "test.path:2: 'goto' takes 2 number(s): goto x y");
+  EXPECT_EQ(errorOf("start 0 0 0\nwait 1 2\n"),
+            "test.path:2: 'wait' takes 1 number(s): wait seconds");
+  EXPECT_EQ(errorOf("# nothing yet\ngoto 1 1\n"),
+            "test.path:2: 'start x y yaw' must come before 'goto'");
+  EXPECT_EQ(errorOf("start 0 0 0\nstart 1 1 0\n"), "test.path:2: 'start' given twice");
+  EXPECT_EQ(errorOf("start 0 0 0\nspeed 0 1\n"),
+            "test.path:2: speed v must be positive, got 0.000000");
+  EXPECT_EQ(errorOf("start 0 0 0\nwait -1\n"),
+            "test.path:2: wait time must be positive, got -1.000000");
+  EXPECT_EQ(errorOf("start 0 0 nan\n"), "test.path:1: 'nan' is not a number (in 'start')");
+  EXPECT_EQ(errorOf("# empty\n"), "test.path: no 'start x y yaw' line");
+  EXPECT_THROW(loadPathScript("/nonexistent/x.path"), PathScriptError);
+}
+
+// A 10 x 6 room of 0.1 m cells (1 x 0.6 m) with a pillar in the middle.
+OccupancyGrid room() {
+  std::vector<int8_t> data(10 * 6, 0);
+  for (int x = 0; x < 10; ++x) data[x] = data[5 * 10 + x] = 100;
+  for (int y = 0; y < 6; ++y) data[y * 10] = data[y * 10 + 9] = 100;
+  data[2 * 10 + 5] = data[3 * 10 + 5] = 100;  // pillar at x 0.5-0.6, y 0.2-0.4
+  return OccupancyGrid(10, 6, 0.1, {}, data);
+}
+
+TEST(CheckClearanceTest, AcceptsAPathInFreeSpace) {
+  const PathScript s = parse("start 0.2 0.25 0\ngoto 0.2 0.35\nturn 3\nwait 1\n");
+  EXPECT_EQ(checkClearance(s, room(), 0.045), std::nullopt);
+}
+
+TEST(CheckClearanceTest, ReportsTheLineThatHitsAWall) {
+  const PathScript s = parse("start 0.2 0.25 0\nwait 1\ngoto 0.8 0.25\n");
+  EXPECT_EQ(checkClearance(s, room(), 0.045).value_or(""),
+            "test.path:3: the robot (radius 0.045 m) leaves free space at (0.46, 0.25)");
+}
+
+TEST(CheckClearanceTest, ChecksTheStartAndTeleportTargets) {
+  EXPECT_EQ(checkClearance(parse("start 0.05 0.25 0\n"), room(), 0.045).value_or(""),
+            "test.path:1: the robot (radius 0.045 m) leaves free space at (0.05, 0.25)");
+  EXPECT_EQ(
+      checkClearance(parse("start 0.2 0.25 0\nteleport 0.55 0.3 0\n"), room(), 0.045).value_or(""),
+      "test.path:2: the robot (radius 0.045 m) leaves free space at (0.55, 0.30)");
+}
+
+}  // namespace
+}  // namespace pf::sim

@@ -29,7 +29,10 @@ geometry_msgs::Transform toTransformMsg(const pf::Pose2& p);
 /// The scan with the laser's pose on the robot attached.
 pf::LaserScan toCore(const sensor_msgs::LaserScan& msg, const pf::Pose2& sensor_pose);
 /// Throws std::invalid_argument for a malformed grid (size mismatch, zero size, bad resolution).
+/// The float32 resolution is read as the shortest decimal that gives the same
+/// float (0.05f -> 0.05), so toCore(toMsg(g)) == g for map-file resolutions.
 pf::OccupancyGrid toCore(const nav_msgs::OccupancyGrid& msg);
+/// Info and data only: the caller fills the header and map_load_time.
 nav_msgs::OccupancyGrid toMsg(const pf::OccupancyGrid& grid);
 
 /// The 6x6 ROS covariance (x, y, z, roll, pitch, yaw) from the 3x3 (x, y, yaw)
@@ -38,7 +41,7 @@ boost::array<double, 36> toRosCovariance(const Eigen::Matrix3d& cov);
 /// The (x, y, yaw) block of a ROS 6x6 covariance.
 Eigen::Matrix3d fromRosCovariance(const boost::array<double, 36>& cov);
 
-/// Every particle as a pose (weights are not part of a PoseArray).
+/// Every particle as a pose (weights are not part of a PoseArray); the header is left as it is.
 void toPoseArray(const pf::ParticleSet& particles, geometry_msgs::PoseArray* out);
 
 }  // namespace pf_ros

@@ -24,11 +24,11 @@
 namespace pf::sim {
 
 struct DiffDriveParams {
-  double track_width = 0.248;         // m, nominal (what the odometry assumes); Neato XV-11
-  double left_radius_error = 0.0;     // true left wheel radius = nominal * (1 + this)
-  double right_radius_error = 0.0;    // true right wheel radius = nominal * (1 + this)
-  double track_width_error = 0.0;     // true track width = nominal * (1 + this)
-  double slip_sigma = 0.0;            // m / sqrt(m): per-wheel slip std after 1 m of travel
+  double track_width = 0.248;       // m, nominal (what the odometry assumes); Neato XV-11
+  double left_radius_error = 0.0;   // true left wheel radius = nominal * (1 + this)
+  double right_radius_error = 0.0;  // true right wheel radius = nominal * (1 + this)
+  double track_width_error = 0.0;   // true track width = nominal * (1 + this)
+  double slip_sigma = 0.0;          // m / sqrt(m): per-wheel slip std after 1 m of travel
 };
 
 /// The pose reached from `p` by driving `ds` along a circular arc that turns

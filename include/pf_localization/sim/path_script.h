@@ -50,8 +50,8 @@ struct Motion {
 /// A circular obstacle that is not on the map, walking back and forth.
 struct Person {
   double x1 = 0.0, y1 = 0.0, x2 = 0.0, y2 = 0.0;  // m
-  double speed = 0.0;                              // m/s
-  double radius = 0.2;                             // m
+  double speed = 0.0;                             // m/s
+  double radius = 0.2;                            // m
   /// Centre at time t (s): a triangle wave between the two end points.
   void positionAt(double t, double* x, double* y) const;
 };

@@ -47,15 +47,15 @@ class RayCaster {
 double castToCircle(double x, double y, double angle, double cx, double cy, double r);
 
 struct NeatoLaserParams {
-  double range_min = 0.02;      // m
-  double range_max = 5.0;       // m; a return at or beyond it reads 0
-  double sigma = 0.012;         // m, Gaussian range noise
-  double resolution = 0.001;    // m, readings are rounded to this
-  double dropout_near = 0.10;   // probability of a single dropout at range 0
-  double dropout_far = 0.40;    // ... at range_max (linear in between)
-  double burst_rate = 0.02;     // probability that a burst of dropouts starts at a beam
-  double burst_mean = 5.0;      // mean burst length (beams; geometric)
-  double short_rate = 0.003;    // probability of a random short return
+  double range_min = 0.02;     // m
+  double range_max = 5.0;      // m; a return at or beyond it reads 0
+  double sigma = 0.012;        // m, Gaussian range noise
+  double resolution = 0.001;   // m, readings are rounded to this
+  double dropout_near = 0.10;  // probability of a single dropout at range 0
+  double dropout_far = 0.40;   // ... at range_max (linear in between)
+  double burst_rate = 0.02;    // probability that a burst of dropouts starts at a beam
+  double burst_mean = 5.0;     // mean burst length (beams; geometric)
+  double short_rate = 0.003;   // probability of a random short return
 };
 
 /// Neato readings for ideal ranges (+inf: no return), beam by beam in scan order.
