@@ -1,1 +1,288 @@
-// placeholder: being written
+#include "pf_localization/core/likelihood_field_model.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace pf {
+namespace {
+
+// Per-beam values are tabulated as float.
+constexpr double kTol = 1e-5;
+
+// p = z_hit N(d; 0, 0.2) + z_rand / range_max with z_hit 0.9, z_rand 0.1 and
+// range_max 4 m; z_hit N(0; 0, 0.2) = 0.9 / (0.2 sqrt(2 pi)) = 1.795240.
+//   d = 0:   log(1.795240 + 0.025)                     =  0.598969
+//   d = 0.2: log(1.795240 exp(-0.5) + 0.025)            =  0.107839
+//   d = 0.3: log(1.795240 exp(-1.125) + 0.025)          = -0.497861
+//   d = 0.5: log(1.795240 exp(-3.125) + 0.025)          = -2.264544
+//   d = 0.6: log(1.795240 exp(-4.5) + 0.025)            = -3.102353
+//   d = 0.8: log(1.795240 exp(-8) + 0.025)              = -3.665076
+constexpr double kLogP0 = 0.5989685043574534;
+constexpr double kLogP02 = 0.1078388762859554;
+constexpr double kLogP03 = -0.4978613896214299;
+constexpr double kLogP05 = -2.264544381335515;
+constexpr double kLogP06 = -3.1023531864294274;
+constexpr double kLogP08 = -3.665075586938184;
+
+LikelihoodFieldModelParams params(double max_distance = 2.0) {
+  LikelihoodFieldModelParams p;
+  p.z_hit = 0.9;
+  p.z_rand = 0.1;
+  p.sigma_hit = 0.2;
+  p.max_distance = max_distance;
+  p.max_beams = 60;
+  return p;
+}
+
+// 10 x 5 cells of 0.1 m (1 m x 0.5 m); the cells of column `wall_x` are
+// occupied, everything else free.
+OccupancyGrid wallGrid(int wall_x, const Pose2& origin = {}) {
+  std::vector<int8_t> data(50, 0);
+  for (int y = 0; y < 5; ++y) data[y * 10 + wall_x] = 100;
+  return OccupancyGrid(10, 5, 0.1, origin, data);
+}
+
+// Beams at 0, pi/2, pi, ... rad with the given ranges.
+LaserScan quarterScan(std::vector<float> ranges, double range_max = 4.0) {
+  LaserScan scan;
+  scan.ranges = std::move(ranges);
+  scan.angle_min = 0.0;
+  scan.angle_increment = M_PI / 2;
+  scan.range_min = 0.05;
+  scan.range_max = range_max;
+  return scan;
+}
+
+TEST(LikelihoodFieldModel, BeamLogLikelihoodFormula) {
+  LikelihoodFieldModelParams p;
+  p.z_hit = 0.8;
+  p.z_rand = 0.2;
+  p.sigma_hit = 0.5;
+  const LikelihoodFieldModel model(wallGrid(8), p);
+  // 0.8 exp(-0.5 * 0.3^2 / 0.5^2) / (0.5 sqrt(2 pi)) = 0.8 * 0.835270 / 1.253314
+  // = 0.533159, plus 0.2 / 4 = 0.05: log(0.583159) = -0.539295.
+  EXPECT_NEAR(-0.5392947772809207, model.beamLogLikelihood(0.3, 4.0), 1e-12);
+  // Far away only the random component is left: log(0.2 / 4).
+  EXPECT_NEAR(std::log(0.05), model.beamLogLikelihood(100.0, 4.0), 1e-12);
+  // A longer range_max spreads z_rand thinner.
+  EXPECT_NEAR(std::log(0.025), model.beamLogLikelihood(100.0, 8.0), 1e-12);
+
+  const LikelihoodFieldModel m2(wallGrid(8), params());
+  EXPECT_NEAR(kLogP0, m2.beamLogLikelihood(0.0, 4.0), 1e-12);
+  EXPECT_NEAR(kLogP06, m2.beamLogLikelihood(0.6, 4.0), 1e-12);
+}
+
+TEST(LikelihoodFieldModel, PrepareDropsBadBeamsAndPlacesEndPoints) {
+  const LikelihoodFieldModel model(wallGrid(8), params());
+  const PreparedScan scan = model.prepare(quarterScan({1.0f, NAN, 2.0f, 0.0f}));
+  EXPECT_EQ(2, scan.dropped);
+  EXPECT_EQ(4.0, scan.range_max);
+  ASSERT_EQ(2u, scan.size());
+  EXPECT_NEAR(1.0, scan.x[0], 1e-6);  // ahead
+  EXPECT_NEAR(0.0, scan.y[0], 1e-6);
+  EXPECT_NEAR(-2.0, scan.x[1], 1e-6);  // behind
+  EXPECT_NEAR(0.0, scan.y[1], 1e-6);
+}
+
+TEST(LikelihoodFieldModel, PrepareHonoursTheRangeOverrides) {
+  LikelihoodFieldModelParams p = params();
+  p.range_max = 1.5;  // tighter than the scan's 4 m: drops the 2 m and 3 m beams
+  p.range_min = 0.5;  // drops the 0.2 m beam
+  const LikelihoodFieldModel model(wallGrid(8), p);
+  const PreparedScan scan = model.prepare(quarterScan({0.2f, 1.0f, 2.0f, 3.0f}));
+  EXPECT_EQ(3, scan.dropped);
+  EXPECT_EQ(1.5, scan.range_max);  // and z_rand is spread over 1.5 m
+  ASSERT_EQ(1u, scan.size());
+  EXPECT_NEAR(0.0, scan.x[0], 1e-6);
+  EXPECT_NEAR(1.0, scan.y[0], 1e-6);
+}
+
+TEST(LikelihoodFieldModel, HitAndMissOnALiteralWall) {
+  // The wall is column 8, x in [0.8, 0.9).
+  const LikelihoodFieldModel model(wallGrid(8), params());
+  const PreparedScan scan = model.prepare(quarterScan({0.6f, 0.1f}));
+  ASSERT_EQ(2u, scan.size());
+  // From (0.25, 0.25) facing +x the beam ahead ends at x = 0.85, in the wall
+  // (d = 0); the beam to the left ends at (0.25, 0.35), cell (2, 3), six
+  // cells from the wall (d = 0.6).
+  EXPECT_NEAR(kLogP0 + kLogP06, model.logLikelihood(scan, {0.25, 0.25, 0.0}), kTol);
+  // 0.2 m further back, the first beam stops two cells short of the wall
+  // (d = 0.2) and the second ends in cell (0, 3), eight cells away (d = 0.8).
+  EXPECT_NEAR(kLogP02 + kLogP08, model.logLikelihood(scan, {0.05, 0.25, 0.0}), kTol);
+  // The hit scores better than the miss.
+  EXPECT_GT(model.logLikelihood(scan, {0.25, 0.25, 0.0}),
+            model.logLikelihood(scan, {0.05, 0.25, 0.0}));
+  // Facing +y from (0.35, 0.05): the first beam goes up to (0.35, 0.65) and
+  // leaves the 0.5 m high map (d = max_distance = 2, log(0.025 + ~0)); the
+  // second goes left to (0.25, 0.05), d = 0.6.
+  EXPECT_NEAR(std::log(0.025) + kLogP06, model.logLikelihood(scan, {0.35, 0.05, M_PI / 2}), kTol);
+}
+
+TEST(LikelihoodFieldModel, LaserMountedBackwards) {
+  // Wall in column 0, x in [0, 0.1). The robot at (0.45, 0.25) faces +x; its
+  // laser sits 0.1 m behind its centre, looking backwards.
+  const LikelihoodFieldModel model(wallGrid(0), params());
+  LaserScan raw = quarterScan({0.3f, 0.1f});
+  raw.sensor_pose = {-0.1, 0.0, M_PI};
+  const PreparedScan scan = model.prepare(raw);
+  ASSERT_EQ(2u, scan.size());
+  // The laser's beam ahead (0.3, 0) is (-0.1 - 0.3, 0) on the robot; its beam
+  // to the left (0, 0.1) is the robot's right: (-0.1, -0.1).
+  EXPECT_NEAR(-0.4, scan.x[0], 1e-6);
+  EXPECT_NEAR(0.0, scan.y[0], 1e-6);
+  EXPECT_NEAR(-0.1, scan.x[1], 1e-6);
+  EXPECT_NEAR(-0.1, scan.y[1], 1e-6);
+  // In the world: (0.05, 0.25) in the wall (d = 0) and (0.35, 0.15), cell
+  // (3, 1), three cells from it (d = 0.3).
+  EXPECT_NEAR(kLogP0 + kLogP03, model.logLikelihood(scan, {0.45, 0.25, 0.0}), kTol);
+  // A robot turned around, at (0.35, 0.25) facing -x, has its laser at
+  // (0.45, 0.25) looking +x: the beams end at (0.75, 0.25) (d = 0.7) and
+  // (0.45, 0.35) (d = 0.4) - nowhere near the wall.
+  EXPECT_NEAR(model.beamLogLikelihood(0.7, 4.0) + model.beamLogLikelihood(0.4, 4.0),
+              model.logLikelihood(scan, {0.35, 0.25, M_PI}), kTol);
+}
+
+TEST(LikelihoodFieldModel, EndPointsOutsideTheMapScoreMaxDistance) {
+  // Capped at 0.5 m so that the cap is visible inside the map too.
+  const LikelihoodFieldModel model(wallGrid(8), params(0.5));
+  auto score = [&](float range, double bearing, const Pose2& pose) {
+    LaserScan raw = quarterScan({range});
+    raw.angle_min = bearing;
+    return model.logLikelihood(model.prepare(raw), pose);
+  };
+  const Pose2 pose{0.25, 0.25, 0.0};
+  EXPECT_NEAR(kLogP05, score(1.0f, -M_PI / 2, pose), kTol);         // (0.25, -0.75): below
+  EXPECT_NEAR(kLogP05, score(0.5f, M_PI, pose), kTol);              // (-0.25, 0.25): left of it
+  EXPECT_NEAR(kLogP05, score(0.85f, 0.0, pose), kTol);              // (1.1, 0.25): beyond the wall
+  EXPECT_NEAR(kLogP05, score(3.9f, M_PI / 4, pose), kTol);          // far up and right
+  EXPECT_NEAR(kLogP05, score(0.15f, 0.0, {-1e5, 1e5, 0.0}), kTol);  // far away
+  // Inside the map the same cap applies: (0.05, 0.25) is 0.8 m from the wall.
+  EXPECT_NEAR(kLogP05, score(0.2f, M_PI, pose), kTol);
+  EXPECT_NEAR(kLogP0, score(0.6f, 0.0, pose), kTol);  // and the wall still scores d = 0
+}
+
+TEST(LikelihoodFieldModel, RangeMaxChangesAreNotServedFromAStaleTable) {
+  const LikelihoodFieldModel model(wallGrid(8), params());
+  const PreparedScan short_scan = model.prepare(quarterScan({0.6f, 0.1f}, 4.0));
+  const PreparedScan long_scan = model.prepare(quarterScan({0.6f, 0.1f}, 8.0));
+  const Pose2 pose{0.25, 0.25, 0.0};
+  const double expected_long =
+      model.beamLogLikelihood(0.0, 8.0) + model.beamLogLikelihood(0.6, 8.0);  // -2.836183
+  EXPECT_NEAR(kLogP0 + kLogP06, model.logLikelihood(short_scan, pose), kTol);
+  EXPECT_NEAR(-2.8361831871950933, model.logLikelihood(long_scan, pose), kTol);
+  EXPECT_NEAR(expected_long, model.logLikelihood(long_scan, pose), kTol);
+  EXPECT_NEAR(kLogP0 + kLogP06, model.logLikelihood(short_scan, pose), kTol);
+}
+
+TEST(LikelihoodFieldModel, RotatedMapOrigin) {
+  // The same cells, but the map's x axis points along world +y and its
+  // corner is at (2, 1): a pose p of the unrotated map is origin (+) p here.
+  const Pose2 origin{2.0, 1.0, M_PI / 2};
+  const LikelihoodFieldModel plain(wallGrid(8), params());
+  const LikelihoodFieldModel rotated(wallGrid(8, origin), params());
+  const PreparedScan scan = rotated.prepare(quarterScan({0.6f, 0.1f, 0.3f, 0.2f}));
+  // The literal case: (0.25, 0.25, 0) becomes (1.75, 1.25, pi/2).
+  const PreparedScan two = rotated.prepare(quarterScan({0.6f, 0.1f}));
+  EXPECT_NEAR(kLogP0 + kLogP06, rotated.logLikelihood(two, {1.75, 1.25, M_PI / 2}), kTol);
+  // Ahead of (0.25, 0.25, 0) in the unrotated world is outside the rotated map.
+  EXPECT_NEAR(std::log(0.025) + std::log(0.025), rotated.logLikelihood(two, {0.25, 0.25, 0.0}),
+              1e-4);
+  const Pose2 poses[] = {{0.25, 0.25, 0.0}, {0.55, 0.15, 0.3}, {0.35, 0.45, -2.0}};
+  for (const Pose2& p : poses) {
+    EXPECT_NEAR(plain.logLikelihood(scan, p), rotated.logLikelihood(scan, compose(origin, p)),
+                kTol);
+  }
+}
+
+TEST(LikelihoodFieldModel, ParticleSetMatchesPerPoseAndBruteForce) {
+  // A 3 m x 2 m room of 0.05 m cells with walls on its border and a pillar.
+  const int w = 60, h = 40;
+  std::vector<int8_t> data(w * h, 0);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const bool border = x == 0 || y == 0 || x == w - 1 || y == h - 1;
+      const bool pillar = x >= 30 && x < 36 && y >= 10 && y < 14;
+      if (border || pillar) data[y * w + x] = 100;
+      if (x >= 40 && x < 45 && y >= 30 && y < 35) data[y * w + x] = -1;
+    }
+  }
+  const OccupancyGrid grid(w, h, 0.05, {-0.5, -0.3, 0.2}, data);
+  LikelihoodFieldModelParams p = params(1.0);
+  p.max_beams = 30;
+  const LikelihoodFieldModel model(grid, p);
+
+  LaserScan raw;
+  raw.angle_min = -2.0;
+  raw.angle_increment = 0.1;
+  raw.range_min = 0.1;
+  raw.range_max = 5.0;
+  raw.sensor_pose = {0.12, -0.03, 0.05};
+  std::mt19937 rng(99);
+  std::uniform_real_distribution<float> range(0.05f, 5.5f);  // some out of limits
+  for (int i = 0; i < 41; ++i) raw.ranges.push_back(range(rng));
+  const PreparedScan scan = model.prepare(raw);
+  ASSERT_GT(scan.size(), 20u);
+
+  ParticleSet particles;
+  std::uniform_real_distribution<double> coord(-1.0, 3.0), angle(-M_PI, M_PI);
+  particles.resize(50);
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    particles.setPose(i, {coord(rng), coord(rng), angle(rng)});
+  }
+  std::vector<double> all;
+  model.logLikelihoods(scan, particles, &all);
+  ASSERT_EQ(particles.size(), all.size());
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    EXPECT_DOUBLE_EQ(model.logLikelihood(scan, particles.pose(i)), all[i]);
+    // An independent reference: every end point placed in double precision
+    // and looked up in the distance field.
+    double expected = 0.0;
+    for (std::size_t b = 0; b < scan.size(); ++b) {
+      const Pose2 end = compose(particles.pose(i), {scan.x[b], scan.y[b], 0.0});
+      expected += model.beamLogLikelihood(model.field().distanceAt(end.x, end.y), scan.range_max);
+    }
+    EXPECT_NEAR(expected, all[i], 1e-4) << "particle " << i;
+  }
+}
+
+void expectRejected(const LikelihoodFieldModelParams& p, const std::string& name) {
+  try {
+    LikelihoodFieldModel model(wallGrid(8), p);
+    ADD_FAILURE() << name << " accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string::npos, std::string(e.what()).find(name)) << e.what();
+  }
+}
+
+TEST(LikelihoodFieldModel, InvalidParametersThrowNamingThem) {
+  using P = LikelihoodFieldModelParams;
+  auto with = [](auto change) {
+    P p = params();
+    change(p);
+    return p;
+  };
+  expectRejected(with([](P& p) { p.z_hit = -0.1; }), "laser_z_hit");
+  expectRejected(with([](P& p) { p.z_hit = NAN; }), "laser_z_hit");
+  expectRejected(with([](P& p) { p.z_rand = -0.1; }), "laser_z_rand");
+  expectRejected(with([](P& p) { p.z_hit = p.z_rand = 0.0; }), "laser_z_hit + laser_z_rand");
+  expectRejected(with([](P& p) { p.sigma_hit = 0.0; }), "laser_sigma_hit");
+  expectRejected(with([](P& p) { p.sigma_hit = -1.0; }), "laser_sigma_hit");
+  expectRejected(with([](P& p) { p.sigma_hit = INFINITY; }), "laser_sigma_hit");
+  expectRejected(with([](P& p) { p.max_beams = 0; }), "laser_max_beams");
+  expectRejected(with([](P& p) { p.range_min = -1.0; }), "laser_min_range");
+  expectRejected(with([](P& p) { p.range_max = -1.0; }), "laser_max_range");
+  expectRejected(with([](P& p) { p.max_distance = 0.0; }), "max_dist");
+  expectRejected(with([](P& p) { p.max_distance = NAN; }), "max_dist");
+  // Only z_hit or only z_rand is fine.
+  EXPECT_NO_THROW(LikelihoodFieldModel(wallGrid(8), with([](P& p) { p.z_rand = 0.0; })));
+  EXPECT_NO_THROW(LikelihoodFieldModel(wallGrid(8), with([](P& p) { p.z_hit = 0.0; })));
+}
+
+}  // namespace
+}  // namespace pf

@@ -67,8 +67,7 @@ Stats stats(std::size_t n, F value) {
 TEST(Decompose, StraightAhead) {
   expectStep({0.0, 1.0, 0.0}, OdometryMotionModel::decompose({0, 0, 0}, {1, 0, 0}));
   // Facing +y and moving +y is still straight ahead.
-  expectStep({0.0, 2.0, 0.0},
-             OdometryMotionModel::decompose({1, 1, M_PI / 2}, {1, 3, M_PI / 2}));
+  expectStep({0.0, 2.0, 0.0}, OdometryMotionModel::decompose({1, 1, M_PI / 2}, {1, 3, M_PI / 2}));
 }
 
 TEST(Decompose, TurnMoveTurn) {
@@ -76,8 +75,7 @@ TEST(Decompose, TurnMoveTurn) {
   expectStep({M_PI / 4, std::sqrt(2.0), M_PI / 4},
              OdometryMotionModel::decompose({0, 0, 0}, {1, 1, M_PI / 2}));
   // Sideways to the right, ending with the original heading.
-  expectStep({-M_PI / 2, 0.5, M_PI / 2},
-             OdometryMotionModel::decompose({0, 0, 0}, {0, -0.5, 0}));
+  expectStep({-M_PI / 2, 0.5, M_PI / 2}, OdometryMotionModel::decompose({0, 0, 0}, {0, -0.5, 0}));
 }
 
 TEST(Decompose, BackwardsIsAHalfTurnEachWay) {
@@ -220,9 +218,8 @@ TEST(ApplyNoisy, ForwardSpreadMatchesTheModel) {
   // final heading less that direction recovers rot2.
   const Stats trans = stats(kSamples, [&](std::size_t i) { return std::hypot(p.x[i], p.y[i]); });
   const Stats rot1 = stats(kSamples, [&](std::size_t i) { return std::atan2(p.y[i], p.x[i]); });
-  const Stats rot2 = stats(kSamples, [&](std::size_t i) {
-    return angleDiff(p.yaw[i], std::atan2(p.y[i], p.x[i]));
-  });
+  const Stats rot2 = stats(
+      kSamples, [&](std::size_t i) { return angleDiff(p.yaw[i], std::atan2(p.y[i], p.x[i])); });
   EXPECT_NEAR(1.0, trans.mean, 0.005);
   EXPECT_NEAR(0.2, trans.stddev, 0.01);
   EXPECT_NEAR(0.0, rot1.mean, 0.003);

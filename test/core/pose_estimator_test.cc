@@ -1,1 +1,186 @@
-// placeholder: being written
+#include "pf_localization/core/pose_estimator.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+namespace pf {
+namespace {
+
+constexpr double kTol = 1e-12;
+
+struct Weighted {
+  Pose2 pose;
+  double weight;
+};
+
+ParticleSet particles(const std::vector<Weighted>& list) {
+  ParticleSet set;
+  set.resize(list.size());
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    set.setPose(i, list[i].pose);
+    set.weight[i] = list[i].weight;
+  }
+  return set;
+}
+
+void expectPoseNear(const Pose2& expected, const Pose2& actual, double tol = kTol) {
+  EXPECT_NEAR(expected.x, actual.x, tol);
+  EXPECT_NEAR(expected.y, actual.y, tol);
+  EXPECT_NEAR(0.0, angleDiff(expected.yaw, actual.yaw), tol)
+      << "yaw " << actual.yaw << ", expected " << expected.yaw;
+}
+
+void expectMatrixNear(const Eigen::Matrix3d& expected, const Eigen::Matrix3d& actual,
+                      double tol = kTol) {
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(expected(r, c), actual(r, c), tol) << r << "," << c;
+  }
+}
+
+const ClusterParams kParams{0.5, 0.5236};
+
+TEST(EstimatePose, HeavierClusterWinsEvenWithFewerParticles) {
+  // A: two particles near (0.2, 0.15) carrying 0.7; B: four near (5.15, 5.15)
+  // carrying 0.3.
+  const ParticleSet set = particles({
+      {{5.1, 5.1, 1.0}, 0.075},
+      {{0.1, 0.1, 0.0}, 0.35},
+      {{5.2, 5.1, 1.0}, 0.075},
+      {{5.1, 5.2, 1.0}, 0.075},
+      {{0.3, 0.2, 0.2}, 0.35},
+      {{5.2, 5.2, 1.0}, 0.075},
+  });
+  const PoseEstimate e = estimatePose(set, kParams);
+  ASSERT_EQ(2u, e.clusters.size());
+  // Sorted heaviest first.
+  EXPECT_NEAR(0.7, e.clusters[0].weight, kTol);
+  EXPECT_EQ(2u, e.clusters[0].count);
+  EXPECT_NEAR(0.3, e.clusters[1].weight, kTol);
+  EXPECT_EQ(4u, e.clusters[1].count);
+  // A's mean: x = (0.1 + 0.3) / 2, y = (0.1 + 0.2) / 2, yaw halfway between 0 and 0.2.
+  expectPoseNear({0.2, 0.15, 0.1}, e.pose);
+  expectPoseNear({0.2, 0.15, 0.1}, e.clusters[0].mean);
+  expectPoseNear({5.15, 5.15, 1.0}, e.clusters[1].mean);
+  // A's covariance: the deviations are +-(0.1, 0.05, 0.1), so it is d d^T.
+  Eigen::Matrix3d expected;
+  expected << 0.01, 0.005, 0.01,  //
+      0.005, 0.0025, 0.005,       //
+      0.01, 0.005, 0.01;
+  expectMatrixNear(expected, e.covariance);
+  expectMatrixNear(expected, e.clusters[0].covariance);
+  // Not a mean of everything, which would land between the clusters.
+  EXPECT_LT(e.pose.x, 1.0);
+}
+
+TEST(EstimatePose, EqualWeightClustersAreOrderedByPosition) {
+  const ParticleSet set = particles({{{3.0, 0.0, 0.0}, 0.5}, {{-3.0, 0.0, 0.0}, 0.5}});
+  const PoseEstimate e = estimatePose(set, kParams);
+  ASSERT_EQ(2u, e.clusters.size());
+  EXPECT_EQ(-3.0, e.pose.x);
+  EXPECT_EQ(3.0, e.clusters[1].mean.x);
+}
+
+TEST(EstimatePose, CircularMeanAcrossPiIsPi) {
+  // An arithmetic mean of pi - 0.1 and -pi + 0.1 would be 0, facing the
+  // other way.
+  const ParticleSet set = particles({{{1, 1, M_PI - 0.1}, 0.5}, {{1, 1, -M_PI + 0.1}, 0.5}});
+  const PoseEstimate e = estimatePose(set, kParams);
+  ASSERT_EQ(1u, e.clusters.size());
+  EXPECT_NEAR(M_PI, std::fabs(e.pose.yaw), kTol);
+  EXPECT_NEAR(0.0, angleDiff(e.pose.yaw, M_PI), kTol);
+  // The yaw variance uses deviations from that mean (+-0.1), not from 0.
+  Eigen::Matrix3d expected = Eigen::Matrix3d::Zero();
+  expected(2, 2) = 0.01;
+  expectMatrixNear(expected, e.covariance);
+}
+
+TEST(EstimatePose, UnequalWeightsCovariance) {
+  // Weights 0.5, 0.25, 0.25 at (0, 0), (0.4, 0), (0, 0.4): mean (0.1, 0.1).
+  // x deviations -0.1, 0.3, -0.1: var = 0.5 * 0.01 + 0.25 * 0.09 + 0.25 * 0.01 = 0.03.
+  // y likewise 0.03; cov(x, y) = 0.5 * 0.01 + 0.25 * (0.3 * -0.1) * 2 = -0.01.
+  const ParticleSet set = particles({
+      {{0.0, 0.0, 0.0}, 0.5},
+      {{0.4, 0.0, 0.0}, 0.25},
+      {{0.0, 0.4, 0.0}, 0.25},
+  });
+  const PoseEstimate e = estimatePose(set, kParams);
+  ASSERT_EQ(1u, e.clusters.size());
+  expectPoseNear({0.1, 0.1, 0.0}, e.pose);
+  Eigen::Matrix3d expected;
+  expected << 0.03, -0.01, 0.0,  //
+      -0.01, 0.03, 0.0,          //
+      0.0, 0.0, 0.0;
+  expectMatrixNear(expected, e.covariance);
+}
+
+TEST(EstimatePose, ClusterStraddlingPiStaysOne) {
+  // Yaw bins of 30 degrees: pi - 0.05 is in the last bin, -pi + 0.05 in the
+  // first; they touch because yaw wraps.
+  const ParticleSet set = particles({
+      {{2.0, 2.0, M_PI - 0.05}, 0.25},
+      {{2.0, 2.0, -M_PI + 0.05}, 0.25},
+      {{2.0, 2.0, M_PI - 0.2}, 0.25},
+      {{2.0, 2.0, -M_PI + 0.2}, 0.25},
+  });
+  const PoseEstimate e = estimatePose(set, kParams);
+  ASSERT_EQ(1u, e.clusters.size());
+  EXPECT_EQ(4u, e.clusters[0].count);
+  expectPoseNear({2.0, 2.0, M_PI}, e.pose);
+  // Deviations +-0.05 and +-0.2: (2 * 0.0025 + 2 * 0.04) / 4.
+  EXPECT_NEAR(0.02125, e.covariance(2, 2), kTol);
+}
+
+TEST(EstimatePose, ClusterStraddlingABinEdgeInSpaceStaysOne) {
+  const ParticleSet set = particles({{{-0.05, 0.0, 0.0}, 0.5}, {{0.05, -0.05, 0.0}, 0.5}});
+  const PoseEstimate e = estimatePose(set, kParams);
+  ASSERT_EQ(1u, e.clusters.size());
+  expectPoseNear({0.0, -0.025, 0.0}, e.pose);
+}
+
+TEST(EstimatePose, OppositeHeadingsAtOnePlaceAreTwoClusters) {
+  const ParticleSet set = particles({{{1.0, 1.0, 0.0}, 0.6}, {{1.0, 1.0, M_PI}, 0.4}});
+  const PoseEstimate e = estimatePose(set, kParams);
+  ASSERT_EQ(2u, e.clusters.size());
+  expectPoseNear({1.0, 1.0, 0.0}, e.pose);
+  expectPoseNear({1.0, 1.0, M_PI}, e.clusters[1].mean);
+}
+
+TEST(EstimatePose, ChainOfTouchingBinsIsOneCluster) {
+  // Particles 0.4 m apart in a line touch bin to bin: one cluster even though
+  // its ends are 2 m apart.
+  std::vector<Weighted> list;
+  for (int i = 0; i < 6; ++i) list.push_back({{0.4 * i, 0.0, 0.0}, 1.0 / 6});
+  // A separate one 1.5 m beyond the end: bins 4 and 7 do not touch.
+  list.push_back({{3.5, 0.0, 0.0}, 0.01});
+  const PoseEstimate e = estimatePose(particles(list), kParams);
+  ASSERT_EQ(2u, e.clusters.size());
+  EXPECT_EQ(6u, e.clusters[0].count);
+  EXPECT_NEAR(1.0, e.pose.x, kTol);
+}
+
+TEST(EstimatePose, EmptySetHasNoClusters) {
+  const PoseEstimate e = estimatePose(ParticleSet(), kParams);
+  EXPECT_TRUE(e.clusters.empty());
+}
+
+TEST(Summarize, UsesOnlyTheGivenIndices) {
+  const ParticleSet set = particles({
+      {{100.0, 0.0, 3.0}, 0.4},
+      {{1.0, 2.0, 0.5}, 0.1},
+      {{-100.0, 0.0, -3.0}, 0.4},
+      {{3.0, 2.0, 0.5}, 0.3},
+  });
+  const Cluster c = summarize(set, {1, 3});
+  EXPECT_EQ(2u, c.count);
+  EXPECT_NEAR(0.4, c.weight, kTol);
+  // x = (0.1 * 1 + 0.3 * 3) / 0.4 = 2.5; var = (0.1 * 1.5^2 + 0.3 * 0.5^2) / 0.4 = 0.75.
+  expectPoseNear({2.5, 2.0, 0.5}, c.mean);
+  EXPECT_NEAR(0.75, c.covariance(0, 0), kTol);
+  EXPECT_NEAR(0.0, c.covariance(1, 1), kTol);
+  EXPECT_NEAR(0.0, c.covariance(2, 2), kTol);
+}
+
+}  // namespace
+}  // namespace pf
