@@ -180,14 +180,18 @@ class PnmParser {
     img.width = static_cast<int>(w);
     img.height = static_cast<int>(h);
     img.channels = channels;
-    img.color_sum.assign(w * h, 0);
     maxval_ = static_cast<uint32_t>(maxval);
     const uint64_t samples = w * h * channels;
 
+    // The pixel buffer is allocated only once the file is known to be long
+    // enough, so a corrupt header cannot ask for gigabytes.
     if (ascii) {
+      // Every sample takes at least one byte; if they cannot all be there the
+      // loop still runs, to report how many were found.
+      if (buf_.size() - pos_ >= samples) img.color_sum.assign(w * h, 0);
       for (uint64_t i = 0; i < samples; ++i) {
-        const uint64_t v = asciiSample(i, samples, img);
-        img.color_sum[i / channels] += scale(v, i);
+        const uint16_t v = scale(asciiSample(i, samples, img), i);
+        if (!img.color_sum.empty()) img.color_sum[i / channels] += v;
       }
     } else {
       // Exactly one whitespace byte separates maxval from the raster, which
@@ -207,6 +211,7 @@ class PnmParser {
              std::to_string(available) + " (only " + std::to_string(available / row_bytes) +
              " of " + std::to_string(h) + " rows complete)");
       }
+      img.color_sum.assign(w * h, 0);
       const auto* p = reinterpret_cast<const unsigned char*>(buf_.data()) + pos_;
       for (uint64_t i = 0; i < samples; ++i) {
         // Netpbm stores 16-bit samples most significant byte first.

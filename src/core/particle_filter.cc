@@ -201,12 +201,19 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
     scratch_[i] += std::log(particles_.weight[i]);
     max_log = std::max(max_log, scratch_[i]);
   }
-  double total = 0.0;
-  for (std::size_t i = 0; i < particles_.size(); ++i) {
-    particles_.weight[i] = std::exp(scratch_[i] - max_log);
-    total += particles_.weight[i];
+  // When every particle scores zero (possible with z_rand = 0: an end point
+  // far from any obstacle has likelihood exp(-800) = 0), max_log is -inf and
+  // normalising would give 0/0 = NaN weights, which the resampler collapses
+  // onto particle 0. Evidence that rules out all particles alike favours
+  // none: the weights are left as they were.
+  if (std::isfinite(max_log)) {
+    double total = 0.0;
+    for (std::size_t i = 0; i < particles_.size(); ++i) {
+      particles_.weight[i] = std::exp(scratch_[i] - max_log);
+      total += particles_.weight[i];
+    }
+    for (double& w : particles_.weight) w /= total;
   }
-  for (double& w : particles_.weight) w /= total;
   report->mean_beam_likelihood = mean_beam;
 
   if (params_.recovery.alpha_slow > 0.0) {

@@ -287,9 +287,8 @@ int main(int argc, char** argv) {
       // message filter would, or when it has waited too long.
       while (!pending.empty()) {
         const auto& s = pending.front();
-        const bool ready =
-            tf.canTransform(config.odom_frame, config.base_frame, s->header.stamp) &&
-            tf.canTransform(config.base_frame, s->header.frame_id, ros::Time(0));
+        const bool ready = tf.canTransform(config.odom_frame, config.base_frame, s->header.stamp) &&
+                           tf.canTransform(config.base_frame, s->header.frame_id, ros::Time(0));
         if (!ready && now - s->header.stamp.toSec() < kMaxTfWait) {
           break;
         }

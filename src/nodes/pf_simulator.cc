@@ -1,8 +1,8 @@
 // pf_simulator: drives a simulated Neato XV-11 along a path script on a map
 // and writes what the real robot would have recorded, as a ROS 1 bag.
 //
-//   pf_simulator --map maps/building.yaml --path bags/tracking.path --seed 1 \
-//                --out bags/tracking.bag [--compression bz2|lz4|none]
+//   pf_simulator --map maps/building.yaml --path bags/tracking.path
+//                --seed 1 --out bags/tracking.bag [--compression bz2|lz4|none]
 //                [--odom-error K] [--no-people] [--start-time SECONDS]
 //
 // Topics, as on the real robot (see /work/shared/data/neato_ac109_1):
@@ -120,14 +120,14 @@ Options parseOptions(int argc, char** argv) {
 }
 
 // A Neato's odometry: a few per mille of wheel radius mismatch bends straight
-// lines by about a degree per metre, the track width error over-counts turns
-// by 2 %, and slip adds a random walk.
+// lines by under a degree per metre, the track width error over-counts turns
+// by 1.5 %, and slip adds a random walk.
 pf::sim::DiffDriveParams odometryErrors(double scale) {
   pf::sim::DiffDriveParams p;
-  p.left_radius_error = 0.003 * scale;
-  p.right_radius_error = -0.002 * scale;
-  p.track_width_error = 0.02 * scale;
-  p.slip_sigma = 0.005 * scale;
+  p.left_radius_error = 0.002 * scale;
+  p.right_radius_error = -0.001 * scale;
+  p.track_width_error = 0.015 * scale;
+  p.slip_sigma = 0.004 * scale;
   return p;
 }
 

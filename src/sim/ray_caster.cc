@@ -60,9 +60,23 @@ double castToCircle(double x, double y, double angle, double cx, double cy, doub
 
 std::vector<float> neatoReadings(const std::vector<double>& ideal, const NeatoLaserParams& params,
                                  Random* random) {
-  std::vector<float> out(ideal.size(), 0.0f);
+  const std::size_t n = ideal.size();
+  // How likely each beam is to be hidden by the robot itself.
+  std::vector<double> blind(n, 0.0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const double deg = 360.0 * i / n;
+    for (const auto& [first, last] : params.blind_sectors) {
+      if (deg >= first && deg <= last) {
+        blind[i] = 1.0;
+      } else if (deg >= first - 1.0 && deg <= last + 1.0) {
+        blind[i] = std::max(blind[i], params.blind_edge);
+      }
+    }
+  }
+
+  std::vector<float> out(n, 0.0f);
   int burst_left = 0;
-  for (std::size_t i = 0; i < ideal.size(); ++i) {
+  for (std::size_t i = 0; i < n; ++i) {
     if (burst_left == 0 && random->uniform() < params.burst_rate) {
       // Geometric length with the given mean, at least one beam.
       const double p = 1.0 / params.burst_mean;
@@ -73,14 +87,17 @@ std::vector<float> neatoReadings(const std::vector<double>& ideal, const NeatoLa
       --burst_left;
       continue;
     }
+    if (blind[i] > 0.0 && random->uniform() < blind[i]) continue;
     double range = ideal[i];
     if (random->uniform() < params.short_rate) {
       range = random->uniform(params.range_min, std::min(range, params.range_max));
     }
     if (!(range < params.range_max)) continue;
-    const double dropout =
-        params.dropout_near + (params.dropout_far - params.dropout_near) * range / params.range_max;
-    if (random->uniform() < dropout) continue;
+    const double f = range / params.range_max;
+    if (random->uniform() <
+        params.dropout_near + (params.dropout_far - params.dropout_near) * f * f) {
+      continue;
+    }
     range += random->gaussian(params.sigma);
     range = std::round(range / params.resolution) * params.resolution;
     if (range < params.range_min || range >= params.range_max) continue;

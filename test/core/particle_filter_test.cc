@@ -1,1 +1,607 @@
-// placeholder: being written
+#include "pf_localization/core/particle_filter.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace pf {
+namespace {
+
+constexpr double kRes = 0.05;
+
+// --- A synthetic world ---------------------------------------------------------
+
+// A room of width x height metres in 0.05 m cells, with one-cell walls on its
+// border and the given boxes (x0, y0, x1, y1 in metres) filled.
+struct Box {
+  double x0, y0, x1, y1;
+};
+
+OccupancyGrid room(double width, double height, const std::vector<Box>& boxes) {
+  const int w = static_cast<int>(std::lround(width / kRes));
+  const int h = static_cast<int>(std::lround(height / kRes));
+  std::vector<int8_t> data(static_cast<std::size_t>(w) * h, 0);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const double cx = (x + 0.5) * kRes, cy = (y + 0.5) * kRes;
+      bool occupied = x == 0 || y == 0 || x == w - 1 || y == h - 1;
+      for (const Box& b : boxes) {
+        occupied = occupied || (cx > b.x0 && cx < b.x1 && cy > b.y0 && cy < b.y1);
+      }
+      data[static_cast<std::size_t>(y) * w + x] = occupied ? 100 : 0;
+    }
+  }
+  return OccupancyGrid(w, h, kRes, {}, data);
+}
+
+// A 4 m x 3 m room with a box near its lower right and a smaller one near its
+// upper left, so that no rotation or mirror image of it looks the same.
+OccupancyGrid trackingRoom() {
+  return room(4.0, 3.0, {{2.5, 0.5, 3.0, 1.2}, {0.6, 2.0, 1.0, 2.4}});
+}
+
+// 360 degrees, 2 degrees apart, from a laser 0.1 m ahead of the robot centre.
+LaserScan emptyScan() {
+  LaserScan scan;
+  scan.angle_min = -M_PI;
+  scan.angle_increment = 2.0 * M_PI / 180;
+  scan.range_min = 0.05;
+  scan.range_max = 8.0;
+  scan.sensor_pose = {0.1, 0.0, 0.0};
+  scan.ranges.assign(180, std::numeric_limits<float>::quiet_NaN());
+  return scan;
+}
+
+// Ray casting by small steps: the range to the first occupied cell along each
+// beam, or NaN (no return) when the beam leaves the map first.
+LaserScan simulateScan(const OccupancyGrid& grid, const Pose2& robot) {
+  LaserScan scan = emptyScan();
+  const Pose2 laser = compose(robot, scan.sensor_pose);
+  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+    const double bearing = laser.yaw + scan.angle_min + i * scan.angle_increment;
+    const double c = std::cos(bearing), s = std::sin(bearing);
+    for (double t = 0.0; t < scan.range_max; t += 0.002) {
+      const CellIndex cell = grid.worldToCell(laser.x + t * c, laser.y + t * s);
+      if (!grid.contains(cell)) break;
+      if (grid.state(cell) == CellState::kOccupied) {
+        scan.ranges[i] = static_cast<float>(t);
+        break;
+      }
+    }
+  }
+  return scan;
+}
+
+ParticleFilterParams baseParams() {
+  ParticleFilterParams p;
+  p.kld.min_particles = 300;
+  p.kld.max_particles = 2000;
+  p.seed = 1;
+  return p;
+}
+
+Eigen::Matrix3d diag(double sx, double sy, double syaw) {
+  return Eigen::Vector3d(sx * sx, sy * sy, syaw * syaw).asDiagonal();
+}
+
+double distance(const Pose2& a, const Pose2& b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+// The odometry frame is not the map frame: odom = kOdomInMap^-1 (+) truth,
+// so map -> odom is kOdomInMap.
+const Pose2 kOdomInMap{0.7, -0.4, 0.3};
+Pose2 odomOf(const Pose2& truth) { return compose(inverse(kOdomInMap), truth); }
+
+// A gently curving drive, 0.25 m per step, starting at (1, 1.5) facing +x.
+std::vector<Pose2> trackingPath(int steps) {
+  std::vector<Pose2> path{{1.0, 1.5, 0.0}};
+  for (int k = 1; k <= steps; ++k) path.push_back(compose(path.back(), {0.25, 0.0, 0.05}));
+  return path;
+}
+
+std::string whatOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  return "";
+}
+
+// --- Parameters ----------------------------------------------------------------
+
+void expectInvalid(const std::function<void(ParticleFilterParams&)>& change,
+                   const std::string& name) {
+  ParticleFilterParams p = baseParams();
+  change(p);
+  const std::string what = whatOf([&] { validate(p); });
+  EXPECT_NE(std::string::npos, what.find(name))
+      << "expected an error naming " << name << ", got \"" << what << "\"";
+  EXPECT_FALSE(whatOf([&] { ParticleFilter filter(p); }).empty());
+}
+
+TEST(ParticleFilterParams, DefaultsAreValid) {
+  EXPECT_NO_THROW(validate(ParticleFilterParams()));
+  EXPECT_NO_THROW(validate(baseParams()));
+}
+
+TEST(ParticleFilterParams, InvalidValuesAreNamed) {
+  using P = ParticleFilterParams;
+  expectInvalid([](P& p) { p.kld.min_particles = -5; }, "min_particles");
+  expectInvalid([](P& p) { p.kld.min_particles = 0; }, "min_particles");
+  expectInvalid([](P& p) { p.kld.max_particles = -1; }, "max_particles");
+  expectInvalid([](P& p) { p.kld.max_particles = 299; }, "max_particles");  // < min 300
+  expectInvalid([](P& p) { p.sensor.sigma_hit = 0.0; }, "laser_sigma_hit");
+  expectInvalid([](P& p) { p.sensor.sigma_hit = -0.2; }, "laser_sigma_hit");
+  expectInvalid([](P& p) { p.motion.alpha1 = -0.1; }, "odom_alpha1");
+  expectInvalid([](P& p) { p.motion.alpha3 = -1e-9; }, "odom_alpha3");
+  expectInvalid([](P& p) { p.motion.alpha5 = NAN; }, "odom_alpha5");
+  expectInvalid([](P& p) { p.sensor.z_hit = p.sensor.z_rand = 0.0; }, "laser_z_hit + laser_z_rand");
+  expectInvalid([](P& p) { p.sensor.z_rand = -0.5; }, "laser_z_rand");
+  expectInvalid([](P& p) { p.kld.confidence = 0.0; }, "kld_confidence");
+  expectInvalid([](P& p) { p.kld.confidence = 1.0; }, "kld_confidence");
+  expectInvalid([](P& p) { p.kld.confidence = 1.5; }, "kld_confidence");
+  expectInvalid([](P& p) { p.kld.confidence = NAN; }, "kld_confidence");
+  expectInvalid([](P& p) { p.kld.kld_err = 0.0; }, "kld_err");
+  expectInvalid([](P& p) { p.resample_ess_fraction = 0.0; }, "resample_ess_fraction");
+  expectInvalid([](P& p) { p.resample_ess_fraction = 1.5; }, "resample_ess_fraction");
+  expectInvalid([](P& p) { p.update_min_d = -0.1; }, "update_min_d");
+  expectInvalid([](P& p) { p.sensor.max_beams = 0; }, "laser_max_beams");
+  expectInvalid([](P& p) { p.sensor.max_distance = 0.0; }, "laser_likelihood_max_dist");
+  expectInvalid([](P& p) { p.clusters.cell_xy = 0.0; }, "cluster_xy");
+  expectInvalid([](P& p) { p.recovery.alpha_slow = 0.1, p.recovery.alpha_fast = 0.05; },
+                "recovery_alpha_fast");
+  // The message names the valid range too.
+  ParticleFilterParams p = baseParams();
+  p.kld.confidence = 2.0;
+  EXPECT_NE(std::string::npos, whatOf([&] { validate(p); }).find("(0, 1)"));
+}
+
+// --- Initialisation --------------------------------------------------------------
+
+TEST(ParticleFilter, StartsUninitialisedWithoutMap) {
+  ParticleFilter filter(baseParams());
+  EXPECT_FALSE(filter.hasMap());
+  EXPECT_EQ(nullptr, filter.map());
+  EXPECT_FALSE(filter.isInitialized());
+  EXPECT_FALSE(filter.mapToOdom().has_value());
+  EXPECT_THROW(filter.initializeUniform(), std::logic_error);
+}
+
+TEST(ParticleFilter, InitializeGaussian) {
+  ParticleFilter filter(baseParams());
+  filter.initializeGaussian({1.0, 2.0, 3.0}, diag(0.2, 0.1, 0.05));
+  ASSERT_TRUE(filter.isInitialized());
+  const ParticleSet& p = filter.particles();
+  ASSERT_EQ(2000u, p.size());  // max_particles
+  double sx = 0, sy = 0, sxx = 0, syy = 0, sw = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    sx += p.x[i];
+    sy += p.y[i];
+    sxx += (p.x[i] - 1.0) * (p.x[i] - 1.0);
+    syy += (p.y[i] - 2.0) * (p.y[i] - 2.0);
+    sw += p.weight[i];
+    ASSERT_GT(p.yaw[i], -M_PI);
+    ASSERT_LE(p.yaw[i], M_PI);
+  }
+  EXPECT_NEAR(1.0, sx / p.size(), 0.02);
+  EXPECT_NEAR(2.0, sy / p.size(), 0.01);
+  EXPECT_NEAR(0.2, std::sqrt(sxx / p.size()), 0.01);
+  EXPECT_NEAR(0.1, std::sqrt(syy / p.size()), 0.005);
+  EXPECT_NEAR(1.0, sw, 1e-9);
+  // yaw 3.0 +- 0.05 wraps past pi for some particles; the estimate does not care.
+  EXPECT_NEAR(0.0, angleDiff(filter.estimate().pose.yaw, 3.0), 0.01);
+  EXPECT_NEAR(1.0, filter.estimate().pose.x, 0.02);
+  // No update yet: no map -> odom.
+  EXPECT_FALSE(filter.mapToOdom().has_value());
+}
+
+TEST(ParticleFilter, InitializeGaussianCorrelatedAndSemiDefinite) {
+  ParticleFilter filter(baseParams());
+  // x and y perfectly correlated, yaw fixed: every particle on the line y - 2 = x - 1.
+  Eigen::Matrix3d cov;
+  cov << 0.04, 0.04, 0.0,  //
+      0.04, 0.04, 0.0,     //
+      0.0, 0.0, 0.0;
+  filter.initializeGaussian({1.0, 2.0, 0.5}, cov);
+  const ParticleSet& p = filter.particles();
+  double spread = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    EXPECT_NEAR(p.x[i] - 1.0, p.y[i] - 2.0, 1e-9);
+    EXPECT_EQ(0.5, p.yaw[i]);
+    spread = std::max(spread, std::fabs(p.x[i] - 1.0));
+  }
+  EXPECT_GT(spread, 0.3);  // it is not collapsed to a point either
+}
+
+TEST(ParticleFilter, InitializeGaussianRejectsBadInput) {
+  ParticleFilter filter(baseParams());
+  EXPECT_THROW(filter.initializeGaussian({NAN, 0, 0}, diag(0.1, 0.1, 0.1)), std::invalid_argument);
+  Eigen::Matrix3d asymmetric = diag(0.1, 0.1, 0.1);
+  asymmetric(0, 1) = 0.01;
+  EXPECT_THROW(filter.initializeGaussian({0, 0, 0}, asymmetric), std::invalid_argument);
+  Eigen::Matrix3d negative = diag(0.1, 0.1, 0.1);
+  negative(2, 2) = -0.01;
+  EXPECT_THROW(filter.initializeGaussian({0, 0, 0}, negative), std::invalid_argument);
+  Eigen::Matrix3d indefinite;   // symmetric, eigenvalues 1.5 and -0.5
+  indefinite << 0.5, 1.0, 0.0,  //
+      1.0, 0.5, 0.0,            //
+      0.0, 0.0, 0.1;
+  EXPECT_THROW(filter.initializeGaussian({0, 0, 0}, indefinite), std::invalid_argument);
+  Eigen::Matrix3d nan = diag(0.1, 0.1, 0.1);
+  nan(1, 1) = NAN;
+  EXPECT_THROW(filter.initializeGaussian({0, 0, 0}, nan), std::invalid_argument);
+  EXPECT_FALSE(filter.isInitialized());
+}
+
+TEST(ParticleFilter, InitializeUniformFillsFreeSpaceOnly) {
+  ParticleFilter filter(baseParams());
+  const OccupancyGrid grid = trackingRoom();
+  EXPECT_FALSE(filter.setMap(grid));  // nothing to keep yet
+  ASSERT_TRUE(filter.hasMap());
+  EXPECT_EQ(grid.width(), filter.map()->width());
+  filter.initializeUniform();
+  const ParticleSet& p = filter.particles();
+  ASSERT_EQ(2000u, p.size());
+  double min_x = 1e9, max_x = -1e9, min_yaw = 1e9, max_yaw = -1e9;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    ASSERT_TRUE(grid.isFreeAt(p.x[i], p.y[i])) << p.x[i] << ", " << p.y[i];
+    min_x = std::min(min_x, p.x[i]);
+    max_x = std::max(max_x, p.x[i]);
+    min_yaw = std::min(min_yaw, p.yaw[i]);
+    max_yaw = std::max(max_yaw, p.yaw[i]);
+  }
+  // Spread over the whole room and all headings.
+  EXPECT_LT(min_x, 0.3);
+  EXPECT_GT(max_x, 3.7);
+  EXPECT_LT(min_yaw, -3.0);
+  EXPECT_GT(max_yaw, 3.0);
+
+  ParticleFilter walled(baseParams());
+  walled.setMap(OccupancyGrid(4, 4, 0.1, {}, std::vector<int8_t>(16, 100)));
+  EXPECT_THROW(walled.initializeUniform(), std::logic_error);
+}
+
+// --- Update gating -------------------------------------------------------------------
+
+TEST(ParticleFilterUpdate, SkipsWithoutMap) {
+  ParticleFilter filter(baseParams());
+  filter.initializeGaussian({1.0, 1.5, 0.0}, diag(0.1, 0.1, 0.1));
+  const UpdateReport r = filter.update({0, 0, 0}, simulateScan(trackingRoom(), {1.0, 1.5, 0.0}));
+  EXPECT_FALSE(r.updated);
+  EXPECT_NE(std::string::npos, r.skip_reason.find("no map")) << r.skip_reason;
+}
+
+TEST(ParticleFilterUpdate, SkipsWhenNotInitialised) {
+  ParticleFilter filter(baseParams());
+  filter.setMap(trackingRoom());
+  const UpdateReport r = filter.update({0, 0, 0}, simulateScan(trackingRoom(), {1.0, 1.5, 0.0}));
+  EXPECT_FALSE(r.updated);
+  EXPECT_NE(std::string::npos, r.skip_reason.find("not initialised")) << r.skip_reason;
+}
+
+TEST(ParticleFilterUpdate, SkipsBadScansAndBadOdometry) {
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilter filter(baseParams());
+  filter.setMap(grid);
+  filter.initializeGaussian({1.0, 1.5, 0.0}, diag(0.1, 0.1, 0.1));
+  const LaserScan good = simulateScan(grid, {1.0, 1.5, 0.0});
+
+  LaserScan empty = good;
+  empty.ranges.clear();
+  UpdateReport r = filter.update({0, 0, 0}, empty);
+  EXPECT_FALSE(r.updated);
+  EXPECT_EQ(0u, r.skip_reason.find("bad scan")) << r.skip_reason;
+
+  LaserScan zero_increment = good;
+  zero_increment.angle_increment = 0.0;
+  r = filter.update({0, 0, 0}, zero_increment);
+  EXPECT_FALSE(r.updated);
+  EXPECT_NE(std::string::npos, r.skip_reason.find("angle_increment")) << r.skip_reason;
+
+  r = filter.update({NAN, 0, 0}, good);
+  EXPECT_FALSE(r.updated);
+  EXPECT_NE(std::string::npos, r.skip_reason.find("odometry")) << r.skip_reason;
+
+  // None of that counted as the first update.
+  EXPECT_FALSE(filter.mapToOdom().has_value());
+  EXPECT_TRUE(filter.update({0, 0, 0}, good).updated);
+}
+
+TEST(ParticleFilterUpdate, RunsOnTheFirstScanThenOnlyAfterMotion) {
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilter filter(baseParams());  // update_min_d 0.2 m, update_min_a pi/6
+  filter.setMap(grid);
+  filter.initializeGaussian({1.0, 1.5, 0.0}, diag(0.1, 0.1, 0.1));
+  const LaserScan scan = simulateScan(grid, {1.0, 1.5, 0.0});
+  const Pose2 odom0{5.0, 5.0, 2.0};
+
+  UpdateReport r = filter.update(odom0, scan);
+  EXPECT_TRUE(r.updated) << r.skip_reason;
+  EXPECT_TRUE(r.skip_reason.empty());
+  EXPECT_GT(r.beams_used, 0);
+  EXPECT_LE(r.beams_used, 60);  // max_beams
+
+  r = filter.update(odom0, scan);
+  EXPECT_FALSE(r.updated);
+  EXPECT_NE(std::string::npos, r.skip_reason.find("not moved enough")) << r.skip_reason;
+
+  // 0.19 m, then 0.5 rad: below both thresholds.
+  EXPECT_FALSE(filter.update(compose(odom0, {0.19, 0.0, 0.0}), scan).updated);
+  EXPECT_FALSE(filter.update(compose(odom0, {0.0, 0.0, 0.5}), scan).updated);
+  // The robot went back: still not moved since the last update.
+  EXPECT_FALSE(filter.update(odom0, scan).updated);
+
+  // requestNoMotionUpdate forces one update, once.
+  filter.requestNoMotionUpdate();
+  EXPECT_TRUE(filter.update(odom0, scan).updated);
+  EXPECT_FALSE(filter.update(odom0, scan).updated);
+
+  // 0.21 m sideways (the direction does not matter) or 0.55 rad is enough.
+  const Pose2 odom1 = compose(odom0, {0.0, -0.21, 0.0});
+  EXPECT_TRUE(filter.update(odom1, scan).updated);
+  const Pose2 odom2 = compose(odom1, {0.0, 0.0, -0.55});
+  EXPECT_TRUE(filter.update(odom2, scan).updated);
+  EXPECT_FALSE(filter.update(odom2, scan).updated);
+}
+
+TEST(ParticleFilterUpdate, NanOnlyScanIsSkippedWithAReason) {
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilter filter(baseParams());
+  filter.setMap(grid);
+  filter.initializeGaussian({1.0, 1.5, 0.0}, diag(0.1, 0.1, 0.1));
+  const std::vector<double> before = filter.particles().x;
+
+  const UpdateReport r = filter.update({0, 0, 0}, emptyScan());  // 180 NaN ranges
+  EXPECT_FALSE(r.updated);
+  EXPECT_NE(std::string::npos, r.skip_reason.find("no valid beam")) << r.skip_reason;
+  EXPECT_NE(std::string::npos, r.skip_reason.find("180 of 180")) << r.skip_reason;
+  EXPECT_EQ(0, r.beams_used);
+  EXPECT_EQ(180, r.beams_dropped);
+  EXPECT_EQ(before, filter.particles().x);
+  EXPECT_FALSE(filter.mapToOdom().has_value());
+  // The next usable scan is still the first one.
+  EXPECT_TRUE(filter.update({0, 0, 0}, simulateScan(grid, {1.0, 1.5, 0.0})).updated);
+}
+
+// With noiseless motion and all particles at one pose, the particles move
+// exactly by the odometry and the sensor update cannot change them.
+ParticleFilterParams exactParams() {
+  ParticleFilterParams p = baseParams();
+  p.kld.min_particles = 10;
+  p.kld.max_particles = 10;
+  p.motion.alpha1 = p.motion.alpha2 = p.motion.alpha3 = p.motion.alpha4 = p.motion.alpha5 = 0.0;
+  return p;
+}
+
+TEST(ParticleFilterUpdate, MotionIsAppliedFromTheLastUpdateOnly) {
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilter filter(exactParams());
+  filter.setMap(grid);
+  const Pose2 start{1.0, 1.5, 0.2};
+  filter.initializeGaussian(start, Eigen::Matrix3d::Zero());
+  const LaserScan scan = simulateScan(grid, start);
+
+  // The first update after an initialisation does not move the particles,
+  // whatever odometry came before.
+  const Pose2 odom0{-3.0, 4.0, 1.0};
+  ASSERT_TRUE(filter.update(odom0, scan).updated);
+  for (std::size_t i = 0; i < filter.particles().size(); ++i) {
+    EXPECT_EQ(start.x, filter.particles().x[i]);
+    EXPECT_EQ(start.y, filter.particles().y[i]);
+    EXPECT_EQ(start.yaw, filter.particles().yaw[i]);
+  }
+  // Motion seen with a scan without usable beams is not lost: it is applied
+  // with the next usable scan.
+  const Pose2 odom1 = compose(odom0, {0.15, 0.0, 0.0});
+  EXPECT_FALSE(filter.update(odom1, emptyScan()).updated);
+  const Pose2 odom2 = compose(odom1, {0.3, 0.1, 0.2});
+  ASSERT_TRUE(filter.update(odom2, scan).updated);
+  const Pose2 expected = compose(start, between(odom0, odom2));
+  for (std::size_t i = 0; i < filter.particles().size(); ++i) {
+    EXPECT_NEAR(expected.x, filter.particles().x[i], 1e-9);
+    EXPECT_NEAR(expected.y, filter.particles().y[i], 1e-9);
+    EXPECT_NEAR(expected.yaw, filter.particles().yaw[i], 1e-9);
+  }
+  // Re-initialising discards the odometry travelled since the last update.
+  const Pose2 restart{2.0, 2.0, -1.0};
+  filter.initializeGaussian(restart, Eigen::Matrix3d::Zero());
+  ASSERT_TRUE(filter.update(compose(odom2, {1.0, 0.0, 1.0}), scan).updated);
+  EXPECT_EQ(restart.x, filter.particles().x[0]);
+  EXPECT_EQ(restart.yaw, filter.particles().yaw[0]);
+}
+
+TEST(ParticleFilter, MapToOdomIsEstimateComposedWithInverseOdometry) {
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilter filter(baseParams());
+  filter.setMap(grid);
+  filter.initializeGaussian({1.0, 1.5, 0.0}, diag(0.05, 0.05, 0.05));
+  EXPECT_FALSE(filter.mapToOdom().has_value());
+  const Pose2 odom{3.0, -2.0, 2.5};
+  ASSERT_TRUE(filter.update(odom, simulateScan(grid, {1.0, 1.5, 0.0})).updated);
+  ASSERT_TRUE(filter.mapToOdom().has_value());
+  const Pose2 expected = compose(filter.estimate().pose, inverse(odom));
+  const Pose2 actual = *filter.mapToOdom();
+  EXPECT_NEAR(expected.x, actual.x, 1e-12);
+  EXPECT_NEAR(expected.y, actual.y, 1e-12);
+  EXPECT_NEAR(0.0, angleDiff(expected.yaw, actual.yaw), 1e-12);
+  // And map -> odom (+) odom gives the estimate back.
+  const Pose2 back = compose(actual, odom);
+  EXPECT_NEAR(filter.estimate().pose.x, back.x, 1e-9);
+  EXPECT_NEAR(filter.estimate().pose.y, back.y, 1e-9);
+  EXPECT_NEAR(0.0, angleDiff(filter.estimate().pose.yaw, back.yaw), 1e-9);
+}
+
+// --- Determinism ---------------------------------------------------------------------
+
+ParticleSet runTracking(uint64_t seed, int steps) {
+  ParticleFilterParams params = baseParams();
+  params.seed = seed;
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilter filter(params);
+  filter.setMap(grid);
+  const std::vector<Pose2> path = trackingPath(steps);
+  filter.initializeGaussian({1.2, 1.3, 0.1}, diag(0.3, 0.3, 0.15));
+  for (const Pose2& truth : path) filter.update(odomOf(truth), simulateScan(grid, truth));
+  return filter.particles();
+}
+
+TEST(ParticleFilter, SameSeedSameParticlesDifferentSeedDifferent) {
+  const ParticleSet a = runTracking(7, 3);
+  const ParticleSet b = runTracking(7, 3);
+  const ParticleSet c = runTracking(8, 3);
+  ASSERT_FALSE(a.empty());
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.y, b.y);
+  EXPECT_EQ(a.yaw, b.yaw);
+  EXPECT_EQ(a.weight, b.weight);
+  EXPECT_NE(a.x, c.x);
+}
+
+// --- Localisation ----------------------------------------------------------------------
+
+TEST(ParticleFilter, TracksFromAnOffInitialGuess) {
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilter filter(baseParams());
+  filter.setMap(grid);
+  const std::vector<Pose2> path = trackingPath(10);
+  // 0.3 m and 0.1 rad off the truth (1, 1.5, 0).
+  filter.initializeGaussian({1.18, 1.26, 0.1}, diag(0.3, 0.3, 0.15));
+  ASSERT_NEAR(0.3, distance(path[0], {1.18, 1.26, 0.0}), 1e-9);
+  for (std::size_t k = 0; k < path.size(); ++k) {
+    const UpdateReport r = filter.update(odomOf(path[k]), simulateScan(grid, path[k]));
+    ASSERT_TRUE(r.updated) << "step " << k << ": " << r.skip_reason;
+    EXPECT_GE(r.particles, 300u);
+    EXPECT_LE(r.particles, 2000u);
+  }
+  const Pose2 truth = path.back();
+  const Pose2 estimate = filter.estimate().pose;
+  EXPECT_LT(distance(truth, estimate), 0.1)
+      << "estimate " << estimate.x << ", " << estimate.y << ", " << estimate.yaw;
+  EXPECT_LT(std::fabs(angleDiff(truth.yaw, estimate.yaw)), 0.05);
+  // map -> odom recovers the frame the odometry was expressed in.
+  const Pose2 map_to_odom = *filter.mapToOdom();
+  EXPECT_LT(distance(kOdomInMap, map_to_odom), 0.15);
+  EXPECT_LT(std::fabs(angleDiff(kOdomInMap.yaw, map_to_odom.yaw)), 0.05);
+  // A confident estimate: its covariance is small.
+  EXPECT_LT(filter.estimate().covariance(0, 0), 0.05 * 0.05);
+  EXPECT_LT(filter.estimate().covariance(1, 1), 0.05 * 0.05);
+}
+
+TEST(ParticleFilter, GlobalLocalizationInAnAsymmetricRoom) {
+  // 3 m x 2 m with an L of two boxes against the lower wall.
+  const OccupancyGrid grid = room(3.0, 2.0, {{1.8, 0.0, 2.1, 0.9}, {2.1, 0.6, 2.6, 0.9}});
+  ParticleFilterParams params = baseParams();
+  params.kld.min_particles = 500;
+  params.kld.max_particles = 20000;
+  ParticleFilter filter(params);
+  filter.setMap(grid);
+  filter.initializeUniform();
+  // Drive around the room: from the upper left along +x, turn right in place,
+  // down along -y, turn right again, and back along -x.
+  std::vector<Pose2> path{{0.6, 1.4, 0.0}};
+  auto drive = [&](int n, const Pose2& step) {
+    for (int i = 0; i < n; ++i) path.push_back(compose(path.back(), step));
+  };
+  drive(4, {0.25, 0.0, 0.0});       // to (1.6, 1.4)
+  drive(2, {0.0, 0.0, -M_PI / 4});  // facing -y
+  drive(4, {0.21, 0.0, 0.0});       // to (1.6, 0.56), 0.2 m from the L
+  drive(2, {0.0, 0.0, -M_PI / 4});  // facing -x
+  drive(4, {0.25, 0.0, 0.0});       // to (0.6, 0.6)
+  int converged_at = -1;
+  for (std::size_t k = 0; k < path.size(); ++k) {
+    ASSERT_TRUE(grid.isFreeAt(path[k].x, path[k].y)) << "step " << k;
+    const UpdateReport r = filter.update(odomOf(path[k]), simulateScan(grid, path[k]));
+    ASSERT_TRUE(r.updated) << "step " << k << ": " << r.skip_reason;
+    const bool close = distance(path[k], filter.estimate().pose) < 0.2 &&
+                       std::fabs(angleDiff(path[k].yaw, filter.estimate().pose.yaw)) < 0.2;
+    if (close && converged_at < 0) converged_at = static_cast<int>(k);
+    if (!close) converged_at = -1;
+  }
+  EXPECT_GE(converged_at, 0) << "never settled on the true pose";
+  EXPECT_LE(converged_at, 10);
+  EXPECT_LT(distance(path.back(), filter.estimate().pose), 0.2);
+  // KLD-sampling shrank the cloud once it had converged.
+  EXPECT_LT(filter.particles().size(), 20000u);
+}
+
+// --- Map changes -------------------------------------------------------------------
+
+TEST(ParticleFilter, SetMapKeepsParticlesWhenTheEstimateIsStillFree) {
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilter filter(baseParams());
+  filter.setMap(grid);
+  filter.initializeGaussian({1.0, 1.5, 0.0}, diag(0.05, 0.05, 0.05));
+  ASSERT_TRUE(filter.update(odomOf({1.0, 1.5, 0.0}), simulateScan(grid, {1.0, 1.5, 0.0})).updated);
+  const ParticleSet before = filter.particles();
+
+  // The same room with an extra box elsewhere: particles stay.
+  EXPECT_TRUE(filter.setMap(room(4.0, 3.0, {{2.5, 0.5, 3.0, 1.2}, {3.0, 2.0, 3.5, 2.5}})));
+  EXPECT_TRUE(filter.isInitialized());
+  EXPECT_EQ(before.x, filter.particles().x);
+  EXPECT_EQ(before.yaw, filter.particles().yaw);
+  EXPECT_TRUE(filter.mapToOdom().has_value());
+
+  // A map with a box over the estimate: the particles are dropped.
+  EXPECT_FALSE(filter.setMap(room(4.0, 3.0, {{0.5, 1.0, 1.5, 2.0}})));
+  EXPECT_FALSE(filter.isInitialized());
+  EXPECT_TRUE(filter.particles().empty());
+  EXPECT_TRUE(filter.estimate().clusters.empty());
+  EXPECT_FALSE(filter.mapToOdom().has_value());
+  const UpdateReport r = filter.update(odomOf({1.0, 1.5, 0.0}), simulateScan(grid, {1, 1.5, 0}));
+  EXPECT_FALSE(r.updated);
+  EXPECT_NE(std::string::npos, r.skip_reason.find("not initialised"));
+}
+
+TEST(ParticleFilter, SetMapDropsParticlesWhenTheEstimateLeavesTheMap) {
+  ParticleFilter filter(baseParams());
+  filter.setMap(trackingRoom());
+  filter.initializeGaussian({3.5, 2.5, 0.0}, diag(0.05, 0.05, 0.05));
+  EXPECT_FALSE(filter.setMap(room(2.0, 2.0, {})));  // (3.5, 2.5) is outside
+  EXPECT_FALSE(filter.isInitialized());
+  EXPECT_THROW(filter.setMap(OccupancyGrid()), std::invalid_argument);
+}
+
+// --- Degenerate likelihoods -------------------------------------------------------------
+
+TEST(ParticleFilter, WeightsStayFiniteWhenEveryParticleScoresZero) {
+  // Without the random component and with a narrow Gaussian, a beam ending
+  // 2 m from any wall has likelihood exp(-0.5 (2 / 0.05)^2) = exp(-800),
+  // which is 0 in double precision: every particle scores log 0 = -inf.
+  ParticleFilterParams params = baseParams();
+  params.sensor.z_rand = 0.0;
+  params.sensor.sigma_hit = 0.05;
+  params.sensor.max_distance = 2.0;
+  const OccupancyGrid grid = room(8.0, 8.0, {});
+  ParticleFilter filter(params);
+  filter.setMap(grid);
+  filter.initializeGaussian({2.0, 4.0, 0.0}, diag(0.05, 0.05, 0.02));
+  LaserScan scan = emptyScan();
+  scan.sensor_pose = {};
+  scan.ranges[90] = 2.0f;  // straight ahead, ending at the room's centre
+  const UpdateReport r = filter.update({0, 0, 0}, scan);
+  ASSERT_TRUE(r.updated) << r.skip_reason;
+  double total = 0.0;
+  for (double w : filter.particles().weight) {
+    ASSERT_TRUE(std::isfinite(w));
+    total += w;
+  }
+  EXPECT_NEAR(1.0, total, 1e-9);
+  EXPECT_TRUE(std::isfinite(r.ess));
+  EXPECT_TRUE(filter.estimate().pose.isFinite());
+  EXPECT_LT(distance({2.0, 4.0, 0.0}, filter.estimate().pose), 0.1);
+  // Evidence that rules out every particle alike tells them nothing: the
+  // cloud keeps its 0.05 m spread instead of collapsing onto one particle.
+  const ParticleSet& p = filter.particles();
+  double mean = 0.0, var = 0.0;
+  for (double x : p.x) mean += x / p.size();
+  for (double x : p.x) var += (x - mean) * (x - mean) / p.size();
+  EXPECT_GT(std::sqrt(var), 0.03);
+}
+
+}  // namespace
+}  // namespace pf

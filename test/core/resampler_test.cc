@@ -203,7 +203,8 @@ TEST(KldParticleCount, CountsOccupiedBins) {
   // Particles sharing bins do not add any: 10 bins of 3 particles each.
   ParticleSet shared;
   shared.resize(30);
-  for (std::size_t i = 0; i < 30; ++i) shared.setPose(i, {1.0 * (i % 10) + 0.1 * (i / 10), 0.1, 0.0});
+  for (std::size_t i = 0; i < 30; ++i)
+    shared.setPose(i, {1.0 * (i % 10) + 0.1 * (i / 10), 0.1, 0.0});
   shared.setUniformWeights();
   EXPECT_EQ(217u, kldParticleCount(shared, kld(1, 100000)));
   // The same in y and in yaw.

@@ -89,6 +89,7 @@ NeatoLaserParams noiseless() {
   p.dropout_near = p.dropout_far = 0.0;
   p.burst_rate = 0.0;
   p.short_rate = 0.0;
+  p.blind_sectors.clear();
   return p;
 }
 
@@ -115,8 +116,35 @@ TEST(NeatoReadingsTest, DropoutRateGrowsWithRange) {
     for (float v : r) dropped += v == 0.0f;
     return dropped / 20000.0;
   };
-  EXPECT_NEAR(fraction(0.05), 0.104, 0.01);
-  EXPECT_NEAR(fraction(2.5), 0.3, 0.01);
+  EXPECT_NEAR(fraction(0.05), 0.10004, 0.01);
+  EXPECT_NEAR(fraction(2.5), 0.2, 0.01);
+  EXPECT_NEAR(fraction(4.5), 0.424, 0.01);
+}
+
+TEST(NeatoReadingsTest, BlindSectorsNeverReturnAndTheirEdgesSometimes) {
+  NeatoLaserParams p = noiseless();
+  p.blind_sectors = {{10, 12}};
+  p.blind_edge = 0.5;
+  Random random(2);
+  std::vector<int> valid(36, 0);
+  for (int scan = 0; scan < 2000; ++scan) {
+    const auto r = neatoReadings(std::vector<double>(36, 1.0), p, &random);  // 10 deg apart
+    for (int i = 0; i < 36; ++i) valid[i] += r[i] != 0.0f;
+  }
+  EXPECT_EQ(valid[1], 0);  // 10 deg
+  EXPECT_EQ(valid[0], 2000);
+  EXPECT_EQ(valid[2], 2000);  // 20 deg: beyond the edge
+  p.blind_sectors = {{20, 20}};
+  std::vector<int> edge(360, 0);
+  for (int scan = 0; scan < 2000; ++scan) {
+    const auto r = neatoReadings(std::vector<double>(360, 1.0), p, &random);  // 1 deg apart
+    for (int i = 0; i < 360; ++i) edge[i] += r[i] != 0.0f;
+  }
+  EXPECT_EQ(edge[20], 0);
+  EXPECT_NEAR(edge[19], 1000, 80);
+  EXPECT_NEAR(edge[21], 1000, 80);
+  EXPECT_EQ(edge[18], 2000);
+  EXPECT_EQ(edge[22], 2000);
 }
 
 TEST(NeatoReadingsTest, BurstsDropRunsOfBeams) {

@@ -8,17 +8,26 @@
 // rounded to cell centres. Unknown cells are transparent (nothing is there to
 // reflect), and a ray that leaves the map returns nothing.
 //
-// The Neato model (neatoReadings) turns those ideal ranges into readings:
+// The Neato model (neatoReadings) turns those ideal ranges into readings,
+// after the real AC109 bag (/work/shared/data/neato_ac109_1), which loses
+// ~39 % of its beams:
 //   - nothing within range_max, or a dropout: 0.0, as the Neato reports it;
-//   - dropouts come singly, with a probability growing linearly with range
-//     (weak returns from far walls), and in bursts of consecutive beams
-//     (dark or shiny patches): the real AC109 bag loses ~39 % of its beams,
-//     mostly in runs of 1-10;
+//   - fixed blind sectors, where the robot's own mast and posts hide the
+//     laser: 16 % of the beams are never valid, and their neighbours are
+//     valid only half the time;
+//   - single dropouts, more likely at long range (weak returns), with
+//     p = dropout_near + (dropout_far - dropout_near) (r / range_max)^2;
+//     the real rate grows from ~15 % below 1 m to ~60 % near 4 m, but the
+//     AC109 arena is small: the defaults are lower so that a run through the
+//     package's building, where many beams find nothing within range_max,
+//     loses about as many beams in total as the real bag;
+//   - bursts of consecutive dropouts (dark or shiny patches);
 //   - a small fraction of beams hit something that is not on the map and
 //     return a uniformly random shorter range;
 //   - Gaussian noise, then rounding to the Neato's 1 mm resolution.
 #pragma once
 
+#include <utility>
 #include <vector>
 
 #include "pf_localization/core/occupancy_grid.h"
@@ -47,18 +56,25 @@ class RayCaster {
 double castToCircle(double x, double y, double angle, double cx, double cy, double r);
 
 struct NeatoLaserParams {
-  double range_min = 0.02;     // m
-  double range_max = 5.0;      // m; a return at or beyond it reads 0
-  double sigma = 0.012;        // m, Gaussian range noise
-  double resolution = 0.001;   // m, readings are rounded to this
-  double dropout_near = 0.10;  // probability of a single dropout at range 0
-  double dropout_far = 0.40;   // ... at range_max (linear in between)
-  double burst_rate = 0.02;    // probability that a burst of dropouts starts at a beam
+  double range_min = 0.02;    // m
+  double range_max = 5.0;     // m; a return at or beyond it reads 0
+  double sigma = 0.012;       // m, Gaussian range noise
+  double resolution = 0.001;  // m, readings are rounded to this
+  // Laser-frame angles (degrees, first and last beam inclusive) that never
+  // return, and the dropout probability of the beam on either side of one.
+  std::vector<std::pair<int, int>> blind_sectors = {{21, 24},   {69, 77},   {106, 107},
+                                                    {145, 151}, {209, 213}, {219, 221},
+                                                    {260, 265}, {294, 300}, {341, 353}};
+  double blind_edge = 0.5;
+  double dropout_near = 0.05;  // probability of a single dropout at range 0
+  double dropout_far = 0.2;    // ... at range_max (quadratic in between)
+  double burst_rate = 0.01;    // probability that a burst of dropouts starts at a beam
   double burst_mean = 5.0;     // mean burst length (beams; geometric)
   double short_rate = 0.003;   // probability of a random short return
 };
 
-/// Neato readings for ideal ranges (+inf: no return), beam by beam in scan order.
+/// Neato readings for ideal ranges (+inf: no return) of a full turn of
+/// evenly spaced beams, the first at laser-frame angle 0.
 std::vector<float> neatoReadings(const std::vector<double>& ideal, const NeatoLaserParams& params,
                                  Random* random);
 

@@ -1,0 +1,116 @@
+// Benchmarks of the filter's hot paths (Google Benchmark).
+//
+// Build with -DPF_BUILD_BENCHMARKS=ON and run scripts/benchmark.sh. The world
+// is synthetic and fixed: a square-room map with a grid of pillars, scans with
+// every beam valid, particles scattered around one pose, so the figures only
+// depend on the code and the machine.
+#include <benchmark/benchmark.h>
+
+#include <cmath>
+
+#include "pf_localization/core/likelihood_field_model.h"
+#include "pf_localization/core/particle_filter.h"
+#include "pf_localization/core/resampler.h"
+
+namespace {
+
+// A side x side map at 0.05 m with walls on the border and a pillar every 2 m.
+pf::OccupancyGrid pillarMap(int side) {
+  std::vector<int8_t> data(static_cast<std::size_t>(side) * side, 0);
+  for (int y = 0; y < side; ++y) {
+    for (int x = 0; x < side; ++x) {
+      const bool wall = x == 0 || y == 0 || x == side - 1 || y == side - 1;
+      const bool pillar = x % 40 < 4 && y % 40 < 4;
+      if (wall || pillar) data[static_cast<std::size_t>(y) * side + x] = 100;
+    }
+  }
+  return pf::OccupancyGrid(side, side, 0.05, {0.0, 0.0, 0.0}, std::move(data));
+}
+
+pf::LaserScan fullScan(int beams) {
+  pf::LaserScan scan;
+  scan.angle_min = -M_PI;
+  scan.angle_increment = 2.0 * M_PI / beams;
+  scan.range_min = 0.02;
+  scan.range_max = 5.0;
+  for (int i = 0; i < beams; ++i) scan.ranges.push_back(1.0f + 3.0f * (i % 7) / 7.0f);
+  return scan;
+}
+
+pf::ParticleSet scatter(std::size_t n, pf::Random* random) {
+  pf::ParticleSet set;
+  set.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    set.setPose(i, {10.0 + random->gaussian(1.0), 10.0 + random->gaussian(1.0),
+                    random->uniform(-M_PI, M_PI)});
+  }
+  set.setUniformWeights();
+  return set;
+}
+
+void BM_SensorUpdate(benchmark::State& state) {
+  const int beams = static_cast<int>(state.range(1));
+  pf::LikelihoodFieldModelParams params;
+  params.max_beams = beams;
+  const pf::LikelihoodFieldModel model(pillarMap(400), params);
+  pf::Random random(1);
+  const pf::ParticleSet particles = scatter(state.range(0), &random);
+  const pf::PreparedScan scan = model.prepare(fullScan(beams));
+  std::vector<double> out;
+  for (auto _ : state) {
+    model.logLikelihoods(scan, particles, &out);
+    benchmark::DoNotOptimize(out.data());
+  }
+  const double pairs = static_cast<double>(state.range(0)) * beams;
+  state.counters["ns_per_particle_beam"] = benchmark::Counter(
+      pairs * state.iterations(), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_SensorUpdate)->Args({10000, 60})->Args({100000, 60})->Args({100000, 360});
+
+void BM_FullUpdate(benchmark::State& state) {
+  const std::size_t n = state.range(0);
+  pf::ParticleFilterParams params;
+  params.kld.min_particles = params.kld.max_particles = static_cast<int>(n);
+  params.sensor.max_beams = static_cast<int>(state.range(1));
+  params.update_min_d = params.update_min_a = 0.0;
+  pf::ParticleFilter filter(params);
+  filter.setMap(pillarMap(400));
+  filter.initializeGaussian({10.0, 10.0, 0.0}, Eigen::Vector3d(1.0, 1.0, 0.5).asDiagonal());
+  const pf::LaserScan scan = fullScan(360);
+  double x = 0.0;
+  filter.update({x, 0.0, 0.0}, scan);
+  for (auto _ : state) {
+    x += 0.05;
+    benchmark::DoNotOptimize(filter.update({x, 0.0, 0.0}, scan));
+  }
+  state.counters["particles"] = static_cast<double>(filter.particles().size());
+}
+BENCHMARK(BM_FullUpdate)
+    ->ArgsProduct({{1000, 10000, 100000, 1000000}, {60, 360}})
+    ->Unit(benchmark::kMillisecond);
+
+void BM_SystematicResample(benchmark::State& state) {
+  pf::Random random(2);
+  const pf::ParticleSet base = scatter(state.range(0), &random);
+  for (auto _ : state) {
+    state.PauseTiming();
+    pf::ParticleSet set = base;
+    state.ResumeTiming();
+    pf::systematicResample(&set, set.size(), &random);
+    benchmark::DoNotOptimize(set.x.data());
+  }
+}
+BENCHMARK(BM_SystematicResample)->Arg(10000)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond);
+
+void BM_LikelihoodField(benchmark::State& state) {
+  const pf::OccupancyGrid grid = pillarMap(static_cast<int>(state.range(0)));
+  for (auto _ : state) {
+    const pf::LikelihoodField field(grid, 2.0);
+    benchmark::DoNotOptimize(field.distances().data());
+  }
+}
+BENCHMARK(BM_LikelihoodField)->Arg(1000)->Arg(2000)->Arg(4000)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
