@@ -43,11 +43,12 @@ namespace {
 using pf::Pose2;
 using pf::sim::NeatoLaserParams;
 
-constexpr int64_t kTickNs = 10'000'000;  // 100 Hz simulation step
-constexpr int kOdomEvery = 5;            // ticks: 20 Hz /odom and /tf
-constexpr int kTruthEvery = 10;          // 10 Hz /ground_truth
-constexpr int kScanEvery = 20;           // 5 Hz /scan ...
-constexpr int kScanOffset = 7;           // ... 70 ms after an odometry tick
+constexpr int64_t kTickNs = 10'000'000;   // 100 Hz simulation step
+constexpr double kTick = kTickNs * 1e-9;  // s
+constexpr int kOdomEvery = 5;             // ticks: 20 Hz /odom and /tf
+constexpr int kTruthEvery = 10;           // 10 Hz /ground_truth
+constexpr int kScanEvery = 20;            // 5 Hz /scan ...
+constexpr int kScanOffset = 7;            // ... 70 ms after an odometry tick
 constexpr int kBeams = 360;
 constexpr double kRobotRadius = 0.17;         // m, a Neato is 0.33 m across
 const Pose2 kLaserMount{-0.1016, 0.0, M_PI};  // base_link -> base_laser_link
@@ -155,33 +156,13 @@ double simulate(const Options& o, const pf::OccupancyGrid& map, const pf::sim::P
       o.people ? script.people : std::vector<pf::sim::Person>{};
 
   const int64_t start_ns = std::llround(o.start_time * 1e9);
-  const int64_t last_tick = static_cast<int64_t>(std::ceil(script.duration() / 1e-2 - 1e-9));
+  const int64_t last_tick = static_cast<int64_t>(std::ceil(script.duration() / kTick - 1e-9));
   uint32_t odom_seq = 0, truth_seq = 0, scan_seq = 0;
-  std::size_t motion = 0;
-  double motion_left = script.motions.empty() ? 0.0 : script.motions[0].duration;
+  pf::sim::PathPlayer player(script);
   long beams = 0, invalid = 0;
 
   for (int64_t tick = 0; tick <= last_tick; ++tick) {
-    // Advance from the previous tick to this one through as many motions as
-    // that spans; teleports take no time.
-    double left = tick == 0 ? 0.0 : kTickNs * 1e-9;
-    while (left > 1e-12 || (motion < script.motions.size() && script.motions[motion].teleport)) {
-      if (motion >= script.motions.size()) {
-        robot.step(0.0, 0.0, left, &odom_random);
-        break;
-      }
-      const pf::sim::Motion& m = script.motions[motion];
-      if (m.teleport) {
-        robot.teleport(m.target);
-      } else {
-        const double h = std::min(left, motion_left);
-        robot.step(m.v, m.w, h, &odom_random);
-        left -= h;
-        motion_left -= h;
-        if (motion_left > 1e-12) continue;
-      }
-      if (++motion < script.motions.size()) motion_left = script.motions[motion].duration;
-    }
+    player.advance(tick == 0 ? 0.0 : kTick, &robot, &odom_random);
 
     ros::Time stamp;
     stamp.fromNSec(start_ns + tick * kTickNs);
@@ -215,7 +196,7 @@ double simulate(const Options& o, const pf::OccupancyGrid& map, const pf::sim::P
     }
     if (tick % kScanEvery == kScanOffset) {
       const Pose2 sensor = pf::compose(robot.truePose(), kLaserMount);
-      const double t = (tick * kTickNs) * 1e-9;
+      const double t = tick * kTick;
       std::vector<double> ideal(kBeams);
       for (int i = 0; i < kBeams; ++i) {
         const double angle = sensor.yaw + i * (2.0 * M_PI / kBeams);
@@ -235,7 +216,7 @@ double simulate(const Options& o, const pf::OccupancyGrid& map, const pf::sim::P
       scan.angle_increment = 2.0 * M_PI / kBeams;
       scan.angle_max = (kBeams - 1) * scan.angle_increment;
       scan.time_increment = 0.0;  // every beam is cast from the pose at the stamp
-      scan.scan_time = kScanEvery * kTickNs * 1e-9;
+      scan.scan_time = kScanEvery * kTick;
       scan.range_min = laser.range_min;
       scan.range_max = laser.range_max;
       scan.ranges = pf::sim::neatoReadings(ideal, laser, &laser_random);

@@ -7,8 +7,6 @@
 #include <fstream>
 #include <sstream>
 
-#include "pf_localization/sim/diff_drive_robot.h"
-
 namespace pf::sim {
 
 void Person::positionAt(double t, double* x, double* y) const {
@@ -212,6 +210,29 @@ std::optional<std::string> checkClearance(const PathScript& script, const Occupa
     pose = integrateArc(pose, m.v * m.duration, m.w * m.duration);
   }
   return std::nullopt;
+}
+
+PathPlayer::PathPlayer(const PathScript& script) : script_(script) {
+  if (!finished()) left_ = script_.motions[0].duration;
+}
+
+void PathPlayer::advance(double dt, DiffDriveRobot* robot, Random* random) {
+  // Times below a picosecond are rounding noise from splitting steps.
+  constexpr double kEps = 1e-12;
+  while (!finished() && (dt > kEps || script_.motions[next_].teleport)) {
+    const Motion& m = script_.motions[next_];
+    if (m.teleport) {
+      robot->teleport(m.target);
+    } else {
+      const double h = std::min(dt, left_);
+      robot->step(m.v, m.w, h, random);
+      dt -= h;
+      left_ -= h;
+      if (left_ > kEps) continue;
+    }
+    if (++next_ < script_.motions.size()) left_ = script_.motions[next_].duration;
+  }
+  if (dt > kEps) robot->step(0.0, 0.0, dt, random);
 }
 
 }  // namespace pf::sim

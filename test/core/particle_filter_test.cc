@@ -493,25 +493,28 @@ TEST(ParticleFilter, TracksFromAnOffInitialGuess) {
 }
 
 TEST(ParticleFilter, GlobalLocalizationInAnAsymmetricRoom) {
-  // 3 m x 2 m with an L of two boxes against the lower wall.
-  const OccupancyGrid grid = room(3.0, 2.0, {{1.8, 0.0, 2.1, 0.9}, {2.1, 0.6, 2.6, 0.9}});
+  // 3 m x 2 m with a block in the upper right corner, a stub of wall rising
+  // from the bottom and a pillar in the upper left: no rotation or mirror
+  // image of the room matches it.
+  const OccupancyGrid grid =
+      room(3.0, 2.0, {{2.2, 1.3, 3.0, 2.0}, {1.0, 0.0, 1.2, 0.7}, {0.3, 1.5, 0.5, 1.7}});
   ParticleFilterParams params = baseParams();
   params.kld.min_particles = 500;
   params.kld.max_particles = 20000;
   ParticleFilter filter(params);
   filter.setMap(grid);
   filter.initializeUniform();
-  // Drive around the room: from the upper left along +x, turn right in place,
-  // down along -y, turn right again, and back along -x.
-  std::vector<Pose2> path{{0.6, 1.4, 0.0}};
+  // Along +x through the middle, turn left in place, up along +y, turn left
+  // again and back along -x under the pillar.
+  std::vector<Pose2> path{{0.6, 1.1, 0.0}};
   auto drive = [&](int n, const Pose2& step) {
     for (int i = 0; i < n; ++i) path.push_back(compose(path.back(), step));
   };
-  drive(4, {0.25, 0.0, 0.0});       // to (1.6, 1.4)
-  drive(2, {0.0, 0.0, -M_PI / 4});  // facing -y
-  drive(4, {0.21, 0.0, 0.0});       // to (1.6, 0.56), 0.2 m from the L
-  drive(2, {0.0, 0.0, -M_PI / 4});  // facing -x
-  drive(4, {0.25, 0.0, 0.0});       // to (0.6, 0.6)
+  drive(4, {0.25, 0.0, 0.0});      // to (1.6, 1.1)
+  drive(2, {0.0, 0.0, M_PI / 4});  // facing +y
+  drive(3, {0.21, 0.0, 0.0});      // to (1.6, 1.73)
+  drive(2, {0.0, 0.0, M_PI / 4});  // facing -x
+  drive(3, {0.25, 0.0, 0.0});      // to (0.85, 1.73)
   int converged_at = -1;
   for (std::size_t k = 0; k < path.size(); ++k) {
     ASSERT_TRUE(grid.isFreeAt(path[k].x, path[k].y)) << "step " << k;

@@ -127,5 +127,23 @@ TEST(CheckClearanceTest, ChecksTheStartAndTeleportTargets) {
       "test.path:2: the robot (radius 0.045 m) leaves free space at (0.55, 0.30)");
 }
 
+TEST(PathPlayerTest, StepSizeDoesNotChangeThePath) {
+  const PathScript s = parse(
+      "start 0 0 0\nteleport 1 0 0\nspeed 0.5 1\ngoto 2 0\nteleport 5 5 0\ngoto 6 5\nturn 1\n");
+  for (double dt : {0.03, 0.01, 1.0, 100.0}) {
+    DiffDriveRobot robot({}, s.start);
+    PathPlayer player(s);
+    player.advance(0.0, &robot, nullptr);  // the teleport at t = 0
+    EXPECT_DOUBLE_EQ(robot.truePose().x, 1.0);
+    while (!player.finished()) player.advance(dt, &robot, nullptr);
+    EXPECT_NEAR(robot.truePose().x, 6.0, 1e-9) << "dt " << dt;
+    EXPECT_NEAR(robot.truePose().y, 5.0, 1e-9) << "dt " << dt;
+    EXPECT_NEAR(robot.truePose().yaw, 1.0, 1e-9) << "dt " << dt;
+    // The wheels turned for 2 m and 1 rad, wherever the robot was carried.
+    EXPECT_NEAR(robot.odomPose().x, 2.0, 1e-9) << "dt " << dt;
+    EXPECT_NEAR(robot.odomPose().yaw, 1.0, 1e-9) << "dt " << dt;
+  }
+}
+
 }  // namespace
 }  // namespace pf::sim

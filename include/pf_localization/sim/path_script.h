@@ -12,8 +12,9 @@
 //   wait t                 stand still for t seconds
 //   velocity v w t         drive at v m/s turning at w rad/s for t seconds (an arc)
 //   teleport x y yaw       move the true pose instantly, wheels still (a kidnapping)
-//   person x1 y1 x2 y2 v   a person walking to and fro between two points at
-//                          v m/s, from t = 0 and for the whole run
+//   person x1 y1 x2 y2 v   a person (seen as a 0.2 m radius circle) walking to
+//                          and fro between two points at v m/s, for the whole
+//                          run; people are not on the map and may cross the robot
 //
 // A script compiles to a list of constant-velocity motions. The true pose
 // follows them exactly, so whether the robot stays in free space can be
@@ -28,6 +29,8 @@
 
 #include "pf_localization/core/occupancy_grid.h"
 #include "pf_localization/core/pose2.h"
+#include "pf_localization/core/random.h"
+#include "pf_localization/sim/diff_drive_robot.h"
 
 namespace pf::sim {
 
@@ -81,5 +84,25 @@ PathScript loadPathScript(const std::string& path);
 /// Returns "file:line: ..." naming the first motion that leaves free space.
 std::optional<std::string> checkClearance(const PathScript& script, const OccupancyGrid& grid,
                                           double radius);
+
+/// Plays a script's motions on a robot in steps of any length: a step that
+/// spans the end of one motion finishes it and goes on with the next, so the
+/// true path does not depend on the step size.
+class PathPlayer {
+ public:
+  /// `script` must outlive the player.
+  explicit PathPlayer(const PathScript& script);
+
+  /// Drives `robot` through the next dt seconds of the script, teleports
+  /// included (advance(0) performs those due at the current time). After the
+  /// end the robot stands still.
+  void advance(double dt, DiffDriveRobot* robot, Random* random);
+  bool finished() const { return next_ >= script_.motions.size(); }
+
+ private:
+  const PathScript& script_;
+  std::size_t next_ = 0;  // the motion under way
+  double left_ = 0.0;     // seconds left of it
+};
 
 }  // namespace pf::sim
