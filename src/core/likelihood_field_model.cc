@@ -19,11 +19,13 @@ LikelihoodFieldModel::LikelihoodFieldModel(const OccupancyGrid& grid,
     : params_(params), field_(grid, params.max_distance) {
   require(params.z_hit >= 0.0 && std::isfinite(params.z_hit), "laser_z_hit must be >= 0");
   require(params.z_rand >= 0.0 && std::isfinite(params.z_rand), "laser_z_rand must be >= 0");
-  require(params.z_hit + params.z_rand > 0.0,
-          "laser_z_hit + laser_z_rand must be positive, got " +
-              std::to_string(params.z_hit + params.z_rand));
+  require(params.z_hit + params.z_rand > 0.0, "laser_z_hit + laser_z_rand must be positive, got " +
+                                                  std::to_string(params.z_hit + params.z_rand));
   require(params.sigma_hit > 0.0 && std::isfinite(params.sigma_hit),
           "laser_sigma_hit must be positive, got " + std::to_string(params.sigma_hit));
+  require(params.likelihood_exponent > 0.0 && params.likelihood_exponent <= 1.0,
+          "laser_likelihood_exponent must be in (0, 1], got " +
+              std::to_string(params.likelihood_exponent));
   require(params.max_beams >= 1,
           "laser_max_beams must be >= 1, got " + std::to_string(params.max_beams));
   require(params.range_min >= 0.0 && params.range_max >= 0.0,
@@ -41,14 +43,14 @@ PreparedScan LikelihoodFieldModel::prepare(const LaserScan& scan) const {
   const std::vector<Beam> beams =
       selectBeams(scan, params_.max_beams, params_.range_min, params_.range_max, &valid);
   PreparedScan out;
-  out.range_max = params_.range_max > 0.0 ? std::min(params_.range_max, scan.range_max)
-                                          : scan.range_max;
+  out.range_max =
+      params_.range_max > 0.0 ? std::min(params_.range_max, scan.range_max) : scan.range_max;
   out.dropped = static_cast<int>(scan.ranges.size() - valid);
   out.x.reserve(beams.size());
   out.y.reserve(beams.size());
   for (const Beam& b : beams) {
-    const Pose2 end = compose(scan.sensor_pose, {b.range * std::cos(b.bearing),
-                                                 b.range * std::sin(b.bearing), 0.0});
+    const Pose2 end = compose(scan.sensor_pose,
+                              {b.range * std::cos(b.bearing), b.range * std::sin(b.bearing), 0.0});
     out.x.push_back(static_cast<float>(end.x));
     out.y.push_back(static_cast<float>(end.y));
   }
@@ -59,13 +61,14 @@ void LikelihoodFieldModel::buildTable(double range_max) const {
   if (range_max == table_range_max_) return;
   const OccupancyGrid& grid = field_.grid();
   const int stride = grid.width() + 2;
-  const float outside = static_cast<float>(beamLogLikelihood(field_.maxDistance(), range_max));
+  const double k = params_.likelihood_exponent;
+  const float outside = static_cast<float>(k * beamLogLikelihood(field_.maxDistance(), range_max));
   table_.assign(static_cast<std::size_t>(stride) * (grid.height() + 2), outside);
   const std::vector<float>& dist = field_.distances();
   for (int y = 0; y < grid.height(); ++y) {
     for (int x = 0; x < grid.width(); ++x) {
       table_[static_cast<std::size_t>(y + 1) * stride + x + 1] = static_cast<float>(
-          beamLogLikelihood(dist[static_cast<std::size_t>(y) * grid.width() + x], range_max));
+          k * beamLogLikelihood(dist[static_cast<std::size_t>(y) * grid.width() + x], range_max));
     }
   }
   table_range_max_ = range_max;

@@ -3,6 +3,7 @@
 #include <Eigen/Cholesky>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -18,6 +19,23 @@ void require(bool ok, const std::string& name, const std::string& range, double 
 
 bool finite(double v) { return std::isfinite(v); }
 
+// ESS of the weights prior * likelihood^beta, from their logarithms.
+double effectiveSampleSize(const std::vector<double>& log_prior,
+                           const std::vector<double>& log_likelihood, double beta) {
+  double max_log = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < log_prior.size(); ++i) {
+    max_log = std::max(max_log, log_prior[i] + beta * log_likelihood[i]);
+  }
+  if (!std::isfinite(max_log)) return 0.0;
+  double sum = 0.0, sum_sq = 0.0;
+  for (std::size_t i = 0; i < log_prior.size(); ++i) {
+    const double w = std::exp(log_prior[i] + beta * log_likelihood[i] - max_log);
+    sum += w;
+    sum_sq += w * w;
+  }
+  return sum * sum / sum_sq;
+}
+
 }  // namespace
 
 void validate(const ParticleFilterParams& p) {
@@ -29,12 +47,12 @@ void validate(const ParticleFilterParams& p) {
           p.kld.confidence);
   require(p.kld.bin_xy > 0.0 && finite(p.kld.bin_xy), "kld_bin_xy", "> 0", p.kld.bin_xy);
   require(p.kld.bin_yaw > 0.0 && finite(p.kld.bin_yaw), "kld_bin_yaw", "> 0", p.kld.bin_yaw);
-  require(p.update_min_d >= 0.0 && finite(p.update_min_d), "update_min_d", ">= 0",
-          p.update_min_d);
-  require(p.update_min_a >= 0.0 && finite(p.update_min_a), "update_min_a", ">= 0",
-          p.update_min_a);
-  require(p.resample_ess_fraction > 0.0 && p.resample_ess_fraction <= 1.0,
-          "resample_ess_fraction", "in (0, 1]", p.resample_ess_fraction);
+  require(p.update_min_d >= 0.0 && finite(p.update_min_d), "update_min_d", ">= 0", p.update_min_d);
+  require(p.update_min_a >= 0.0 && finite(p.update_min_a), "update_min_a", ">= 0", p.update_min_a);
+  require(p.resample_ess_fraction > 0.0 && p.resample_ess_fraction <= 1.0, "resample_ess_fraction",
+          "in (0, 1]", p.resample_ess_fraction);
+  require(p.tempering_ess_fraction >= 0.0 && p.tempering_ess_fraction <= 1.0,
+          "tempering_ess_fraction", "in [0, 1]", p.tempering_ess_fraction);
   require(p.clusters.cell_xy > 0.0 && finite(p.clusters.cell_xy), "cluster_xy", "> 0",
           p.clusters.cell_xy);
   require(p.clusters.cell_yaw > 0.0 && finite(p.clusters.cell_yaw), "cluster_yaw", "> 0",
@@ -54,6 +72,8 @@ void validate(const ParticleFilterParams& p) {
   require(s.max_distance > 0.0 && finite(s.max_distance), "laser_likelihood_max_dist", "> 0",
           s.max_distance);
   require(s.max_beams >= 1, "laser_max_beams", ">= 1", s.max_beams);
+  require(s.likelihood_exponent > 0.0 && s.likelihood_exponent <= 1.0, "laser_likelihood_exponent",
+          "in (0, 1]", s.likelihood_exponent);
   require(s.range_min >= 0.0 && finite(s.range_min), "laser_min_range", ">= 0", s.range_min);
   require(s.range_max >= 0.0 && finite(s.range_max), "laser_max_range", ">= 0", s.range_max);
   const auto& m = p.motion;
@@ -169,8 +189,8 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
   if (prepared.size() == 0) {
     // Without evidence the cloud would only be moved; keep the odometry
     // reference so the motion is applied once a usable scan comes.
-    report.skip_reason = "no valid beam in the scan (" + std::to_string(prepared.dropped) +
-                         " of " + std::to_string(scan.ranges.size()) + " invalid)";
+    report.skip_reason = "no valid beam in the scan (" + std::to_string(prepared.dropped) + " of " +
+                         std::to_string(scan.ranges.size()) + " invalid)";
     return report;
   }
 
@@ -191,14 +211,31 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
 
 void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
   model_->logLikelihoods(scan, particles_, &scratch_);
-  const double beams = static_cast<double>(scan.size());
-  double max_log = -std::numeric_limits<double>::infinity();
+  // Undo the tempering for the report: it is about the beams, not the weights.
+  const double beams = static_cast<double>(scan.size()) * params_.sensor.likelihood_exponent;
   double mean_beam = 0.0;
+  log_prior_.resize(particles_.size());
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     // The geometric mean of the beam likelihoods does not depend on the beam
     // count, which makes it comparable across scans and robots.
     mean_beam += particles_.weight[i] * std::exp(scratch_[i] / beams);
-    scratch_[i] += std::log(particles_.weight[i]);
+    log_prior_[i] = std::log(particles_.weight[i]);
+  }
+  double beta = 1.0;
+  const double min_ess = params_.tempering_ess_fraction * static_cast<double>(particles_.size());
+  if (min_ess > 0.0 && effectiveSampleSize(log_prior_, scratch_, 1.0) < min_ess) {
+    // Bisection for the largest exponent that keeps min_ess particles.
+    double lo = 0.0, hi = 1.0;
+    for (int k = 0; k < 20; ++k) {
+      const double mid = 0.5 * (lo + hi);
+      (effectiveSampleSize(log_prior_, scratch_, mid) >= min_ess ? lo : hi) = mid;
+    }
+    beta = lo;
+  }
+  report->tempering = beta;
+  double max_log = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    scratch_[i] = log_prior_[i] + beta * scratch_[i];
     max_log = std::max(max_log, scratch_[i]);
   }
   // When every particle scores zero (possible with z_rand = 0: an end point
@@ -227,14 +264,13 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
 }
 
 void ParticleFilter::resample(UpdateReport* report) {
-  const double inject_probability =
-      w_slow_ > 0.0 ? std::max(0.0, 1.0 - w_fast_ / w_slow_) : 0.0;
+  const double inject_probability = w_slow_ > 0.0 ? std::max(0.0, 1.0 - w_fast_ / w_slow_) : 0.0;
   const std::size_t n = static_cast<std::size_t>(particles_.size());
   if (report->ess >= params_.resample_ess_fraction * n && inject_probability < 0.01) return;
 
   const std::size_t target = kldParticleCount(particles_, params_.kld);
-  const auto injected = static_cast<std::size_t>(
-      std::floor(inject_probability * target + random_.uniform()));
+  const auto injected =
+      static_cast<std::size_t>(std::floor(inject_probability * target + random_.uniform()));
   systematicResample(&particles_, target - std::min(injected, target), &random_);
   for (std::size_t i = 0; i < injected && i < target; ++i) {
     particles_.x.push_back(0.0);

@@ -113,6 +113,7 @@ LocalizerConfig readConfig(const ParamSource& p) {
   p.get("update_min_d", &f.update_min_d);
   p.get("update_min_a", &f.update_min_a);
   p.get("resample_ess_fraction", &f.resample_ess_fraction);
+  p.get("tempering_ess_fraction", &f.tempering_ess_fraction);
   int seed = 0;
   if (p.get("seed", &seed)) {
     require(seed >= 0, "seed", ">= 0");
@@ -144,6 +145,7 @@ LocalizerConfig readConfig(const ParamSource& p) {
   p.get("laser_z_rand", &f.sensor.z_rand);
   p.get("laser_sigma_hit", &f.sensor.sigma_hit);
   p.get("laser_likelihood_max_dist", &f.sensor.max_distance);
+  p.get("laser_likelihood_exponent", &f.sensor.likelihood_exponent);
   p.get("laser_min_range", &f.sensor.range_min);
   p.get("laser_max_range", &f.sensor.range_max);
   // amcl spells "use the scan's own limit" as -1; accept that spelling too.

@@ -30,6 +30,12 @@ struct LikelihoodFieldModelParams {
   int max_beams = 60;         // beams used per scan after dropping invalid ones
   double range_min = 0.0;     // m; tighter lower limit than the scan's, 0 = scan's
   double range_max = 0.0;     // m; tighter upper limit than the scan's, 0 = scan's
+  // The beams of one scan are not independent (neighbours see the same wall,
+  // the map is imperfect), so their plain product is far too confident: one
+  // scan can make a single particle outweigh all others by e^100. Raising the
+  // scan likelihood to this power (tempering) keeps rival hypotheses alive
+  // until the evidence really separates them. 1 = independent beams.
+  double likelihood_exponent = 0.2;  // (0, 1]
 };
 
 /// End points of the usable beams in the robot's base frame, computed once per scan.
@@ -52,10 +58,10 @@ class LikelihoodFieldModel {
   /// The usable beams' end points in the robot frame.
   PreparedScan prepare(const LaserScan& scan) const;
 
-  /// log p(scan | pose) for one pose.
+  /// likelihood_exponent * log p(scan | pose) for one pose.
   double logLikelihood(const PreparedScan& scan, const Pose2& pose) const;
 
-  /// log p(scan | particle) for every particle, into `log_likelihood`.
+  /// likelihood_exponent * log p(scan | particle) for every particle, into `log_likelihood`.
   void logLikelihoods(const PreparedScan& scan, const ParticleSet& particles,
                       std::vector<double>* log_likelihood) const;
 

@@ -44,6 +44,12 @@ struct ParticleFilterParams {
   double update_min_d = 0.2;           // m of travel between updates
   double update_min_a = M_PI / 6.0;    // rad of rotation between updates
   double resample_ess_fraction = 0.5;  // resample when ESS < this * N (0..1]
+  // When one scan would leave fewer than this fraction of N effective
+  // particles, its likelihood is tempered (raised to the largest power below 1
+  // that keeps that many). Evidence too strong for the cloud, as right after a
+  // global initialisation, then narrows it over several scans instead of
+  // collapsing it onto one lucky particle. 0 disables. [0, 1]
+  double tempering_ess_fraction = 0.02;
   uint64_t seed = 0;
   OdometryMotionParams motion;
   LikelihoodFieldModelParams sensor;
@@ -65,6 +71,7 @@ struct UpdateReport {
   bool resampled = false;
   double mean_beam_likelihood = 0.0;  // geometric mean over beams, weighted over particles
   std::size_t injected = 0;           // random particles added by recovery
+  double tempering = 1.0;             // exponent applied to this scan's likelihood (1: none)
 };
 
 class ParticleFilter {
@@ -125,6 +132,7 @@ class ParticleFilter {
   double w_slow_ = 0.0;
   double w_fast_ = 0.0;
   std::vector<double> scratch_;
+  std::vector<double> log_prior_;
 };
 
 }  // namespace pf
