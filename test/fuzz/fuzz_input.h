@@ -12,8 +12,15 @@
 //               Once the input is used up: (lo + hi) / 2.
 // Ordinary values therefore cost three bytes (selector >= 10, then u16), and
 // the interesting ones about 4% of selector values each.
+//
+// With PF_FUZZ_BOUNDED=1 in the environment every finite value keeps a sane
+// magnitude: |v| <= 1e4 and |v| >= 1e-3 unless 0 (1e300 becomes 1e4, the
+// denormal 1e-3). NaN and inf stay. Meant for fuzzing past the known
+// overflow bugs (float -> integer casts of huge coordinates) while they are
+// open; the default is unbounded.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -39,7 +46,22 @@ class Input {
     return static_cast<uint16_t>(lo | (hi << 8));
   }
 
+  static bool bounded() {
+    static const bool b = [] {
+      const char* e = std::getenv("PF_FUZZ_BOUNDED");
+      return e && *e && *e != '0';
+    }();
+    return b;
+  }
+
   double num(double lo, double hi) {
+    const double v = numUnbounded(lo, hi);
+    if (!bounded() || !std::isfinite(v) || v == 0.0) return v;
+    const double m = std::fabs(v) > 1e4 ? 1e4 : std::fabs(v) < 1e-3 ? 1e-3 : std::fabs(v);
+    return v < 0 ? -m : m;
+  }
+
+  double numUnbounded(double lo, double hi) {
     if (exhausted()) return 0.5 * (lo + hi);
     const uint8_t sel = u8();
     switch (sel) {
