@@ -37,6 +37,8 @@ LikelihoodFieldModelParams params(double max_distance = 2.0) {
   p.sigma_hit = 0.2;
   p.max_distance = max_distance;
   p.max_beams = 60;
+  // Untempered, so that the expected values are the plain sums of log p.
+  p.likelihood_exponent = 1.0;
   return p;
 }
 
@@ -260,6 +262,20 @@ void expectRejected(const LikelihoodFieldModelParams& p, const std::string& name
   }
 }
 
+TEST(LikelihoodFieldModel, ExponentScalesTheScanLogLikelihood) {
+  // One beam ending 0.15 m short of the wall (x = 0.7 m vs the wall's centre at
+  // 0.85 m): the tempered model scores a quarter of the plain one.
+  LikelihoodFieldModelParams p = params();
+  const LikelihoodFieldModel plain(wallGrid(8), p);
+  p.likelihood_exponent = 0.25;
+  const LikelihoodFieldModel tempered(wallGrid(8), p);
+  const LaserScan scan = quarterScan({0.65f, 0.0f, 0.0f, 0.0f});
+  const Pose2 pose{0.05, 0.25, 0.0};
+  const double full = plain.logLikelihood(plain.prepare(scan), pose);
+  EXPECT_LT(full, kLogP0);
+  EXPECT_NEAR(0.25 * full, tempered.logLikelihood(tempered.prepare(scan), pose), 1e-6);
+}
+
 TEST(LikelihoodFieldModel, InvalidParametersThrowNamingThem) {
   using P = LikelihoodFieldModelParams;
   auto with = [](auto change) {
@@ -279,6 +295,8 @@ TEST(LikelihoodFieldModel, InvalidParametersThrowNamingThem) {
   expectRejected(with([](P& p) { p.range_max = -1.0; }), "laser_max_range");
   expectRejected(with([](P& p) { p.max_distance = 0.0; }), "max_dist");
   expectRejected(with([](P& p) { p.max_distance = NAN; }), "max_dist");
+  expectRejected(with([](P& p) { p.likelihood_exponent = 0.0; }), "laser_likelihood_exponent");
+  expectRejected(with([](P& p) { p.likelihood_exponent = 1.5; }), "laser_likelihood_exponent");
   // Only z_hit or only z_rand is fine.
   EXPECT_NO_THROW(LikelihoodFieldModel(wallGrid(8), with([](P& p) { p.z_rand = 0.0; })));
   EXPECT_NO_THROW(LikelihoodFieldModel(wallGrid(8), with([](P& p) { p.z_hit = 0.0; })));
