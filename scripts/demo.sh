@@ -25,8 +25,9 @@ done
 if [ -z "$bag" ]; then
   bag=$repo/bags/tracking.bag
   map=$repo/maps/building.yaml
-  # The bundled bag's start pose (bags/README.md); the filter is not told more.
-  read -r x y yaw < "$repo/bags/tracking.start"
+  # The bundled bag's start pose, from the `start` line of its path script
+  # (bags/README.md); the filter is told nothing else.
+  read -r x y yaw < <(awk '$1 == "start" {print $2, $3, $4; exit}' "$repo/bags/tracking.path")
   runner_args+=(--initial-pose "$x" "$y" "$yaw")
 fi
 [ -n "$map" ] || { echo "demo: --map is required with --bag" >&2; exit 2; }

@@ -25,8 +25,11 @@ check() {  # check NAME COMMAND...: a source check counted as one test
 
 # --- GoogleTest and rostest, through catkin ---------------------------------
 bash scripts/build.sh run_tests -j1 2>&1 | tee "$ws/run_tests.log" | grep -E "^\[ *(OK|FAILED|PASSED) *\]|^\[ROSTEST\]|^\[Testcase|FAILURE|Error" || true
+# catkin's setup scripts read unset variables.
+set +u
 # shellcheck disable=SC1091
 source "$ws/devel/setup.bash"
+set -u
 summary=$(catkin_test_results --all "$ws/build/test_results" 2>&1)
 echo "$summary" | grep -vE "^Skipping" | tail -n 30
 line=$(echo "$summary" | grep -E "^Summary:" | tail -n 1)

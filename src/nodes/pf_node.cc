@@ -63,6 +63,9 @@ std::string failureText(tf2_ros::filter_failure_reasons::FilterFailureReason rea
 // topic is taken as the source instead.
 constexpr double kOdomSourceGrace = 0.5;
 
+// s a scan may be older than the previous one before time counts as jumping back.
+constexpr double kTimeJumpTolerance = 1.0;
+
 class PfNode {
  public:
   PfNode(const LocalizerConfig& config, ros::NodeHandle nh)
@@ -145,6 +148,7 @@ class PfNode {
   }
 
   void onScan(const sensor_msgs::LaserScanConstPtr& scan) {
+    if (timeJumpedBack(scan->header.stamp)) return;
     const ScanResult result = localizer_.processScan(*scan);
     if (!result.error.empty()) {
       warn(result.error.substr(0, 24), result.error);
@@ -160,6 +164,28 @@ class PfNode {
     }
     last_scan_stamp_ = scan->header.stamp;
     publishMapToOdom(scan->header.stamp + ros::Duration(config_.transform_tolerance));
+  }
+
+  // A scan older than the previous one by more than a second means time
+  // went back (a bag restarted, with --loop or by hand): tf data and the
+  // filter's odometry reference belong to the old timeline, so both start
+  // over, as tf itself does on such a jump.
+  bool timeJumpedBack(const ros::Time& stamp) {
+    if (last_scan_stamp_.isZero() ||
+        stamp + ros::Duration(kTimeJumpTolerance) >= last_scan_stamp_) {
+      return false;
+    }
+    ROS_WARN(
+        "pf_node: time jumped back by %.1f s (a bag restarted?): clearing tf and restarting "
+        "the filter %s",
+        (last_scan_stamp_ - stamp).toSec(),
+        config_.initial_pose ? "from the initial pose" : "with global localization");
+    buffer_.clear();
+    const std::string error = localizer_.restart();
+    if (!error.empty()) ROS_WARN("pf_node: %s", error.c_str());
+    last_scan_stamp_ = ros::Time();
+    last_tf_stamp_ = ros::Time();
+    return true;
   }
 
   void onScanDropped(const sensor_msgs::LaserScanConstPtr& scan,

@@ -20,7 +20,11 @@ std::string describe(const ros::Time& t) {
 }  // namespace
 
 ScanLocalizer::ScanLocalizer(const LocalizerConfig& config, const tf2::BufferCore* tf)
-    : config_(config), tf_(tf), filter_(config.filter) {}
+    : config_(config),
+      configured_pose_(config.initial_pose),
+      configured_cov_(config.initial_cov),
+      tf_(tf),
+      filter_(config.filter) {}
 
 std::string ScanLocalizer::setMap(const nav_msgs::OccupancyGrid& map) {
   pf::OccupancyGrid grid;
@@ -79,6 +83,15 @@ std::string ScanLocalizer::startGlobalLocalization() {
   } catch (const std::logic_error& e) {
     return std::string("global localization failed: ") + e.what();
   }
+  return "";
+}
+
+std::string ScanLocalizer::restart() {
+  config_.initial_pose = configured_pose_;
+  config_.initial_cov = configured_cov_;
+  if (!filter_.hasMap()) return "";
+  if (!configured_pose_) return startGlobalLocalization();
+  filter_.initializeGaussian(*configured_pose_, configured_cov_);
   return "";
 }
 

@@ -52,6 +52,11 @@ class ScanLocalizer {
   /// Global localization: particles spread over the map's free space.
   std::string startGlobalLocalization();
 
+  /// Starts over as on the first map: from the initial pose of the
+  /// configuration (not one set since), or globally without one. For time
+  /// jumping back, as when a bag is replayed with --loop.
+  std::string restart();
+
   /// Uses one scan: odometry and laser pose from tf at the scan's stamp, then
   /// the filter update.
   ScanResult processScan(const sensor_msgs::LaserScan& scan);
@@ -65,6 +70,8 @@ class ScanLocalizer {
 
  private:
   LocalizerConfig config_;
+  const std::optional<pf::Pose2> configured_pose_;
+  const Eigen::Matrix3d configured_cov_;
   const tf2::BufferCore* tf_;
   pf::ParticleFilter filter_;
   bool had_map_ = false;
