@@ -100,7 +100,11 @@ void BM_SystematicResample(benchmark::State& state) {
     benchmark::DoNotOptimize(set.x.data());
   }
 }
-BENCHMARK(BM_SystematicResample)->Arg(10000)->Arg(100000)->Arg(1000000)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_SystematicResample)
+    ->Arg(10000)
+    ->Arg(100000)
+    ->Arg(1000000)
+    ->Unit(benchmark::kMillisecond);
 
 void BM_LikelihoodField(benchmark::State& state) {
   const pf::OccupancyGrid grid = pillarMap(static_cast<int>(state.range(0)));

@@ -30,19 +30,11 @@ set +u
 # shellcheck disable=SC1091
 source "$ws/devel/setup.bash"
 set -u
-summary=$(catkin_test_results --all "$ws/build/test_results" 2>&1)
-echo "$summary" | grep -vE "^Skipping" | tail -n 30
-line=$(echo "$summary" | grep -E "^Summary:" | tail -n 1)
-if [ -n "$line" ]; then
-  total=$(echo "$line" | sed -E 's/Summary: ([0-9]+) tests.*/\1/')
-  errors=$(echo "$line" | sed -E 's/.* ([0-9]+) errors.*/\1/')
-  failures=$(echo "$line" | sed -E 's/.* ([0-9]+) failures.*/\1/')
-  skipped=$(echo "$line" | sed -E 's/.* ([0-9]+) skipped.*/\1/')
-  passed=$((passed + total - errors - failures - skipped))
-  failed=$((failed + errors + failures))
-else
-  echo "catkin_test_results found no results"; failed=$((failed + 1))
-fi
+catkin_test_results "$ws/build/test_results" 2>&1 | grep -vE "^Skipping" | tail -n 20
+read -r ok bad < <(/usr/bin/python3 scripts/count_test_results.py "$ws/build/test_results")
+passed=$((passed + ${ok:-0}))
+failed=$((failed + ${bad:-1}))
+[ "${ok:-0}" -eq 0 ] && { echo "no gtest or rostest result found"; failed=$((failed + 1)); }
 
 # --- Python unit tests (pf_evaluate's metrics) ------------------------------
 if [ -d test/python ]; then
@@ -58,8 +50,11 @@ fi
 # --- Source checks ------------------------------------------------------------
 core_is_ros_free() { ! grep -rnE '#include [<"](ros|tf2|sensor_msgs|nav_msgs|geometry_msgs|rosbag)/' include/pf_localization/core src/core include/pf_localization/sim src/sim; }
 clang_format_clean() {
-  git ls-files '*.h' '*.cc' | xargs -r clang-format --dry-run -Werror 2>&1 | head -n 20 | grep . && return 1
-  return 0
+  local out
+  out=$(git ls-files '*.h' '*.cc' | xargs -r clang-format --dry-run -Werror 2>&1)
+  [ -z "$out" ] && return 0
+  echo "$out" | head -n 20
+  return 1
 }
 check "the core and the simulator include no ROS header" core_is_ros_free
 check "clang-format clean" clang_format_clean

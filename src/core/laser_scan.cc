@@ -12,8 +12,8 @@ std::optional<std::string> validateScan(const LaserScan& scan) {
   }
   if (!std::isfinite(scan.range_max) || !std::isfinite(scan.range_min) ||
       !(scan.range_max > scan.range_min)) {
-    return "range_max (" + std::to_string(scan.range_max) + ") must be finite and above range_min (" +
-           std::to_string(scan.range_min) + ")";
+    return "range_max (" + std::to_string(scan.range_max) +
+           ") must be finite and above range_min (" + std::to_string(scan.range_min) + ")";
   }
   if (!scan.sensor_pose.isFinite()) return "the laser's pose on the robot is not finite";
   return std::nullopt;

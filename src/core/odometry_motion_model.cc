@@ -83,9 +83,8 @@ void OdometryMotionModel::applyOmni(const Pose2& from, const Pose2& to, Particle
   const double trans = std::hypot(dx, dy);
   const double rot = angleDiff(to.yaw, from.yaw);
   // Direction of travel relative to the heading: omni robots may move sideways.
-  const double bearing = trans < kMinTranslationForHeading
-                             ? 0.0
-                             : angleDiff(std::atan2(dy, dx), from.yaw);
+  const double bearing =
+      trans < kMinTranslationForHeading ? 0.0 : angleDiff(std::atan2(dy, dx), from.yaw);
   const double trans2 = trans * trans, rot2 = rot * rot;
   const double sigma_trans = std::sqrt(params_.alpha3 * trans2 + params_.alpha1 * rot2);
   const double sigma_rot = std::sqrt(params_.alpha4 * rot2 + params_.alpha2 * trans2);

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -12,8 +13,9 @@ namespace {
 
 void require(bool ok, const std::string& name, const std::string& range, double value) {
   if (!ok) {
-    throw std::invalid_argument("invalid parameter " + name + " = " + std::to_string(value) +
-                                ": must be " + range);
+    std::ostringstream text;  // shortest form: 500, not 500.000000
+    text << "invalid parameter " << name << " = " << value << ": must be " << range;
+    throw std::invalid_argument(text.str());
   }
 }
 

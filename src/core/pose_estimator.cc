@@ -76,9 +76,11 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
     for (int dx = -1; dx <= 1; ++dx) {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dt = -1; dt <= 1; ++dt) {
-          const BinKey n{keys[b].x + dx, keys[b].y + dy, ((keys[b].yaw + dt) % yaw_bins + yaw_bins) % yaw_bins};
+          const BinKey n{keys[b].x + dx, keys[b].y + dy,
+                         ((keys[b].yaw + dt) % yaw_bins + yaw_bins) % yaw_bins};
           const auto it = bin_of.find(n);
-          if (it != bin_of.end()) parent[find(parent, static_cast<int>(b))] = find(parent, it->second);
+          if (it != bin_of.end())
+            parent[find(parent, static_cast<int>(b))] = find(parent, it->second);
         }
       }
     }

@@ -44,7 +44,7 @@ double normalQuantile(double p) {
   if (!(p > 0.0 && p < 1.0)) throw std::invalid_argument("normalQuantile: p must be in (0, 1)");
   // Acklam's rational approximation of the inverse normal CDF (relative error
   // below 1.2e-9), refined by one Halley step against std::erfc.
-  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02, -2.759285104469687e+02,
+  static const double a[] = {-3.969683028665376e+01, 2.209460984245205e+02,  -2.759285104469687e+02,
                              1.383577518672690e+02,  -3.066479806614716e+01, 2.506628277459239e+00};
   static const double b[] = {-5.447609879822406e+01, 1.615858368580409e+02, -1.556989798598866e+02,
                              6.680131188771972e+01, -1.328068155288572e+01};

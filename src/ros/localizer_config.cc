@@ -9,16 +9,27 @@
 namespace pf_ros {
 namespace {
 
-class YamlParamSource : public ParamSource {
+// The four typed getters of ParamSource, all forwarded to the derived
+// class's one template read().
+template <typename Derived>
+class TypedParamSource : public ParamSource {
+ public:
+  bool get(const std::string& key, double* value) const override { return self().read(key, value); }
+  bool get(const std::string& key, int* value) const override { return self().read(key, value); }
+  bool get(const std::string& key, bool* value) const override { return self().read(key, value); }
+  bool get(const std::string& key, std::string* value) const override {
+    return self().read(key, value);
+  }
+
+ private:
+  const Derived& self() const { return static_cast<const Derived&>(*this); }
+};
+
+class YamlParamSource : public TypedParamSource<YamlParamSource> {
  public:
   YamlParamSource(YAML::Node root, std::string path)
       : root_(std::move(root)), path_(std::move(path)) {}
-  bool get(const std::string& key, double* value) const override { return read(key, value); }
-  bool get(const std::string& key, int* value) const override { return read(key, value); }
-  bool get(const std::string& key, bool* value) const override { return read(key, value); }
-  bool get(const std::string& key, std::string* value) const override { return read(key, value); }
 
- private:
   template <typename T>
   bool read(const std::string& key, T* value) const {
     const YAML::Node node = root_[key];
@@ -31,19 +42,15 @@ class YamlParamSource : public ParamSource {
     return true;
   }
 
+ private:
   YAML::Node root_;
   std::string path_;
 };
 
-class RosParamSource : public ParamSource {
+class RosParamSource : public TypedParamSource<RosParamSource> {
  public:
   explicit RosParamSource(const ros::NodeHandle& nh) : nh_(nh) {}
-  bool get(const std::string& key, double* value) const override { return read(key, value); }
-  bool get(const std::string& key, int* value) const override { return read(key, value); }
-  bool get(const std::string& key, bool* value) const override { return read(key, value); }
-  bool get(const std::string& key, std::string* value) const override { return read(key, value); }
 
- private:
   template <typename T>
   bool read(const std::string& key, T* value) const {
     if (!nh_.hasParam(key)) return false;
@@ -53,6 +60,7 @@ class RosParamSource : public ParamSource {
     return true;
   }
 
+ private:
   ros::NodeHandle nh_;
 };
 

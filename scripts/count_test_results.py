@@ -1,0 +1,42 @@
+#!/usr/bin/python3
+"""Counts passed and failed test cases in catkin's JUnit result files.
+
+catkin_test_results adds up the "tests" attributes of every file, which counts
+each gtest case twice (its suite and the whole run both carry it) and each
+rostest twice (once in rostest-*.xml, once in the test node's rosunit-*.xml).
+Here every <testcase> of the gtest-* and rostest-* files counts once.
+usage: count_test_results.py RESULTS_DIR      prints "PASSED FAILED"
+"""
+import glob
+import os
+import sys
+import xml.etree.ElementTree as ET
+
+
+def count(results_dir):
+    passed = failed = 0
+    for path in sorted(glob.glob(os.path.join(results_dir, '**', '*.xml'), recursive=True)):
+        name = os.path.basename(path)
+        if not name.startswith(('gtest-', 'rostest-')):
+            continue
+        try:
+            cases = ET.parse(path).getroot().iter('testcase')
+        except ET.ParseError as e:
+            print('%s: unreadable result file: %s' % (path, e), file=sys.stderr)
+            failed += 1
+            continue
+        for case in cases:
+            if case.find('skipped') is not None:
+                continue
+            bad = case.find('failure') is not None or case.find('error') is not None
+            failed += bad
+            passed += not bad
+            if bad:
+                print('FAILED: %s %s.%s' % (name, case.get('classname'), case.get('name')),
+                      file=sys.stderr)
+    return passed, failed
+
+
+if __name__ == '__main__':
+    p, f = count(sys.argv[1])
+    print(p, f)
