@@ -51,6 +51,14 @@ PreparedScan LikelihoodFieldModel::prepare(const LaserScan& scan) const {
   for (const Beam& b : beams) {
     const Pose2 end = compose(scan.sensor_pose,
                               {b.range * std::cos(b.bearing), b.range * std::sin(b.bearing), 0.0});
+    // Ranges of 1e38 m pass the scan's own limits when range_max is absurd;
+    // in float cells they overflow, so they are dropped like any bad beam.
+    const double res = field_.grid().resolution();
+    if (!std::isfinite(static_cast<float>(end.x / res)) ||
+        !std::isfinite(static_cast<float>(end.y / res))) {
+      ++out.dropped;
+      continue;
+    }
     out.x.push_back(static_cast<float>(end.x));
     out.y.push_back(static_cast<float>(end.y));
   }
@@ -113,8 +121,12 @@ void LikelihoodFieldModel::logLikelihoods(const PreparedScan& scan, const Partic
     for (std::size_t b = 0; b < n; ++b) {
       // Clamping before truncation sends every point outside the map to the
       // border, and makes truncation equal floor for what remains.
-      const float gx = std::min(std::max(px + c * bx[b] - s * by[b], 0.0f), max_x);
-      const float gy = std::min(std::max(py + s * bx[b] + c * by[b], 0.0f), max_y);
+      // The comparisons are written so that NaN (from a particle at infinity)
+      // also lands in the border instead of becoming an undefined int.
+      const float ex = px + c * bx[b] - s * by[b];
+      const float ey = py + s * bx[b] + c * by[b];
+      const float gx = ex > 0.0f ? std::min(ex, max_x) : 0.0f;
+      const float gy = ey > 0.0f ? std::min(ey, max_y) : 0.0f;
       sum += table[static_cast<int>(gy) * stride + static_cast<int>(gx)];
     }
     (*log_likelihood)[i] = sum;

@@ -45,9 +45,14 @@ CellState OccupancyGrid::state(const CellIndex& c) const {
 }
 
 CellIndex OccupancyGrid::worldToCell(double wx, double wy) const {
+  // Anything off the map lands one cell outside it (NaN included), so that
+  // the conversion to int is always defined.
   const Pose2 local = between(origin_, {wx, wy, 0.0});
-  return {static_cast<int>(std::floor(local.x / resolution_)),
-          static_cast<int>(std::floor(local.y / resolution_))};
+  const auto cell = [this](double v, int size) {
+    const double c = std::floor(v / resolution_);
+    return c >= 0.0 && c < size ? static_cast<int>(c) : (c >= size ? size : -1);
+  };
+  return {cell(local.x, width_), cell(local.y, height_)};
 }
 
 void OccupancyGrid::cellToWorld(const CellIndex& c, double* wx, double* wy) const {

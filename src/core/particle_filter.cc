@@ -47,8 +47,9 @@ void validate(const ParticleFilterParams& p) {
   require(p.kld.kld_err > 0.0 && finite(p.kld.kld_err), "kld_err", "> 0", p.kld.kld_err);
   require(p.kld.confidence > 0.0 && p.kld.confidence < 1.0, "kld_confidence", "in (0, 1)",
           p.kld.confidence);
-  require(p.kld.bin_xy > 0.0 && finite(p.kld.bin_xy), "kld_bin_xy", "> 0", p.kld.bin_xy);
-  require(p.kld.bin_yaw > 0.0 && finite(p.kld.bin_yaw), "kld_bin_yaw", "> 0", p.kld.bin_yaw);
+  require(p.kld.bin_xy >= 1e-3 && finite(p.kld.bin_xy), "kld_bin_xy", ">= 0.001", p.kld.bin_xy);
+  require(p.kld.bin_yaw >= 1e-3 && finite(p.kld.bin_yaw), "kld_bin_yaw", ">= 0.001", p.kld.bin_yaw);
+  require(p.odom_jump_limit > 0.0, "odom_jump_limit", "> 0", p.odom_jump_limit);
   require(p.update_min_d >= 0.0 && finite(p.update_min_d), "update_min_d", ">= 0", p.update_min_d);
   require(p.update_min_a >= 0.0 && finite(p.update_min_a), "update_min_a", ">= 0", p.update_min_a);
   require(p.resample_ess_fraction > 0.0 && p.resample_ess_fraction <= 1.0, "resample_ess_fraction",
@@ -63,6 +64,8 @@ void validate(const ParticleFilterParams& p) {
           "in [0, 1]", p.recovery.alpha_slow);
   require(p.recovery.alpha_fast >= 0.0 && p.recovery.alpha_fast <= 1.0, "recovery_alpha_fast",
           "in [0, 1]", p.recovery.alpha_fast);
+  require(p.recovery.trigger_ratio > 0.0 && p.recovery.trigger_ratio <= 1.0,
+          "recovery_trigger_ratio", "in (0, 1]", p.recovery.trigger_ratio);
   require(p.recovery.alpha_slow == 0.0 || p.recovery.alpha_fast > p.recovery.alpha_slow,
           "recovery_alpha_fast", "> recovery_alpha_slow when recovery is on",
           p.recovery.alpha_fast);
@@ -176,6 +179,21 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
   }
 
   const bool first = restart_ || !odom_at_update_;
+  if (!first) {
+    const Pose2 delta = between(*odom_at_update_, odom);
+    const double step = std::hypot(delta.x, delta.y);
+    if (!(step <= params_.odom_jump_limit)) {
+      // Wheels do not carry a robot this far between two scans: the odometry
+      // was reset or glitched. Moving the particles by it would throw them
+      // away, so the step is skipped and tracking resumes from the new pose.
+      odom_at_update_ = odom;
+      report.skip_reason = "odometry jumped " + std::to_string(step) +
+                           " m since the last update (odom_jump_limit " +
+                           std::to_string(params_.odom_jump_limit) +
+                           " m): treated as an odometry fault, particles not moved";
+      return report;
+    }
+  }
   if (!first && !force_update_) {
     const Pose2 delta = between(*odom_at_update_, odom);
     if (std::hypot(delta.x, delta.y) < params_.update_min_d &&
@@ -203,8 +221,10 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
 
   weigh(prepared, &report);
   report.ess = effectiveSampleSize(particles_.weight);
-  resample(&report);
+  // The estimate comes from the weighted cloud, before resampling: resampling
+  // only adds noise, and the random particles recovery injects must not count.
   estimate_ = estimatePose(particles_, params_.clusters);
+  resample(&report);
   has_estimate_ = true;
   report.updated = true;
   report.particles = particles_.size();
@@ -212,32 +232,28 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
 }
 
 void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
-  model_->logLikelihoods(scan, particles_, &scratch_);
-  // Undo the tempering for the report: it is about the beams, not the weights.
-  const double beams = static_cast<double>(scan.size()) * params_.sensor.likelihood_exponent;
-  double mean_beam = 0.0;
+  model_->logLikelihoods(scan, particles_, &log_likelihood_);
   log_prior_.resize(particles_.size());
   for (std::size_t i = 0; i < particles_.size(); ++i) {
-    // The geometric mean of the beam likelihoods does not depend on the beam
-    // count, which makes it comparable across scans and robots.
-    mean_beam += particles_.weight[i] * std::exp(scratch_[i] / beams);
     log_prior_[i] = std::log(particles_.weight[i]);
   }
+  const std::vector<double>& ll = log_likelihood_;
   double beta = 1.0;
   const double min_ess = params_.tempering_ess_fraction * static_cast<double>(particles_.size());
-  if (min_ess > 0.0 && effectiveSampleSize(log_prior_, scratch_, 1.0) < min_ess) {
+  if (min_ess > 0.0 && effectiveSampleSize(log_prior_, ll, 1.0) < min_ess) {
     // Bisection for the largest exponent that keeps min_ess particles.
     double lo = 0.0, hi = 1.0;
     for (int k = 0; k < 20; ++k) {
       const double mid = 0.5 * (lo + hi);
-      (effectiveSampleSize(log_prior_, scratch_, mid) >= min_ess ? lo : hi) = mid;
+      (effectiveSampleSize(log_prior_, ll, mid) >= min_ess ? lo : hi) = mid;
     }
     beta = lo;
   }
   report->tempering = beta;
+  scratch_.resize(particles_.size());
   double max_log = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < particles_.size(); ++i) {
-    scratch_[i] = log_prior_[i] + beta * scratch_[i];
+    scratch_[i] = log_prior_[i] + beta * ll[i];
     max_log = std::max(max_log, scratch_[i]);
   }
   // When every particle scores zero (possible with z_rand = 0: an end point
@@ -253,6 +269,16 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
     }
     for (double& w : particles_.weight) w /= total;
   }
+  // How well the cloud explains the scan: the per-beam geometric mean
+  // likelihood (independent of the beam count, so comparable across scans and
+  // robots), averaged with the posterior weights. The posterior, not the
+  // prior, so that a few particles that found the robot count for what they
+  // are worth, and a cloud salted with random particles is not judged by them.
+  const double beams = static_cast<double>(scan.size()) * params_.sensor.likelihood_exponent;
+  double mean_beam = 0.0;
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    mean_beam += particles_.weight[i] * std::exp(ll[i] / beams);
+  }
   report->mean_beam_likelihood = mean_beam;
 
   if (params_.recovery.alpha_slow > 0.0) {
@@ -266,25 +292,32 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
 }
 
 void ParticleFilter::resample(UpdateReport* report) {
-  const double inject_probability = w_slow_ > 0.0 ? std::max(0.0, 1.0 - w_fast_ / w_slow_) : 0.0;
-  const std::size_t n = static_cast<std::size_t>(particles_.size());
+  // Augmented MCL: the short-term average of the measurement likelihood
+  // falling below the long-term one means the particles no longer explain the
+  // scans, and a matching share of the new cloud is drawn from free space.
+  // Dips of a few tenths come and go in normal tracking (a person in front
+  // of the laser, a doorway); only a fit below trigger_ratio times the usual
+  // one injects anything.
+  const double usual = params_.recovery.trigger_ratio * w_slow_;
+  const double inject_probability = usual > 0.0 ? std::max(0.0, 1.0 - w_fast_ / usual) : 0.0;
+  const std::size_t n = particles_.size();
   if (report->ess >= params_.resample_ess_fraction * n && inject_probability < 0.01) return;
 
   const std::size_t target = kldParticleCount(particles_, params_.kld);
-  const auto injected =
-      static_cast<std::size_t>(std::floor(inject_probability * target + random_.uniform()));
-  systematicResample(&particles_, target - std::min(injected, target), &random_);
-  for (std::size_t i = 0; i < injected && i < target; ++i) {
-    particles_.x.push_back(0.0);
-    particles_.y.push_back(0.0);
-    particles_.yaw.push_back(0.0);
-    particles_.setPose(particles_.size() - 1, randomFreePose());
-  }
-  particles_.weight.resize(particles_.size());
+  // Random particles are spread over the whole map, so they are counted
+  // against the largest cloud, not the converged one: a lost filter must
+  // search with as many particles as a global localization.
+  const std::size_t max = static_cast<std::size_t>(params_.kld.max_particles);
+  const auto injected = std::min(
+      max, static_cast<std::size_t>(std::floor(inject_probability * max + random_.uniform())));
+  const std::size_t kept = std::min(
+      max - injected, static_cast<std::size_t>(std::ceil((1.0 - inject_probability) * target)));
+  systematicResample(&particles_, kept, &random_);
+  particles_.resize(kept + injected);
+  for (std::size_t i = kept; i < kept + injected; ++i) particles_.setPose(i, randomFreePose());
   particles_.setUniformWeights();
-  if (injected > 0) w_slow_ = w_fast_ = 0.0;  // start the averages afresh, as amcl does
   report->resampled = true;
-  report->injected = std::min(injected, target);
+  report->injected = injected;
 }
 
 std::optional<Pose2> ParticleFilter::mapToOdom() const {

@@ -5,6 +5,8 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "pf_localization/core/bin_index.h"
+
 namespace pf {
 namespace {
 
@@ -61,9 +63,9 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
   std::vector<int> particle_bin(particles.size());
   for (std::size_t i = 0; i < particles.size(); ++i) {
     const double yaw01 = (normalizeAngle(particles.yaw[i]) + M_PI) / (2.0 * M_PI);
-    const BinKey key{static_cast<int64_t>(std::floor(particles.x[i] / params.cell_xy)),
-                     static_cast<int64_t>(std::floor(particles.y[i] / params.cell_xy)),
-                     std::min(yaw_bins - 1, static_cast<int64_t>(yaw01 * yaw_bins))};
+    const BinKey key{binIndex(particles.x[i], params.cell_xy),
+                     binIndex(particles.y[i], params.cell_xy),
+                     std::clamp<int64_t>(binIndex(yaw01, 1.0 / yaw_bins), 0, yaw_bins - 1)};
     auto [it, inserted] = bin_of.try_emplace(key, static_cast<int>(keys.size()));
     if (inserted) keys.push_back(key);
     particle_bin[i] = it->second;

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <unordered_map>
 
+#include "pf_localization/core/bin_index.h"
+
 namespace pf {
 
 double effectiveSampleSize(const std::vector<double>& weights) {
@@ -88,9 +90,9 @@ std::size_t kldParticleCount(const ParticleSet& particles, const KldParams& para
   std::unordered_map<uint64_t, double> bins;
   bins.reserve(particles.size());
   for (std::size_t i = 0; i < particles.size(); ++i) {
-    const auto bx = static_cast<int64_t>(std::floor(particles.x[i] / params.bin_xy));
-    const auto by = static_cast<int64_t>(std::floor(particles.y[i] / params.bin_xy));
-    const auto bt = static_cast<int64_t>(std::floor(particles.yaw[i] / params.bin_yaw));
+    const int64_t bx = binIndex(particles.x[i], params.bin_xy);
+    const int64_t by = binIndex(particles.y[i], params.bin_xy);
+    const int64_t bt = binIndex(particles.yaw[i], params.bin_yaw);
     const uint64_t key = (static_cast<uint64_t>(bx & 0x1FFFFF) << 42) |
                          (static_cast<uint64_t>(by & 0x1FFFFF) << 21) |
                          static_cast<uint64_t>(bt & 0x1FFFFF);

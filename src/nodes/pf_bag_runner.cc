@@ -214,7 +214,8 @@ int main(int argc, char** argv) {
   if (!opt.log.empty()) {
     log.open(opt.log);
     if (!log) fail(opt.log + ": cannot write");
-    log << "t,particles,ess,cpu_ms,mean_beam_likelihood,std_x,std_y,std_yaw,updated\n";
+    log << "t,particles,ess,cpu_ms,mean_beam_likelihood,std_x,std_y,std_yaw,updated,injected,"
+           "tempering\n";
   }
   if (!opt.particles_out.empty()) {
     dump.open(opt.particles_out);
@@ -251,7 +252,8 @@ int main(int argc, char** argv) {
             << std::setprecision(1) << r.report.ess << "," << std::setprecision(3) << cpu * 1e3
             << "," << std::setprecision(6) << r.report.mean_beam_likelihood << ","
             << std::sqrt(est.covariance(0, 0)) << "," << std::sqrt(est.covariance(1, 1)) << ","
-            << std::sqrt(est.covariance(2, 2)) << ",1\n";
+            << std::sqrt(est.covariance(2, 2)) << ",1," << r.report.injected << ","
+            << r.report.tempering << "\n";
       }
       if (dump && t - first_stamp <= kParticleDumpSeconds) {
         const pf::ParticleSet& p = localizer.filter().particles();

@@ -120,6 +120,7 @@ LocalizerConfig readConfig(const ParamSource& p) {
   p.get("kld_bin_yaw", &f.kld.bin_yaw);
   p.get("update_min_d", &f.update_min_d);
   p.get("update_min_a", &f.update_min_a);
+  p.get("odom_jump_limit", &f.odom_jump_limit);
   p.get("resample_ess_fraction", &f.resample_ess_fraction);
   p.get("tempering_ess_fraction", &f.tempering_ess_fraction);
   int seed = 0;
@@ -131,6 +132,7 @@ LocalizerConfig readConfig(const ParamSource& p) {
   p.get("cluster_yaw", &f.clusters.cell_yaw);
   p.get("recovery_alpha_slow", &f.recovery.alpha_slow);
   p.get("recovery_alpha_fast", &f.recovery.alpha_fast);
+  p.get("recovery_trigger_ratio", &f.recovery.trigger_ratio);
 
   std::string odom_model = "diff";
   p.get("odom_model_type", &odom_model);

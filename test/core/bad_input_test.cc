@@ -168,7 +168,7 @@ TEST_F(BadScan, UnusableScansSayWhyAndTheNextGoodScanWorks) {
 TEST(BadScanBeams, SelectBeamsDropsEveryInvalidRange) {
   LaserScan scan = scanAt(kStart);
   scan.ranges = {kNaNf, kInff, -kInff, 0.0f, -1.0f, 0.01f /* < range_min */, 8.0f /* = max */,
-                 1.0f, 2.0f};
+                 1.0f,  2.0f};
   std::size_t valid = 0;
   const std::vector<Beam> beams = selectBeams(scan, 0, 0.0, 0.0, &valid);
   ASSERT_EQ(valid, 2u);
@@ -266,8 +266,14 @@ TEST(BadMap, GridConstructorNamesTheProblem) {
       {[&] { OccupancyGrid(3, 2, -0.05, {}, six); }, "resolution"},
       {[&] { OccupancyGrid(3, 2, kNaN, {}, six); }, "resolution"},
       {[&] { OccupancyGrid(3, 2, kInf, {}, six); }, "resolution"},
-      {[&] { OccupancyGrid(3, 2, 0.05, {kNaN, 0.0, 0.0}, six); }, "origin"},
-      {[&] { OccupancyGrid(3, 2, 0.05, {0.0, 0.0, kInf}, six); }, "origin"},
+      {[&] {
+         OccupancyGrid(3, 2, 0.05, {kNaN, 0.0, 0.0}, six);
+       },
+       "origin"},
+      {[&] {
+         OccupancyGrid(3, 2, 0.05, {0.0, 0.0, kInf}, six);
+       },
+       "origin"},
       {[&] { OccupancyGrid(3, 2, 0.05, {}, std::vector<int8_t>(5, 0)); }, "5 cell values"},
   };
   for (const auto& c : cases) {
@@ -291,8 +297,14 @@ TEST(BadInitialPose, NonFinitePoseOrBadCovarianceThrowsAndKeepsTheFilter) {
   Eigen::Matrix3d nan = good;
   nan(2, 2) = kNaN;
   const std::vector<std::pair<std::function<void()>, std::string>> cases = {
-      {[&] { filter.initializeGaussian({kNaN, 0.0, 0.0}, good); }, "pose"},
-      {[&] { filter.initializeGaussian({0.0, 0.0, kInf}, good); }, "pose"},
+      {[&] {
+         filter.initializeGaussian({kNaN, 0.0, 0.0}, good);
+       },
+       "pose"},
+      {[&] {
+         filter.initializeGaussian({0.0, 0.0, kInf}, good);
+       },
+       "pose"},
       {[&] { filter.initializeGaussian(kStart, asym); }, "symmetric"},
       {[&] { filter.initializeGaussian(kStart, negative); }, "positive semi-definite"},
       {[&] { filter.initializeGaussian(kStart, nan); }, "finite"},

@@ -35,13 +35,13 @@ bool verbose() {
   static const bool v = std::getenv("PF_FUZZ_VERBOSE") != nullptr;
   return v;
 }
-#define PF_FUZZ_LOG(...)                     \
-  do {                                       \
-    if (verbose()) {                         \
-      std::fprintf(stderr, "fuzz_core: ");   \
-      std::fprintf(stderr, __VA_ARGS__);     \
-      std::fprintf(stderr, "\n");            \
-    }                                        \
+#define PF_FUZZ_LOG(...)                   \
+  do {                                     \
+    if (verbose()) {                       \
+      std::fprintf(stderr, "fuzz_core: "); \
+      std::fprintf(stderr, __VA_ARGS__);   \
+      std::fprintf(stderr, "\n");          \
+    }                                      \
   } while (0)
 
 void logParams(const pf::ParticleFilterParams& p) {
@@ -49,14 +49,13 @@ void logParams(const pf::ParticleFilterParams& p) {
       "params: %s particles %d..%d kld_err %g conf %g bins %g %g update_min %g %g ess %g "
       "seed %llu alphas %g %g %g %g %g z_hit %g z_rand %g sigma %g max_dist %g beams %d "
       "range %g..%g clusters %g %g recovery %g %g",
-      p.motion.kind == pf::OdometryMotionParams::Kind::kOmni ? "omni" : "diff",
-      p.kld.min_particles, p.kld.max_particles, p.kld.kld_err, p.kld.confidence, p.kld.bin_xy,
-      p.kld.bin_yaw, p.update_min_d, p.update_min_a, p.resample_ess_fraction,
-      static_cast<unsigned long long>(p.seed), p.motion.alpha1, p.motion.alpha2,
-      p.motion.alpha3, p.motion.alpha4, p.motion.alpha5, p.sensor.z_hit, p.sensor.z_rand,
-      p.sensor.sigma_hit, p.sensor.max_distance, p.sensor.max_beams, p.sensor.range_min,
-      p.sensor.range_max, p.clusters.cell_xy, p.clusters.cell_yaw, p.recovery.alpha_slow,
-      p.recovery.alpha_fast);
+      p.motion.kind == pf::OdometryMotionParams::Kind::kOmni ? "omni" : "diff", p.kld.min_particles,
+      p.kld.max_particles, p.kld.kld_err, p.kld.confidence, p.kld.bin_xy, p.kld.bin_yaw,
+      p.update_min_d, p.update_min_a, p.resample_ess_fraction,
+      static_cast<unsigned long long>(p.seed), p.motion.alpha1, p.motion.alpha2, p.motion.alpha3,
+      p.motion.alpha4, p.motion.alpha5, p.sensor.z_hit, p.sensor.z_rand, p.sensor.sigma_hit,
+      p.sensor.max_distance, p.sensor.max_beams, p.sensor.range_min, p.sensor.range_max,
+      p.clusters.cell_xy, p.clusters.cell_yaw, p.recovery.alpha_slow, p.recovery.alpha_fast);
 }
 
 void logScan(const pf::LaserScan& s) {
@@ -203,7 +202,8 @@ void spoilScan(Input& in, pf::LaserScan* scan) {
       scan->sensor_pose.yaw = v;
       break;
     case 6:
-      if (!scan->ranges.empty()) scan->ranges[in.u8() % scan->ranges.size()] = static_cast<float>(v);
+      if (!scan->ranges.empty())
+        scan->ranges[in.u8() % scan->ranges.size()] = static_cast<float>(v);
       break;
     default:
       scan->ranges.clear();
@@ -217,8 +217,9 @@ void checkBeams(const pf::LaserScan& scan, const pf::ParticleFilterParams& p) {
       pf::selectBeams(scan, p.sensor.max_beams, p.sensor.range_min, p.sensor.range_max, &valid);
   PF_FUZZ_CHECK(valid <= scan.ranges.size(), "%zu valid of %zu", valid, scan.ranges.size());
   PF_FUZZ_CHECK(beams.size() <= valid, "%zu beams from %zu valid", beams.size(), valid);
-  PF_FUZZ_CHECK(p.sensor.max_beams <= 0 || beams.size() <= static_cast<std::size_t>(p.sensor.max_beams),
-                "%zu beams for max_beams %d", beams.size(), p.sensor.max_beams);
+  PF_FUZZ_CHECK(
+      p.sensor.max_beams <= 0 || beams.size() <= static_cast<std::size_t>(p.sensor.max_beams),
+      "%zu beams for max_beams %d", beams.size(), p.sensor.max_beams);
   for (const pf::Beam& b : beams) {
     PF_FUZZ_CHECK(std::isfinite(b.range) && b.range > 0.0f, "beam range %g", b.range);
   }
@@ -230,9 +231,9 @@ void checkBeams(const pf::LaserScan& scan, const pf::ParticleFilterParams& p) {
 void checkFilter(const pf::ParticleFilter& filter, const pf::UpdateReport& report) {
   const pf::ParticleFilterParams& p = filter.params();
   const pf::ParticleSet& s = filter.particles();
-  PF_FUZZ_CHECK(s.x.size() == s.y.size() && s.x.size() == s.yaw.size() &&
-                    s.x.size() == s.weight.size(),
-                "particle arrays of different sizes");
+  PF_FUZZ_CHECK(
+      s.x.size() == s.y.size() && s.x.size() == s.yaw.size() && s.x.size() == s.weight.size(),
+      "particle arrays of different sizes");
   PF_FUZZ_CHECK(report.updated || !report.skip_reason.empty(), "skipped without a reason");
   if (!filter.isInitialized()) return;
   PF_FUZZ_CHECK(s.size() >= static_cast<std::size_t>(p.kld.min_particles) &&
@@ -306,16 +307,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
       cov(0, 2) = cov(2, 0) = in.num(-0.05, 0.05);
       cov(1, 2) = cov(2, 1) = in.num(-0.05, 0.05);
       if (init & 0x80) cov(2, 0) += in.num(-1.0, 1.0);  // not symmetric
-      PF_FUZZ_LOG("initializeGaussian at (%g, %g, %g), cov diag %g %g %g", mean.x, mean.y,
-                  mean.yaw, cov(0, 0), cov(1, 1), cov(2, 2));
+      PF_FUZZ_LOG("initializeGaussian at (%g, %g, %g), cov diag %g %g %g", mean.x, mean.y, mean.yaw,
+                  cov(0, 0), cov(1, 1), cov(2, 2));
       try {
         filter->initializeGaussian(mean, cov);
-        PF_FUZZ_CHECK(filter->particles().size() ==
-                          static_cast<std::size_t>(params.kld.max_particles),
-                      "%zu particles after initializeGaussian", filter->particles().size());
+        PF_FUZZ_CHECK(
+            filter->particles().size() == static_cast<std::size_t>(params.kld.max_particles),
+            "%zu particles after initializeGaussian", filter->particles().size());
       } catch (const std::invalid_argument& e) {
-        PF_FUZZ_CHECK(std::strstr(e.what(), "initial") != nullptr, "unclear message: %s",
-                      e.what());
+        PF_FUZZ_CHECK(std::strstr(e.what(), "initial") != nullptr, "unclear message: %s", e.what());
       }
       break;
     }

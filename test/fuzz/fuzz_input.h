@@ -112,13 +112,12 @@ class Input {
 }  // namespace pf_fuzz
 
 // An invariant of the core that does not hold: a finding, reported as a crash.
-#define PF_FUZZ_CHECK(cond, ...)                                           \
-  do {                                                                     \
-    if (!(cond)) {                                                         \
-      std::fprintf(stderr, "%s:%d: check failed: %s: ", __FILE__, __LINE__, \
-                   #cond);                                                 \
-      std::fprintf(stderr, __VA_ARGS__);                                   \
-      std::fprintf(stderr, "\n");                                          \
-      std::abort();                                                        \
-    }                                                                      \
+#define PF_FUZZ_CHECK(cond, ...)                                                    \
+  do {                                                                              \
+    if (!(cond)) {                                                                  \
+      std::fprintf(stderr, "%s:%d: check failed: %s: ", __FILE__, __LINE__, #cond); \
+      std::fprintf(stderr, __VA_ARGS__);                                            \
+      std::fprintf(stderr, "\n");                                                   \
+      std::abort();                                                                 \
+    }                                                                               \
   } while (0)

@@ -86,7 +86,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
     meta.resolution = 0.05;
     meta.origin = {-1.0, 2.0, 0.5};
     meta.negate = mode & 4;
-    meta.mode = (mode & 3) == 1 ? pf::MapMode::kScale
+    meta.mode = (mode & 3) == 1   ? pf::MapMode::kScale
                 : (mode & 3) == 2 ? pf::MapMode::kRaw
                                   : pf::MapMode::kTrinary;
     if (mode & 8) {
@@ -96,9 +96,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
     writeFile(image, in.rest());
     static const char* const kModes[] = {"trinary", "scale", "raw"};
     writeFile(yaml, "image: map.pgm\nresolution: 0.05\norigin: [-1.0, 2.0, 0.5]\nnegate: " +
-                        std::to_string(meta.negate ? 1 : 0) + "\noccupied_thresh: " +
-                        std::to_string(meta.occupied_thresh) + "\nfree_thresh: " +
-                        std::to_string(meta.free_thresh) + "\nmode: " +
+                        std::to_string(meta.negate ? 1 : 0) +
+                        "\noccupied_thresh: " + std::to_string(meta.occupied_thresh) +
+                        "\nfree_thresh: " + std::to_string(meta.free_thresh) + "\nmode: " +
                         kModes[meta.mode == pf::MapMode::kScale ? 1
                                : meta.mode == pf::MapMode::kRaw ? 2
                                                                 : 0] +

@@ -41,17 +41,17 @@ def pose(x, y, yaw, xy, a):
 
 
 def params(flags=0, min_p=50, max_p=150, max_beams=32, recovery=None, omni=False,
-           sigma_hit=0.2, z_rand=0.05):
+           sigma_hit=0.2, z_rand=0.05, kld_bin_xy=None, cluster_xy=None, ess=0.5):
     b = u8(flags | (1 if omni else 0) | (16 if recovery else 0))
     b += u8(min_p - 1)                      # min_particles = raw % 100 + 1
     b += u8(max_p - min_p)                  # max_particles = min + raw % 101
     b += num(0.05, 0.001, 0.5)              # kld_err
     b += num(0.99, 0.0, 1.0)                # kld_confidence
-    b += num(0.5, 0.01, 2.0)                # kld_bin_xy
+    b += kld_bin_xy or num(0.5, 0.01, 2.0)  # kld_bin_xy
     b += num(0.17, 0.01, 1.0)               # kld_bin_yaw
     b += num(0.1, 0.0, 0.5)                 # update_min_d
     b += num(0.3, 0.0, 1.0)                 # update_min_a
-    b += num(0.5, 0.0, 1.0)                 # resample_ess_fraction
+    b += num(ess, 0.0, 1.0)                 # resample_ess_fraction
     b += u8(7)                              # seed
     for _ in range(5):
         b += num(0.1, 0.0, 0.5)             # alpha1..5
@@ -60,7 +60,7 @@ def params(flags=0, min_p=50, max_p=150, max_beams=32, recovery=None, omni=False
     b += num(sigma_hit, 0.01, 1.0)          # sigma_hit
     b += num(2.0, 0.05, 3.0)                # max_distance
     b += u8(max_beams + 2)                  # max_beams
-    b += num(0.5, 0.05, 2.0)                # cluster_xy
+    b += cluster_xy or num(0.5, 0.05, 2.0)  # cluster_xy
     b += num(0.5, 0.05, 1.5)                # cluster_yaw
     if recovery:
         b += num(recovery[0], 0.0, 0.1) + num(recovery[1], 0.0, 1.0)
@@ -188,6 +188,47 @@ def map_seeds():
     return seeds
 
 
+def tracking_start(prm):
+    """params + the walled room + a Gaussian start at (1.5, 1.0, 0) + a good scan."""
+    b = prm + room_map(1)
+    b += u8(0) + pose(1.5, 1.0, 0.0, 25.0, 4.0) + cov()
+    b += pose(0.0, 0.0, 0.0, 5.0, 4.0)
+    b += scan(ray_ranges(1.5, 1.0, 0.0, 72))
+    return b
+
+
+def crash_inputs():
+    """Hand-made reproducers of the bugs the fuzzer found (test/fuzz/crashes/README.md)."""
+    seeds = {}
+    # A tiny cluster bin (1e-300 m passes validate()): floor(x / 1e-300) does not fit int64.
+    seeds["fuzz_core-cluster_bin_overflow"] = tracking_start(params(cluster_xy=raw(1e-300)))
+    # The same in KLD-sampling's histogram, on the first resample (ess fraction 1).
+    seeds["fuzz_core-kld_bin_overflow"] = (tracking_start(params(kld_bin_xy=raw(1e-300), ess=1.0))
+                                           + u8(1) + u8(9) + pose(0, 0, 0, 0.05, 0.1))
+    # A finite but absurd odometry jump (1e300 m): the motion noise overflows to inf,
+    # particles become inf/NaN, and the likelihood table is indexed with (int)NaN.
+    seeds["fuzz_core-odometry_jump"] = (tracking_start(params())
+                                        + u8(2) + u8(9) + pose(0, 0, 0, 0.05, 0.1)
+                                        + u8(3) + special(HUGE) + special(HUGE)
+                                        + num(0.0, -10, 10))
+    # A valid scan whose range_max (1e39) and one range (3e38 m) are finite but so
+    # large that the end point in cells overflows float: inf - inf = NaN -> (int)NaN.
+    b = tracking_start(params()) + u8(1) + u8(4)
+    b += (u8(2) + num(0.7, -4, 4) + num(0.1, -0.2, 0.2) + num(0.05, 0, 1) + raw(1e39)
+          + pose(0, 0, 0, 0.5, 4.0) + raw(3e38) + num(1.0, 0, 12))
+    seeds["fuzz_core-scan_endpoint_overflow"] = b
+    return seeds
+
+
+def write_crashes():
+    folder = os.path.join(HERE, "crashes")
+    os.makedirs(folder, exist_ok=True)
+    for name, data in crash_inputs().items():
+        with open(os.path.join(folder, name), "wb") as f:
+            f.write(data)
+    print(f"{folder}: {len(crash_inputs())} reproducers")
+
+
 def write(target, seeds):
     folder = os.path.join(HERE, "corpus", target)
     os.makedirs(folder, exist_ok=True)
@@ -200,3 +241,4 @@ def write(target, seeds):
 if __name__ == "__main__":
     write("fuzz_core", core_seeds())
     write("fuzz_map_loader", map_seeds())
+    write_crashes()

@@ -55,7 +55,8 @@ class OccupancyGrid {
   CellState state(const CellIndex& c) const;
   static CellState classify(int8_t value);
 
-  /// Cell containing a world point (may lie outside the map: check contains()).
+  /// Cell containing a world point. A point off the map gives -1 or width
+  /// (height) in the coordinate that is off: check contains().
   CellIndex worldToCell(double wx, double wy) const;
   /// World coordinates of a cell's centre.
   void cellToWorld(const CellIndex& c, double* wx, double* wy) const;

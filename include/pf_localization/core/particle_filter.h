@@ -34,15 +34,24 @@
 
 namespace pf {
 
+// Augmented MCL: w_slow and w_fast are long- and short-term averages of how
+// well the cloud explains the scans (the posterior-weighted per-beam
+// likelihood). When w_fast falls below trigger_ratio * w_slow, a share
+// 1 - w_fast / (trigger_ratio * w_slow) of max_particles is drawn from free
+// space at the next resampling. Unlike amcl, the averages are not reset after
+// an injection: the memory of what a good fit looks like is what keeps the
+// search going until the robot is found again.
 struct RecoveryParams {
-  double alpha_slow = 0.0;  // long-term likelihood average rate (0 disables recovery)
-  double alpha_fast = 0.0;  // short-term likelihood average rate
+  double alpha_slow = 0.01;    // long-term average rate, per update (0 disables recovery)
+  double alpha_fast = 0.2;     // short-term average rate, per update
+  double trigger_ratio = 0.7;  // (0, 1]: 1 injects on any dip, as amcl does
 };
 
 struct ParticleFilterParams {
   KldParams kld;                       // particle count bounds and KLD-sampling
   double update_min_d = 0.2;           // m of travel between updates
   double update_min_a = M_PI / 6.0;    // rad of rotation between updates
+  double odom_jump_limit = 5.0;        // m; a longer odometry step between updates is a fault
   double resample_ess_fraction = 0.5;  // resample when ESS < this * N (0..1]
   // When one scan would leave fewer than this fraction of N effective
   // particles, its likelihood is tempered (raised to the largest power below 1
@@ -133,6 +142,7 @@ class ParticleFilter {
   double w_fast_ = 0.0;
   std::vector<double> scratch_;
   std::vector<double> log_prior_;
+  std::vector<double> log_likelihood_;
 };
 
 }  // namespace pf

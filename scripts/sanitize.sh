@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# Builds the GoogleTest unit tests with AddressSanitizer + UndefinedBehaviorSanitizer
+# (CMake option PF_SANITIZE) in their own catkin workspace and runs them.
+#
+#   bash scripts/sanitize.sh            # workspace .ws_asan, or $PF_ASAN_WS
+#
+# Prints each binary's gtest summary and exits non-zero when a test fails or a
+# sanitizer reports anything (memory error, leak, undefined behaviour).
+set -uo pipefail
+repo=$(cd "$(dirname "$0")/.." && pwd)
+ws=${PF_ASAN_WS:-$repo/.ws_asan}
+tests=(pf_core_test pf_sim_test pf_ros_test)
+start=$(date +%s)
+
+echo "sanitize: building ${tests[*]} with PF_SANITIZE=ON in $ws"
+if ! PF_WS=$ws PF_CMAKE_ARGS="-DPF_SANITIZE=ON" bash "$repo/scripts/build.sh" "${tests[@]}" \
+  >"$ws.build.log" 2>&1; then
+  tail -40 "$ws.build.log"
+  echo "sanitize: build failed (log: $ws.build.log)" >&2
+  exit 2
+fi
+echo "sanitize: built in $(($(date +%s) - start)) s"
+
+# halt_on_error makes UBSan fatal; detect_leaks is LeakSanitizer (part of ASan).
+export ASAN_OPTIONS=detect_leaks=1:halt_on_error=1:${ASAN_OPTIONS:-}
+export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1:${UBSAN_OPTIONS:-}
+export PATH=/usr/bin:$PATH
+failed=0
+for t in "${tests[@]}"; do
+  log=$ws/$t.sanitize.log
+  t0=$(date +%s)
+  "$ws/devel/lib/pf_localization/$t" >"$log" 2>&1
+  rc=$?
+  summary=$(grep -E '^\[  (PASSED|FAILED)  \] [0-9]+ test' "$log" | tr '\n' ' ')
+  reports=$(grep -cE 'runtime error:|ERROR: (Address|Leak|Undefined)Sanitizer|SUMMARY: (Address|Leak|Undefined)' "$log")
+  echo "sanitize: $t: exit $rc, ${summary:-no gtest summary}, $reports sanitizer report line(s), $(($(date +%s) - t0)) s"
+  if [ "$rc" -ne 0 ] || [ "$reports" -ne 0 ]; then
+    failed=1
+    grep -E '^\[  FAILED  \] [A-Za-z]' "$log" | sort -u | sed 's/^/    /'
+    grep -m1 -A25 -E 'runtime error:|ERROR: (Address|Leak|Undefined)Sanitizer' "$log" | sed 's/^/    /'
+    echo "    log: $log"
+  fi
+done
+echo "sanitize: $([ $failed -eq 0 ] && echo OK || echo FAILED) in $(($(date +%s) - start)) s"
+exit $failed
