@@ -1,13 +1,14 @@
 #include "pf_localization/core/distance_transform.h"
 
+#include <algorithm>
 #include <limits>
+#include <stdexcept>
 
 namespace pf {
 namespace {
 
-// Stands in for "no source" inside the passes: large enough never to win,
-// small enough that squared offsets added to it stay exact and no inf - inf
-// turns into NaN.
+// Stands in for "no source" inside the passes: large enough never to win
+// against a real source, and finite so that no inf - inf turns into NaN.
 constexpr double kFar = 1e20;
 
 // One pass of Felzenszwalb-Huttenlocher over n samples of f (with a stride):
@@ -47,6 +48,11 @@ void transform1d(const double* f, int n, int stride, double* d, std::vector<int>
 std::vector<float> squaredDistanceTransform(const std::vector<bool>& is_source, int width,
                                             int height) {
   const std::size_t n = static_cast<std::size_t>(width) * height;
+  if (is_source.size() != n) {
+    throw std::invalid_argument("squaredDistanceTransform: " + std::to_string(is_source.size()) +
+                                " flags for a " + std::to_string(width) + " x " +
+                                std::to_string(height) + " grid");
+  }
   std::vector<double> f(n), g(n);
   for (std::size_t i = 0; i < n; ++i) f[i] = is_source[i] ? 0.0 : kFar;
 

@@ -82,6 +82,17 @@ void LikelihoodFieldModel::buildTable(double range_max) const {
   table_range_max_ = range_max;
 }
 
+double LikelihoodFieldModel::hitFraction(const PreparedScan& scan, const Pose2& pose,
+                                         double distance) const {
+  if (scan.size() == 0) return 0.0;
+  std::size_t hits = 0;
+  for (std::size_t b = 0; b < scan.size(); ++b) {
+    const Pose2 end = compose(pose, {scan.x[b], scan.y[b], 0.0});
+    hits += field_.distanceAt(end.x, end.y) <= distance ? 1 : 0;
+  }
+  return static_cast<double>(hits) / static_cast<double>(scan.size());
+}
+
 double LikelihoodFieldModel::logLikelihood(const PreparedScan& scan, const Pose2& pose) const {
   ParticleSet one;
   one.resize(1);

@@ -56,6 +56,8 @@ void validate(const ParticleFilterParams& p) {
           "in (0, 1]", p.resample_ess_fraction);
   require(p.tempering_ess_fraction >= 0.0 && p.tempering_ess_fraction <= 1.0,
           "tempering_ess_fraction", "in [0, 1]", p.tempering_ess_fraction);
+  require(p.tempering_ess_fraction_uncertain >= 0.0 && p.tempering_ess_fraction_uncertain <= 1.0,
+          "tempering_ess_fraction_uncertain", "in [0, 1]", p.tempering_ess_fraction_uncertain);
   require(p.clusters.cell_xy > 0.0 && finite(p.clusters.cell_xy), "cluster_xy", "> 0",
           p.clusters.cell_xy);
   require(p.clusters.cell_yaw > 0.0 && finite(p.clusters.cell_yaw), "cluster_yaw", "> 0",
@@ -69,6 +71,7 @@ void validate(const ParticleFilterParams& p) {
   require(p.recovery.alpha_slow == 0.0 || p.recovery.alpha_fast > p.recovery.alpha_slow,
           "recovery_alpha_fast", "> recovery_alpha_slow when recovery is on",
           p.recovery.alpha_fast);
+  validate(p.confidence);
   const auto& s = p.sensor;
   require(s.z_hit >= 0.0 && finite(s.z_hit), "laser_z_hit", ">= 0", s.z_hit);
   require(s.z_rand >= 0.0 && finite(s.z_rand), "laser_z_rand", ">= 0", s.z_rand);
@@ -144,6 +147,10 @@ void ParticleFilter::restartAfterInitialization() {
   // last update must not move them again, so the next update skips motion.
   restart_ = true;
   has_estimate_ = false;
+  confidence_ = Confidence();
+  confidence_.state = LocalizationState::kUncertain;
+  confidence_.reason = "no scan since the initialisation";
+  confidence_.covariance = estimate_.covariance;
   w_slow_ = w_fast_ = 0.0;
 }
 
@@ -224,6 +231,10 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
   // The estimate comes from the weighted cloud, before resampling: resampling
   // only adds noise, and the random particles recovery injects must not count.
   estimate_ = estimatePose(particles_, params_.clusters);
+  confidence_ = assessConfidence(
+      particles_, estimate_,
+      model_->hitFraction(prepared, estimate_.pose, params_.confidence.hit_distance),
+      params_.confidence);
   resample(&report);
   has_estimate_ = true;
   report.updated = true;
@@ -239,7 +250,13 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
   }
   const std::vector<double>& ll = log_likelihood_;
   double beta = 1.0;
-  const double min_ess = params_.tempering_ess_fraction * static_cast<double>(particles_.size());
+  // A filter that is not sure of itself weighs evidence more cautiously:
+  // rival hypotheses (twin rooms) then survive until the scans really
+  // separate them, instead of the luckiest one winning outright.
+  const double fraction = confidence_.state == LocalizationState::kLocalized
+                              ? params_.tempering_ess_fraction
+                              : params_.tempering_ess_fraction_uncertain;
+  const double min_ess = fraction * static_cast<double>(particles_.size());
   if (min_ess > 0.0 && effectiveSampleSize(log_prior_, ll, 1.0) < min_ess) {
     // Bisection for the largest exponent that keeps min_ess particles.
     double lo = 0.0, hi = 1.0;

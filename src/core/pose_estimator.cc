@@ -42,7 +42,7 @@ Cluster summarize(const ParticleSet& particles, const std::vector<std::size_t>& 
     sc += w * std::cos(particles.yaw[i]);
   }
   if (!(c.weight > 0.0)) return c;
-  c.mean = {sx / c.weight, sy / c.weight, std::atan2(ss, sc)};
+  c.mean = {sx / c.weight, sy / c.weight, normalizeAngle(std::atan2(ss, sc))};
   for (std::size_t i : indices) {
     const Eigen::Vector3d d(particles.x[i] - c.mean.x, particles.y[i] - c.mean.y,
                             angleDiff(particles.yaw[i], c.mean.yaw));

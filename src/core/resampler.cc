@@ -27,16 +27,18 @@ void systematicResample(ParticleSet* particles, std::size_t n, Random* random) {
   double total = 0.0;
   for (double w : in.weight) total += w;
   const double step = total / static_cast<double>(n);
-  double pointer = random->uniform() * step;
+  const double offset = random->uniform();
   double cumulative = in.weight[0];
   std::size_t j = 0;
   for (std::size_t i = 0; i < n; ++i) {
+    // (offset + i) * step rather than a running sum, so that the pointers
+    // cannot drift over a million particles.
+    const double pointer = (offset + static_cast<double>(i)) * step;
     // The last particle absorbs rounding in the cumulative sum.
-    while (pointer > cumulative && j + 1 < in.size()) cumulative += in.weight[++j];
+    while (pointer >= cumulative && j + 1 < in.size()) cumulative += in.weight[++j];
     out.x[i] = in.x[j];
     out.y[i] = in.y[j];
     out.yaw[i] = in.yaw[j];
-    pointer += step;
   }
   out.setUniformWeights();
   *particles = std::move(out);

@@ -215,7 +215,7 @@ int main(int argc, char** argv) {
     log.open(opt.log);
     if (!log) fail(opt.log + ": cannot write");
     log << "t,particles,ess,cpu_ms,mean_beam_likelihood,std_x,std_y,std_yaw,updated,injected,"
-           "tempering\n";
+           "tempering,hit_fraction,rivals,state\n";
   }
   if (!opt.particles_out.empty()) {
     dump.open(opt.particles_out);
@@ -248,12 +248,14 @@ int main(int argc, char** argv) {
       ++updates;
       if (log) {
         const auto& est = localizer.filter().estimate();
+        const pf::Confidence& conf = localizer.filter().confidence();
         log << std::fixed << std::setprecision(6) << t << "," << r.report.particles << ","
             << std::setprecision(1) << r.report.ess << "," << std::setprecision(3) << cpu * 1e3
             << "," << std::setprecision(6) << r.report.mean_beam_likelihood << ","
             << std::sqrt(est.covariance(0, 0)) << "," << std::sqrt(est.covariance(1, 1)) << ","
             << std::sqrt(est.covariance(2, 2)) << ",1," << r.report.injected << ","
-            << r.report.tempering << "\n";
+            << r.report.tempering << "," << conf.hit_fraction << "," << conf.rivals << ","
+            << pf::toString(conf.state) << "\n";
       }
       if (dump && t - first_stamp <= kParticleDumpSeconds) {
         const pf::ParticleSet& p = localizer.filter().particles();

@@ -123,6 +123,13 @@ LocalizerConfig readConfig(const ParamSource& p) {
   p.get("odom_jump_limit", &f.odom_jump_limit);
   p.get("resample_ess_fraction", &f.resample_ess_fraction);
   p.get("tempering_ess_fraction", &f.tempering_ess_fraction);
+  p.get("tempering_ess_fraction_uncertain", &f.tempering_ess_fraction_uncertain);
+  p.get("confidence_hit_distance", &f.confidence.hit_distance);
+  p.get("confidence_lost_hit_fraction", &f.confidence.lost_hit_fraction);
+  p.get("confidence_localized_hit_fraction", &f.confidence.localized_hit_fraction);
+  p.get("confidence_localized_std_xy", &f.confidence.localized_std_xy);
+  p.get("confidence_localized_std_yaw", &f.confidence.localized_std_yaw);
+  p.get("confidence_rival_weight_ratio", &f.confidence.rival_weight_ratio);
   int seed = 0;
   if (p.get("seed", &seed)) {
     require(seed >= 0, "seed", ">= 0");

@@ -65,6 +65,10 @@ class LikelihoodFieldModel {
   void logLikelihoods(const PreparedScan& scan, const ParticleSet& particles,
                       std::vector<double>* log_likelihood) const;
 
+  /// The fraction of the scan's beams whose end point, placed from `pose`,
+  /// lies within `distance` metres of an obstacle (0 for an empty scan).
+  double hitFraction(const PreparedScan& scan, const Pose2& pose, double distance) const;
+
   /// log p of one beam whose end point is `distance` metres from an obstacle.
   double beamLogLikelihood(double distance, double range_max) const;
 

@@ -13,7 +13,10 @@
 // translations the direction of travel is meaningless, so rot1 is taken as 0.
 //
 // Omnidirectional: the step is a translation in the robot frame (forward and
-// strafe) plus a rotation; alpha5 scales the strafe noise.
+// strafe) plus a rotation, with amcl's omni convention for the alphas:
+//   trans:  sqrt(alpha3 * trans^2 + alpha1 * rot^2)
+//   rot:    sqrt(alpha4 * rot^2 + alpha2 * trans^2)
+//   strafe: sqrt(alpha1 * rot^2 + alpha5 * trans^2)
 #pragma once
 
 #include "pf_localization/core/particle_set.h"

@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "pf_localization/core/confidence.h"
 #include "pf_localization/core/laser_scan.h"
 #include "pf_localization/core/likelihood_field_model.h"
 #include "pf_localization/core/occupancy_grid.h"
@@ -59,11 +60,14 @@ struct ParticleFilterParams {
   // global initialisation, then narrows it over several scans instead of
   // collapsing it onto one lucky particle. 0 disables. [0, 1]
   double tempering_ess_fraction = 0.02;
+  // The same while the filter is not localized (see Confidence). [0, 1]
+  double tempering_ess_fraction_uncertain = 0.1;
   uint64_t seed = 0;
   OdometryMotionParams motion;
   LikelihoodFieldModelParams sensor;
   ClusterParams clusters;
   RecoveryParams recovery;
+  ConfidenceParams confidence;
 };
 
 /// Throws std::invalid_argument naming the first parameter out of range and its valid range.
@@ -117,6 +121,8 @@ class ParticleFilter {
 
   const ParticleSet& particles() const { return particles_; }
   const PoseEstimate& estimate() const { return estimate_; }
+  /// How far to trust the estimate, as of the last update.
+  const Confidence& confidence() const { return confidence_; }
 
   /// map -> odom: the estimate composed with the inverse of the odometry pose
   /// it was computed at. Empty until the first update after an initialisation.
@@ -134,6 +140,7 @@ class ParticleFilter {
   std::unique_ptr<LikelihoodFieldModel> model_;
   ParticleSet particles_;
   PoseEstimate estimate_;
+  Confidence confidence_;
   std::optional<Pose2> odom_at_update_;
   bool force_update_ = false;
   bool restart_ = false;  // the next update follows an initialisation

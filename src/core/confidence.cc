@@ -1,0 +1,92 @@
+#include "pf_localization/core/confidence.h"
+
+#include <cmath>
+#include <numeric>
+#include <sstream>
+#include <stdexcept>
+
+namespace pf {
+namespace {
+
+void require(bool ok, const std::string& name, const std::string& range, double value) {
+  if (!ok) {
+    std::ostringstream text;
+    text << "invalid parameter " << name << " = " << value << ": must be " << range;
+    throw std::invalid_argument(text.str());
+  }
+}
+
+}  // namespace
+
+const char* toString(LocalizationState state) {
+  switch (state) {
+    case LocalizationState::kLocalized:
+      return "localized";
+    case LocalizationState::kUncertain:
+      return "uncertain";
+    default:
+      return "lost";
+  }
+}
+
+void validate(const ConfidenceParams& p) {
+  require(p.hit_distance > 0.0 && std::isfinite(p.hit_distance), "confidence_hit_distance", "> 0",
+          p.hit_distance);
+  require(p.lost_hit_fraction >= 0.0 && p.lost_hit_fraction <= 1.0, "confidence_lost_hit_fraction",
+          "in [0, 1]", p.lost_hit_fraction);
+  require(p.localized_hit_fraction >= p.lost_hit_fraction && p.localized_hit_fraction <= 1.0,
+          "confidence_localized_hit_fraction", "in [confidence_lost_hit_fraction, 1]",
+          p.localized_hit_fraction);
+  require(p.localized_std_xy > 0.0, "confidence_localized_std_xy", "> 0", p.localized_std_xy);
+  require(p.localized_std_yaw > 0.0, "confidence_localized_std_yaw", "> 0", p.localized_std_yaw);
+  require(p.rival_weight_ratio > 0.0 && p.rival_weight_ratio <= 1.0,
+          "confidence_rival_weight_ratio", "in (0, 1]", p.rival_weight_ratio);
+}
+
+Confidence assessConfidence(const ParticleSet& particles, const PoseEstimate& estimate,
+                            double hit_fraction, const ConfidenceParams& params) {
+  Confidence c;
+  c.hit_fraction = hit_fraction;
+  if (estimate.clusters.empty()) {
+    c.reason = "no particles";
+    return c;
+  }
+  const Cluster& first = estimate.clusters.front();
+  c.std_x = std::sqrt(first.covariance(0, 0));
+  c.std_y = std::sqrt(first.covariance(1, 1));
+  c.std_yaw = std::sqrt(first.covariance(2, 2));
+  for (std::size_t k = 1; k < estimate.clusters.size(); ++k) {
+    c.rivals += estimate.clusters[k].weight >= params.rival_weight_ratio * first.weight ? 1 : 0;
+  }
+  c.covariance = first.covariance;
+  if (c.rivals > 0) {
+    std::vector<std::size_t> all(particles.size());
+    std::iota(all.begin(), all.end(), 0);
+    c.covariance = summarize(particles, all).covariance;
+  }
+
+  std::ostringstream why;
+  why.precision(2);
+  if (hit_fraction < params.lost_hit_fraction) {
+    c.state = LocalizationState::kLost;
+    why << "only " << 100.0 * hit_fraction << " % of the beams fit the map at the estimate";
+  } else if (c.rivals > 0) {
+    c.state = LocalizationState::kUncertain;
+    why << c.rivals << " rival hypothes" << (c.rivals == 1 ? "is" : "es") << " elsewhere";
+  } else if (hit_fraction < params.localized_hit_fraction) {
+    c.state = LocalizationState::kUncertain;
+    why << "only " << 100.0 * hit_fraction << " % of the beams fit the map at the estimate";
+  } else if (std::max(c.std_x, c.std_y) > params.localized_std_xy ||
+             c.std_yaw > params.localized_std_yaw) {
+    c.state = LocalizationState::kUncertain;
+    why << "the particles are spread (std " << std::max(c.std_x, c.std_y) << " m, "
+        << c.std_yaw * 180.0 / M_PI << " deg)";
+  } else {
+    c.state = LocalizationState::kLocalized;
+    why << 100.0 * hit_fraction << " % of the beams fit, one hypothesis";
+  }
+  c.reason = why.str();
+  return c;
+}
+
+}  // namespace pf
