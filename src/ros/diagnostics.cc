@@ -1,0 +1,57 @@
+#include "pf_localization/ros/diagnostics.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace pf_ros {
+namespace {
+
+void add(diagnostic_msgs::DiagnosticStatus* status, const std::string& key, double value) {
+  std::ostringstream text;
+  text << value;
+  diagnostic_msgs::KeyValue kv;
+  kv.key = key;
+  kv.value = text.str();
+  status->values.push_back(kv);
+}
+
+}  // namespace
+
+diagnostic_msgs::DiagnosticStatus toDiagnosticStatus(const pf::ParticleFilter& filter,
+                                                     const pf::UpdateReport& report,
+                                                     const std::string& name) {
+  const pf::Confidence& c = filter.confidence();
+  diagnostic_msgs::DiagnosticStatus status;
+  status.name = name;
+  status.hardware_id = "none";
+  switch (c.state) {
+    case pf::LocalizationState::kLocalized:
+      status.level = diagnostic_msgs::DiagnosticStatus::OK;
+      break;
+    case pf::LocalizationState::kUncertain:
+      status.level = diagnostic_msgs::DiagnosticStatus::WARN;
+      break;
+    default:
+      status.level = diagnostic_msgs::DiagnosticStatus::ERROR;
+  }
+  status.message = std::string(pf::toString(c.state)) + ": " + c.reason;
+  diagnostic_msgs::KeyValue state;
+  state.key = "state";
+  state.value = pf::toString(c.state);
+  status.values.push_back(state);
+  add(&status, "particles", static_cast<double>(filter.particles().size()));
+  add(&status, "effective_sample_size", report.ess);
+  add(&status, "mean_beam_likelihood", report.mean_beam_likelihood);
+  add(&status, "hit_fraction", c.hit_fraction);
+  add(&status, "std_x_m", c.std_x);
+  add(&status, "std_y_m", c.std_y);
+  add(&status, "std_yaw_deg", c.std_yaw * 180.0 / M_PI);
+  add(&status, "clusters", static_cast<double>(filter.estimate().clusters.size()));
+  add(&status, "rival_clusters", c.rivals);
+  add(&status, "injected_particles", static_cast<double>(report.injected));
+  add(&status, "tempering", report.tempering);
+  add(&status, "beams_used", report.beams_used);
+  return status;
+}
+
+}  // namespace pf_ros

@@ -1,0 +1,48 @@
+#include "pf_localization/ros/diagnostics.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+
+namespace pf_ros {
+namespace {
+
+std::map<std::string, std::string> values(const diagnostic_msgs::DiagnosticStatus& s) {
+  std::map<std::string, std::string> out;
+  for (const auto& kv : s.values) out[kv.key] = kv.value;
+  return out;
+}
+
+pf::ParticleFilterParams smallFilter() {
+  pf::ParticleFilterParams p;
+  p.kld.min_particles = p.kld.max_particles = 100;
+  return p;
+}
+
+TEST(Diagnostics, FreshlyInitialisedFilterIsUncertainWithItsReason) {
+  pf::ParticleFilter filter(smallFilter());
+  filter.setMap(pf::OccupancyGrid(10, 10, 0.1, {}, std::vector<int8_t>(100, 0)));
+  filter.initializeGaussian({0.5, 0.5, 0.0}, Eigen::Vector3d(0.01, 0.01, 0.01).asDiagonal());
+  pf::UpdateReport report;
+  report.ess = 42.0;
+  const auto status = toDiagnosticStatus(filter, report, "pf_node: localization");
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::WARN);
+  EXPECT_EQ(status.name, "pf_node: localization");
+  EXPECT_EQ(status.message, "uncertain: no scan since the initialisation");
+  const auto v = values(status);
+  EXPECT_EQ(v.at("state"), "uncertain");
+  EXPECT_EQ(v.at("particles"), "100");
+  EXPECT_EQ(v.at("effective_sample_size"), "42");
+  EXPECT_EQ(v.count("hit_fraction"), 1u);
+  EXPECT_EQ(v.count("rival_clusters"), 1u);
+}
+
+TEST(Diagnostics, UninitialisedFilterIsLost) {
+  pf::ParticleFilter filter(smallFilter());
+  const auto status = toDiagnosticStatus(filter, pf::UpdateReport(), "x");
+  EXPECT_EQ(status.level, diagnostic_msgs::DiagnosticStatus::ERROR);
+  EXPECT_EQ(values(status).at("state"), "lost");
+}
+
+}  // namespace
+}  // namespace pf_ros
