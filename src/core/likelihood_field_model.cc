@@ -102,8 +102,9 @@ double LikelihoodFieldModel::logLikelihood(const PreparedScan& scan, const Pose2
   return out[0];
 }
 
-void LikelihoodFieldModel::logLikelihoods(const PreparedScan& scan, const ParticleSet& particles,
-                                          std::vector<double>* log_likelihood) const {
+__attribute__((target_clones("avx2", "default"))) void LikelihoodFieldModel::logLikelihoods(
+    const PreparedScan& scan, const ParticleSet& particles,
+    std::vector<double>* log_likelihood) const {
   buildTable(scan.range_max);
   const OccupancyGrid& grid = field_.grid();
   const float inv_res = static_cast<float>(1.0 / grid.resolution());
@@ -120,14 +121,18 @@ void LikelihoodFieldModel::logLikelihoods(const PreparedScan& scan, const Partic
     by[b] = scan.y[b] * inv_res;
   }
 
+  // The particles go into the grid's frame, in cells, shifted by the
+  // one-cell border; the origin's rotation is applied once, not per particle.
+  const Pose2& o = grid.origin();
+  const double oc = std::cos(o.yaw), os = std::sin(o.yaw);
   log_likelihood->resize(particles.size());
   for (std::size_t i = 0; i < particles.size(); ++i) {
-    // The particle in the grid's frame, in cells, shifted by the one-cell border.
-    const Pose2 local = between(grid.origin(), particles.pose(i));
-    const float px = static_cast<float>(local.x) * inv_res + 1.0f;
-    const float py = static_cast<float>(local.y) * inv_res + 1.0f;
-    const float c = static_cast<float>(std::cos(local.yaw));
-    const float s = static_cast<float>(std::sin(local.yaw));
+    const double dx = particles.x[i] - o.x, dy = particles.y[i] - o.y;
+    const float px = static_cast<float>((oc * dx + os * dy) * inv_res) + 1.0f;
+    const float py = static_cast<float>((-os * dx + oc * dy) * inv_res) + 1.0f;
+    const float yaw = static_cast<float>(particles.yaw[i] - o.yaw);
+    const float c = std::cos(yaw);
+    const float s = std::sin(yaw);
     float sum = 0.0f;
     for (std::size_t b = 0; b < n; ++b) {
       // Clamping before truncation sends every point outside the map to the

@@ -244,9 +244,14 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
 
 void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
   model_->logLikelihoods(scan, particles_, &log_likelihood_);
-  log_prior_.resize(particles_.size());
-  for (std::size_t i = 0; i < particles_.size(); ++i) {
-    log_prior_[i] = std::log(particles_.weight[i]);
+  // After a resampling every weight is the same, and a constant prior does
+  // not change the normalised result: zeros spare N logarithms.
+  const std::vector<double>& w = particles_.weight;
+  if (std::all_of(w.begin(), w.end(), [&](double v) { return v == w.front(); })) {
+    log_prior_.assign(particles_.size(), 0.0);
+  } else {
+    log_prior_.resize(particles_.size());
+    for (std::size_t i = 0; i < particles_.size(); ++i) log_prior_[i] = std::log(w[i]);
   }
   const std::vector<double>& ll = log_likelihood_;
   double beta = 1.0;

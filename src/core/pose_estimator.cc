@@ -17,8 +17,14 @@ struct BinKey {
 
 struct BinKeyHash {
   std::size_t operator()(const BinKey& k) const {
-    return static_cast<std::size_t>(k.x * 73856093) ^ static_cast<std::size_t>(k.y * 19349663) ^
-           static_cast<std::size_t>(k.yaw * 83492791);
+    // splitmix64's finaliser over the packed key: neighbouring bins must not
+    // collide, as they would with a plain XOR of scaled coordinates.
+    uint64_t z = (static_cast<uint64_t>(k.x) * 0x9e3779b97f4a7c15ULL) ^
+                 (static_cast<uint64_t>(k.y) * 0xc2b2ae3d27d4eb4fULL) ^
+                 static_cast<uint64_t>(k.yaw);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return static_cast<std::size_t>(z ^ (z >> 31));
   }
 };
 
@@ -78,6 +84,8 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
     for (int dx = -1; dx <= 1; ++dx) {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dt = -1; dt <= 1; ++dt) {
+          // Joining is symmetric: half the neighbourhood is enough.
+          if (dx < 0 || (dx == 0 && (dy < 0 || (dy == 0 && dt <= 0)))) continue;
           const BinKey n{keys[b].x + dx, keys[b].y + dy,
                          ((keys[b].yaw + dt) % yaw_bins + yaw_bins) % yaw_bins};
           const auto it = bin_of.find(n);
@@ -88,11 +96,44 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
     }
   }
 
-  std::unordered_map<int, std::vector<std::size_t>> members;
+  // Cluster ids in order of first appearance, then the weighted sums of each
+  // cluster in two passes (means, then covariances) over flat arrays.
+  std::vector<int> cluster_of_root(keys.size(), -1);
+  std::vector<int> cluster(particles.size());
+  int clusters = 0;
   for (std::size_t i = 0; i < particles.size(); ++i) {
-    members[find(parent, particle_bin[i])].push_back(i);
+    int& id = cluster_of_root[find(parent, particle_bin[i])];
+    if (id < 0) id = clusters++;
+    cluster[i] = id;
   }
-  for (const auto& m : members) estimate.clusters.push_back(summarize(particles, m.second));
+  std::vector<Cluster> c(clusters);
+  std::vector<Eigen::Vector4d> sums(clusters, Eigen::Vector4d::Zero());  // x, y, sin, cos
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    const double w = particles.weight[i];
+    Cluster& k = c[cluster[i]];
+    k.weight += w;
+    ++k.count;
+    // Single precision (1e-7 rad) is ample for a mean direction, and its
+    // sine and cosine cost half as much, once per particle and update.
+    const float yaw = static_cast<float>(particles.yaw[i]);
+    sums[cluster[i]] +=
+        w * Eigen::Vector4d(particles.x[i], particles.y[i], std::sin(yaw), std::cos(yaw));
+  }
+  for (int k = 0; k < clusters; ++k) {
+    const double w = c[k].weight > 0.0 ? c[k].weight : 1.0;
+    c[k].mean = {sums[k][0] / w, sums[k][1] / w,
+                 normalizeAngle(std::atan2(sums[k][2], sums[k][3]))};
+  }
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    Cluster& k = c[cluster[i]];
+    const Eigen::Vector3d d(particles.x[i] - k.mean.x, particles.y[i] - k.mean.y,
+                            angleDiff(particles.yaw[i], k.mean.yaw));
+    k.covariance += particles.weight[i] * d * d.transpose();
+  }
+  for (Cluster& k : c) {
+    if (k.weight > 0.0) k.covariance /= k.weight;
+  }
+  estimate.clusters = std::move(c);
   // Heaviest first; ties broken by the mean so the order never depends on hashing.
   std::sort(estimate.clusters.begin(), estimate.clusters.end(),
             [](const Cluster& a, const Cluster& b) {

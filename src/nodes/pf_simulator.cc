@@ -148,7 +148,7 @@ geometry_msgs::TransformStamped transform(const ros::Time& stamp, const std::str
 double simulate(const Options& o, const pf::OccupancyGrid& map, const pf::sim::PathScript& script,
                 rosbag::Bag* bag) {
   // Separate streams, so that changing the laser model leaves the odometry alone.
-  pf::Random odom_random(o.seed * 2 + 1), laser_random(o.seed * 2 + 2);
+  pf::sim::SimRandom odom_random(o.seed * 2 + 1), laser_random(o.seed * 2 + 2);
   pf::sim::DiffDriveRobot robot(odometryErrors(o.odom_error), script.start);
   const pf::sim::RayCaster caster(map);
   const NeatoLaserParams laser;

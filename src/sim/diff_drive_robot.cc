@@ -17,7 +17,7 @@ Pose2 integrateArc(const Pose2& p, double ds, double dtheta) {
 DiffDriveRobot::DiffDriveRobot(const DiffDriveParams& params, const Pose2& start)
     : params_(params), true_pose_(start) {}
 
-void DiffDriveRobot::step(double v, double w, double dt, Random* random) {
+void DiffDriveRobot::step(double v, double w, double dt, SimRandom* random) {
   const double ds = v * dt;
   const double dtheta = w * dt;
   true_pose_ = integrateArc(true_pose_, ds, dtheta);

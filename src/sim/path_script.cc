@@ -216,7 +216,7 @@ PathPlayer::PathPlayer(const PathScript& script) : script_(script) {
   if (!finished()) left_ = script_.motions[0].duration;
 }
 
-void PathPlayer::advance(double dt, DiffDriveRobot* robot, Random* random) {
+void PathPlayer::advance(double dt, DiffDriveRobot* robot, SimRandom* random) {
   // Times below a picosecond are rounding noise from splitting steps.
   constexpr double kEps = 1e-12;
   while (!finished() && (dt > kEps || script_.motions[next_].teleport)) {

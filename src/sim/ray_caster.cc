@@ -59,7 +59,7 @@ double castToCircle(double x, double y, double angle, double cx, double cy, doub
 }
 
 std::vector<float> neatoReadings(const std::vector<double>& ideal, const NeatoLaserParams& params,
-                                 Random* random) {
+                                 SimRandom* random) {
   const std::size_t n = ideal.size();
   // How likely each beam is to be hidden by the robot itself.
   std::vector<double> blind(n, 0.0);

@@ -81,7 +81,7 @@ TEST(DiffDriveRobotTest, SlipIsRandomButSeeded) {
   DiffDriveParams params;
   params.slip_sigma = 0.01;
   DiffDriveRobot a(params, {}), b(params, {});
-  Random ra(5), rb(5);
+  SimRandom ra(5), rb(5);
   for (int i = 0; i < 100; ++i) {
     a.step(0.3, 0.1, 0.05, &ra);
     b.step(0.3, 0.1, 0.05, &rb);

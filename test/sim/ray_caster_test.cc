@@ -94,7 +94,7 @@ NeatoLaserParams noiseless() {
 }
 
 TEST(NeatoReadingsTest, NoiselessReadingsAreRoundedToMillimetres) {
-  Random random(1);
+  SimRandom random(1);
   const auto r = neatoReadings({1.2344, kInf, 5.0, 4.9996, 0.01, 4.9994}, noiseless(), &random);
   ASSERT_EQ(r.size(), 6u);
   EXPECT_FLOAT_EQ(r[0], 1.234f);
@@ -109,7 +109,7 @@ TEST(NeatoReadingsTest, DropoutRateGrowsWithRange) {
   NeatoLaserParams p = noiseless();
   p.dropout_near = 0.1;
   p.dropout_far = 0.5;
-  Random random(7);
+  SimRandom random(7);
   const auto fraction = [&](double range) {
     const auto r = neatoReadings(std::vector<double>(20000, range), p, &random);
     int dropped = 0;
@@ -125,7 +125,7 @@ TEST(NeatoReadingsTest, BlindSectorsNeverReturnAndTheirEdgesSometimes) {
   NeatoLaserParams p = noiseless();
   p.blind_sectors = {{10, 12}};
   p.blind_edge = 0.5;
-  Random random(2);
+  SimRandom random(2);
   std::vector<int> valid(36, 0);
   for (int scan = 0; scan < 2000; ++scan) {
     const auto r = neatoReadings(std::vector<double>(36, 1.0), p, &random);  // 10 deg apart
@@ -151,7 +151,7 @@ TEST(NeatoReadingsTest, BurstsDropRunsOfBeams) {
   NeatoLaserParams p = noiseless();
   p.burst_rate = 0.02;
   p.burst_mean = 5.0;
-  Random random(3);
+  SimRandom random(3);
   const auto r = neatoReadings(std::vector<double>(100000, 1.0), p, &random);
   int runs = 0, dropped = 0;
   for (std::size_t i = 0; i < r.size(); ++i) {

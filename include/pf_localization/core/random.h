@@ -1,27 +1,55 @@
 // The filter's single source of randomness. Seeded explicitly so that the same
-// seed and the same input always give the same particles.
+// seed and the same input always give the same particles, on any standard
+// library: the generator and both distributions are implemented here.
+//
+// Engine: xoshiro256++ (Blackman & Vigna, "Scrambled Linear Pseudorandom
+// Number Generators", ACM TOMS 47(4), 2021), seeded through splitmix64.
+// Normal variates: the ziggurat method (Marsaglia & Tsang, "The Ziggurat
+// Method for Generating Random Variables", J. Stat. Software 5(8), 2000) with
+// 128 layers: one 64-bit draw and a compare for 98.8% of the samples. The
+// motion model draws three normals per particle per update, so this is on
+// the filter's hot path.
 #pragma once
 
+#include <array>
 #include <cstdint>
-#include <random>
 
 namespace pf {
 
 class Random {
  public:
-  explicit Random(uint64_t seed) : engine_(seed) {}
+  explicit Random(uint64_t seed);
 
+  /// 64 uniformly random bits.
+  uint64_t bits() {
+    const uint64_t result = rotl(s_[0] + s_[3], 23) + s_[0];
+    const uint64_t t = s_[1] << 17;
+    s_[2] ^= s_[0];
+    s_[3] ^= s_[1];
+    s_[1] ^= s_[2];
+    s_[0] ^= s_[3];
+    s_[2] ^= t;
+    s_[3] = rotl(s_[3], 45);
+    return result;
+  }
   /// Uniform in [0, 1).
-  double uniform() { return std::uniform_real_distribution<double>(0.0, 1.0)(engine_); }
+  double uniform() { return static_cast<double>(bits() >> 11) * 0x1.0p-53; }
   double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
-  /// Uniform integer in [0, n).
-  uint64_t index(uint64_t n) { return std::uniform_int_distribution<uint64_t>(0, n - 1)(engine_); }
+  /// Uniform integer in [0, n), n >= 1 (Lemire's multiply-shift; its bias
+  /// below 2^-40 for any n a map can have is irrelevant here).
+  uint64_t index(uint64_t n) {
+    return static_cast<uint64_t>((static_cast<unsigned __int128>(bits()) * n) >> 64);
+  }
+  /// Standard normal variate.
+  double normal();
   /// Zero-mean normal with standard deviation sigma (sigma <= 0 gives 0).
-  double gaussian(double sigma) { return sigma > 0.0 ? sigma * normal_(engine_) : 0.0; }
+  double gaussian(double sigma) { return sigma > 0.0 ? sigma * normal() : 0.0; }
 
  private:
-  std::mt19937_64 engine_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
+  static uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
+  double normalTail(int64_t hz, int layer);
+
+  std::array<uint64_t, 4> s_;
 };
 
 }  // namespace pf

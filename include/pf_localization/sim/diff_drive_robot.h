@@ -19,7 +19,7 @@
 #pragma once
 
 #include "pf_localization/core/pose2.h"
-#include "pf_localization/core/random.h"
+#include "pf_localization/sim/sim_random.h"
 
 namespace pf::sim {
 
@@ -42,7 +42,7 @@ class DiffDriveRobot {
 
   /// Drives at (v, w) for dt seconds. `random` supplies the slip; it may be
   /// null when slip_sigma is 0.
-  void step(double v, double w, double dt, Random* random);
+  void step(double v, double w, double dt, SimRandom* random);
 
   /// Moves the true pose without the wheels turning (a kidnapping).
   void teleport(const Pose2& pose) { true_pose_ = pose; }

@@ -29,8 +29,8 @@
 
 #include "pf_localization/core/occupancy_grid.h"
 #include "pf_localization/core/pose2.h"
-#include "pf_localization/core/random.h"
 #include "pf_localization/sim/diff_drive_robot.h"
+#include "pf_localization/sim/sim_random.h"
 
 namespace pf::sim {
 
@@ -96,7 +96,7 @@ class PathPlayer {
   /// Drives `robot` through the next dt seconds of the script, teleports
   /// included (advance(0) performs those due at the current time). After the
   /// end the robot stands still.
-  void advance(double dt, DiffDriveRobot* robot, Random* random);
+  void advance(double dt, DiffDriveRobot* robot, SimRandom* random);
   bool finished() const { return next_ >= script_.motions.size(); }
 
  private:

@@ -31,7 +31,7 @@
 #include <vector>
 
 #include "pf_localization/core/occupancy_grid.h"
-#include "pf_localization/core/random.h"
+#include "pf_localization/sim/sim_random.h"
 
 namespace pf::sim {
 
@@ -76,6 +76,6 @@ struct NeatoLaserParams {
 /// Neato readings for ideal ranges (+inf: no return) of a full turn of
 /// evenly spaced beams, the first at laser-frame angle 0.
 std::vector<float> neatoReadings(const std::vector<double>& ideal, const NeatoLaserParams& params,
-                                 Random* random);
+                                 SimRandom* random);
 
 }  // namespace pf::sim
