@@ -52,6 +52,7 @@ void BM_SensorUpdate(benchmark::State& state) {
   const int beams = static_cast<int>(state.range(1));
   pf::LikelihoodFieldModelParams params;
   params.max_beams = beams;
+  params.threads = static_cast<int>(state.range(2));
   const pf::LikelihoodFieldModel model(pillarMap(400), params);
   pf::Random random(1);
   const pf::ParticleSet particles = scatter(state.range(0), &random);
@@ -65,7 +66,12 @@ void BM_SensorUpdate(benchmark::State& state) {
   state.counters["ns_per_particle_beam"] = benchmark::Counter(
       pairs * state.iterations(), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
-BENCHMARK(BM_SensorUpdate)->Args({10000, 60})->Args({100000, 60})->Args({100000, 360});
+BENCHMARK(BM_SensorUpdate)
+    ->Args({10000, 60, 1})
+    ->Args({100000, 60, 1})
+    ->Args({100000, 360, 1})
+    ->Args({100000, 60, 2})
+    ->UseRealTime();
 
 void BM_FullUpdate(benchmark::State& state) {
   const std::size_t n = state.range(0);

@@ -26,6 +26,8 @@ LikelihoodFieldModel::LikelihoodFieldModel(const OccupancyGrid& grid,
   require(params.likelihood_exponent > 0.0 && params.likelihood_exponent <= 1.0,
           "laser_likelihood_exponent must be in (0, 1], got " +
               std::to_string(params.likelihood_exponent));
+  require(params.threads >= 1,
+          "sensor_threads must be >= 1, got " + std::to_string(params.threads));
   require(params.max_beams >= 1,
           "laser_max_beams must be >= 1, got " + std::to_string(params.max_beams));
   require(params.range_min >= 0.0 && params.range_max >= 0.0,
@@ -102,42 +104,51 @@ double LikelihoodFieldModel::logLikelihood(const PreparedScan& scan, const Pose2
   return out[0];
 }
 
-__attribute__((target_clones("avx2", "default"))) void LikelihoodFieldModel::logLikelihoods(
-    const PreparedScan& scan, const ParticleSet& particles,
-    std::vector<double>* log_likelihood) const {
-  buildTable(scan.range_max);
-  const OccupancyGrid& grid = field_.grid();
-  const float inv_res = static_cast<float>(1.0 / grid.resolution());
-  const int stride = grid.width() + 2;
-  const float max_x = static_cast<float>(grid.width() + 1);
-  const float max_y = static_cast<float>(grid.height() + 1);
-  const float* table = table_.data();
+namespace {
 
-  // End points in cell units, so the inner loop needs no division.
-  const std::size_t n = scan.size();
-  std::vector<float> bx(n), by(n);
-  for (std::size_t b = 0; b < n; ++b) {
-    bx[b] = scan.x[b] * inv_res;
-    by[b] = scan.y[b] * inv_res;
-  }
+// What scoring a particle needs, in the grid's cell units.
+struct ScoringFrame {
+  const float* table;  // per-cell log-likelihood with a one-cell border
+  int stride;          // table width
+  float max_x, max_y;  // last border column and row
+  float inv_res;
+  Pose2 origin;
+  double origin_cos, origin_sin;
+  const float* bx;  // beam end points in the robot frame, in cells
+  const float* by;
+  std::size_t beams;
+};
 
-  // The particles go into the grid's frame, in cells, shifted by the
-  // one-cell border; the origin's rotation is applied once, not per particle.
-  const Pose2& o = grid.origin();
-  const double oc = std::cos(o.yaw), os = std::sin(o.yaw);
-  log_likelihood->resize(particles.size());
-  for (std::size_t i = 0; i < particles.size(); ++i) {
-    const double dx = particles.x[i] - o.x, dy = particles.y[i] - o.y;
-    const float px = static_cast<float>((oc * dx + os * dy) * inv_res) + 1.0f;
-    const float py = static_cast<float>((-os * dx + oc * dy) * inv_res) + 1.0f;
-    const float yaw = static_cast<float>(particles.yaw[i] - o.yaw);
+// Scores particles [begin, end). Cloned for AVX2 next to the portable
+// version: the beam loop vectorises, and the best clone is picked at load.
+__attribute__((target_clones("avx2", "default"))) void scoreParticles(const ScoringFrame& f,
+                                                                      const ParticleSet& particles,
+                                                                      std::size_t begin,
+                                                                      std::size_t end,
+                                                                      double* out) {
+  // Locals, not the frame's fields: the compiler can then prove that the
+  // stores to `out` change none of them, and vectorises the beam loop.
+  const float* table = f.table;
+  const int stride = f.stride;
+  const float max_x = f.max_x, max_y = f.max_y;
+  const float* bx = f.bx;
+  const float* by = f.by;
+  const std::size_t beams = f.beams;
+  for (std::size_t i = begin; i < end; ++i) {
+    // The particle in the grid's frame, in cells, shifted by the border; the
+    // origin's rotation is applied here, once per particle.
+    const double dx = particles.x[i] - f.origin.x, dy = particles.y[i] - f.origin.y;
+    const float px = static_cast<float>((f.origin_cos * dx + f.origin_sin * dy) * f.inv_res) + 1.0f;
+    const float py =
+        static_cast<float>((-f.origin_sin * dx + f.origin_cos * dy) * f.inv_res) + 1.0f;
+    const float yaw = static_cast<float>(particles.yaw[i] - f.origin.yaw);
     const float c = std::cos(yaw);
     const float s = std::sin(yaw);
     float sum = 0.0f;
-    for (std::size_t b = 0; b < n; ++b) {
+    for (std::size_t b = 0; b < beams; ++b) {
       // Clamping before truncation sends every point outside the map to the
-      // border, and makes truncation equal floor for what remains.
-      // The comparisons are written so that NaN (from a particle at infinity)
+      // border, and makes truncation equal floor for what remains. The
+      // comparisons are written so that NaN (from a particle at infinity)
       // also lands in the border instead of becoming an undefined int.
       const float ex = px + c * bx[b] - s * by[b];
       const float ey = py + s * bx[b] + c * by[b];
@@ -145,7 +156,48 @@ __attribute__((target_clones("avx2", "default"))) void LikelihoodFieldModel::log
       const float gy = ey > 0.0f ? std::min(ey, max_y) : 0.0f;
       sum += table[static_cast<int>(gy) * stride + static_cast<int>(gx)];
     }
-    (*log_likelihood)[i] = sum;
+    out[i] = sum;
+  }
+}
+
+}  // namespace
+
+void LikelihoodFieldModel::logLikelihoods(const PreparedScan& scan, const ParticleSet& particles,
+                                          std::vector<double>* log_likelihood) const {
+  buildTable(scan.range_max);
+  const OccupancyGrid& grid = field_.grid();
+  const float inv_res = static_cast<float>(1.0 / grid.resolution());
+  // End points in cell units, so the inner loop needs no division.
+  const std::size_t n = scan.size();
+  std::vector<float> bx(n), by(n);
+  for (std::size_t b = 0; b < n; ++b) {
+    bx[b] = scan.x[b] * inv_res;
+    by[b] = scan.y[b] * inv_res;
+  }
+  const ScoringFrame frame{table_.data(),
+                           grid.width() + 2,
+                           static_cast<float>(grid.width() + 1),
+                           static_cast<float>(grid.height() + 1),
+                           inv_res,
+                           grid.origin(),
+                           std::cos(grid.origin().yaw),
+                           std::sin(grid.origin().yaw),
+                           bx.data(),
+                           by.data(),
+                           n};
+  log_likelihood->resize(particles.size());
+  const int threads = params_.threads;
+  if (threads <= 1) {
+    scoreParticles(frame, particles, 0, particles.size(), log_likelihood->data());
+    return;
+  }
+  // One contiguous slice per thread; every particle's score is computed
+  // alone, so the result is the same for any thread count.
+#pragma omp parallel for num_threads(threads) schedule(static)
+  for (int t = 0; t < threads; ++t) {
+    const std::size_t size = particles.size();
+    scoreParticles(frame, particles, size * t / threads, size * (t + 1) / threads,
+                   log_likelihood->data());
   }
 }
 

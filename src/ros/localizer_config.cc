@@ -158,6 +158,7 @@ LocalizerConfig readConfig(const ParamSource& p) {
   p.get("odom_alpha5", &f.motion.alpha5);
 
   p.get("laser_max_beams", &f.sensor.max_beams);
+  p.get("sensor_threads", &f.sensor.threads);
   p.get("laser_z_hit", &f.sensor.z_hit);
   p.get("laser_z_rand", &f.sensor.z_rand);
   p.get("laser_sigma_hit", &f.sensor.sigma_hit);

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "pf_localization/core/random.h"
+
 namespace pf {
 namespace {
 
@@ -276,6 +278,24 @@ TEST(LikelihoodFieldModel, ExponentScalesTheScanLogLikelihood) {
   EXPECT_NEAR(0.25 * full, tempered.logLikelihood(tempered.prepare(scan), pose), 1e-6);
 }
 
+TEST(LikelihoodFieldModel, ThreadCountDoesNotChangeTheScores) {
+  LikelihoodFieldModelParams p = params();
+  const LikelihoodFieldModel one(wallGrid(8), p);
+  p.threads = 3;
+  const LikelihoodFieldModel three(wallGrid(8), p);
+  ParticleSet set;
+  set.resize(1001);  // not a multiple of the thread count
+  Random random(3);
+  for (std::size_t i = 0; i < set.size(); ++i) {
+    set.setPose(i, {random.uniform(0.0, 1.0), random.uniform(0.0, 0.5), random.uniform(-3, 3)});
+  }
+  const LaserScan scan = quarterScan({0.3f, 0.2f, 0.4f, 0.25f});
+  std::vector<double> a, b;
+  one.logLikelihoods(one.prepare(scan), set, &a);
+  three.logLikelihoods(three.prepare(scan), set, &b);
+  EXPECT_EQ(a, b);
+}
+
 TEST(LikelihoodFieldModel, InvalidParametersThrowNamingThem) {
   using P = LikelihoodFieldModelParams;
   auto with = [](auto change) {
@@ -296,6 +316,7 @@ TEST(LikelihoodFieldModel, InvalidParametersThrowNamingThem) {
   expectRejected(with([](P& p) { p.max_distance = 0.0; }), "max_dist");
   expectRejected(with([](P& p) { p.max_distance = NAN; }), "max_dist");
   expectRejected(with([](P& p) { p.likelihood_exponent = 0.0; }), "laser_likelihood_exponent");
+  expectRejected(with([](P& p) { p.threads = 0; }), "sensor_threads");
   expectRejected(with([](P& p) { p.likelihood_exponent = 1.5; }), "laser_likelihood_exponent");
   // Only z_hit or only z_rand is fine.
   EXPECT_NO_THROW(LikelihoodFieldModel(wallGrid(8), with([](P& p) { p.z_rand = 0.0; })));

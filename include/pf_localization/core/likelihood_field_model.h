@@ -36,6 +36,9 @@ struct LikelihoodFieldModelParams {
   // scan likelihood to this power (tempering) keeps rival hypotheses alive
   // until the evidence really separates them. 1 = independent beams.
   double likelihood_exponent = 0.2;  // (0, 1]
+  // Threads scoring the particles (OpenMP builds). Each particle is scored on
+  // its own, so the result does not depend on this number.
+  int threads = 1;
 };
 
 /// End points of the usable beams in the robot's base frame, computed once per scan.
