@@ -193,7 +193,9 @@ void LikelihoodFieldModel::logLikelihoods(const PreparedScan& scan, const Partic
   }
   // One contiguous slice per thread; every particle's score is computed
   // alone, so the result is the same for any thread count.
+#ifdef _OPENMP
 #pragma omp parallel for num_threads(threads) schedule(static)
+#endif
   for (int t = 0; t < threads; ++t) {
     const std::size_t size = particles.size();
     scoreParticles(frame, particles, size * t / threads, size * (t + 1) / threads,
