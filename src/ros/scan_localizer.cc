@@ -123,6 +123,7 @@ ScanResult ScanLocalizer::processScan(const sensor_msgs::LaserScan& scan) {
                    " failed: " + e.what();
     return result;
   }
+  result.warning = scanInconsistency(scan);
   result.odom = toPose2(odom.transform);
   result.report = filter_.update(*result.odom, toCore(scan, toPose2(laser.transform)));
   return result;
@@ -157,6 +158,27 @@ geometry_msgs::PoseArray ScanLocalizer::particleCloud(const ros::Time& stamp) co
   msg.header.frame_id = config_.global_frame;
   toPoseArray(filter_.particles(), &msg);
   return msg;
+}
+
+std::string scanInconsistency(const sensor_msgs::LaserScan& scan) {
+  if (!scan.intensities.empty() && scan.intensities.size() != scan.ranges.size()) {
+    return "the scan has " + std::to_string(scan.intensities.size()) + " intensities for " +
+           std::to_string(scan.ranges.size()) + " ranges (intensities are not used)";
+  }
+  if (scan.ranges.size() > 1 && std::isfinite(scan.angle_increment) &&
+      scan.angle_increment != 0.0f) {
+    const double last = scan.angle_min + (scan.ranges.size() - 1.0) * scan.angle_increment;
+    // Half a beam of slack: drivers round angle_max in both directions.
+    if (std::fabs(last - scan.angle_max) > 0.5 * std::fabs(scan.angle_increment) + 1e-6) {
+      std::ostringstream text;
+      text << "the scan's angle_max " << scan.angle_max
+           << " rad disagrees with angle_min + (n - 1) "
+           << "* angle_increment = " << last << " rad for its " << scan.ranges.size()
+           << " ranges; beams are placed by angle_min and angle_increment";
+      return text.str();
+    }
+  }
+  return "";
 }
 
 geometry_msgs::TransformStamped odometryToTransform(const nav_msgs::Odometry& odom) {

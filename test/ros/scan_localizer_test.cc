@@ -184,6 +184,36 @@ TEST_F(ScanLocalizerTest, MalformedMapIsRejected) {
   EXPECT_NE(localizer.setMap(bad).find("ignoring the map"), std::string::npos);
 }
 
+TEST(ScanInconsistency, ConsistentScanHasNone) {
+  sensor_msgs::LaserScan scan;
+  scan.angle_min = -1.0;
+  scan.angle_increment = 0.5;
+  scan.angle_max = 1.0;
+  scan.ranges.assign(5, 1.0f);
+  EXPECT_EQ(scanInconsistency(scan), "");
+  scan.intensities.assign(5, 0.0f);
+  EXPECT_EQ(scanInconsistency(scan), "");
+}
+
+TEST(ScanInconsistency, IntensitiesOfAnotherLengthAreReported) {
+  sensor_msgs::LaserScan scan;
+  scan.angle_min = -1.0;
+  scan.angle_increment = 0.5;
+  scan.angle_max = 1.0;
+  scan.ranges.assign(5, 1.0f);
+  scan.intensities.assign(3, 0.0f);
+  EXPECT_NE(scanInconsistency(scan).find("3 intensities for 5 ranges"), std::string::npos);
+}
+
+TEST(ScanInconsistency, AngleMaxThatDisagreesIsReported) {
+  sensor_msgs::LaserScan scan;
+  scan.angle_min = -1.0;
+  scan.angle_increment = 0.5;
+  scan.angle_max = 2.0;  // five beams end at 1.0
+  scan.ranges.assign(5, 1.0f);
+  EXPECT_NE(scanInconsistency(scan).find("angle_max"), std::string::npos);
+}
+
 TEST_F(ScanLocalizerTest, OdometryMessageBecomesOdomToBaseTransform) {
   nav_msgs::Odometry odom;
   odom.header.frame_id = "odom";

@@ -25,6 +25,7 @@ namespace pf_ros {
 struct ScanResult {
   pf::UpdateReport report;  // report.updated: the filter ran
   std::string error;        // non-empty: the scan was not used, and why (for the log)
+  std::string warning;      // non-empty: the scan was used, but something in it is off
   // The odometry pose (odom -> base) at the scan's stamp, when it was found.
   std::optional<pf::Pose2> odom;
 };
@@ -76,6 +77,13 @@ class ScanLocalizer {
   pf::ParticleFilter filter_;
   bool had_map_ = false;
 };
+
+/// What is inconsistent in a scan message without making it unusable:
+/// intensities of another length than the ranges (they are not used), or an
+/// angle_max that disagrees with angle_min + (n - 1) * angle_increment (the
+/// beams are placed by angle_min and angle_increment, as every ROS consumer
+/// does). Empty when the message is consistent.
+std::string scanInconsistency(const sensor_msgs::LaserScan& scan);
 
 /// A nav_msgs/Odometry as the odom -> base transform it describes, for a tf
 /// buffer that has no odometry on /tf (bags that only record /odom).
