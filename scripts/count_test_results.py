@@ -4,7 +4,7 @@
 catkin_test_results adds up the "tests" attributes of every file, which counts
 each gtest case twice (its suite and the whole run both carry it) and each
 rostest twice (once in rostest-*.xml, once in the test node's rosunit-*.xml).
-Here every <testcase> of the gtest-* and rostest-* files counts once.
+Here every gtest case and every rostest's test node counts once.
 usage: count_test_results.py RESULTS_DIR      prints "PASSED FAILED"
 """
 import glob
@@ -17,10 +17,13 @@ def count(results_dir):
     passed = failed = 0
     for path in sorted(glob.glob(os.path.join(results_dir, '**', '*.xml'), recursive=True)):
         name = os.path.basename(path)
-        if not name.startswith(('gtest-', 'rostest-')):
+        # gtest-*: one case per test. rosunit-*: the test node of a rostest,
+        # which holds its verdict. rostest-*: only the launch itself (it says
+        # "passed" even when its test node failed), so only its failures count.
+        if not name.startswith(('gtest-', 'rosunit-', 'rostest-')):
             continue
         try:
-            cases = ET.parse(path).getroot().iter('testcase')
+            cases = list(ET.parse(path).getroot().iter('testcase'))
         except ET.ParseError as e:
             print('%s: unreadable result file: %s' % (path, e), file=sys.stderr)
             failed += 1
@@ -29,6 +32,8 @@ def count(results_dir):
             if case.find('skipped') is not None:
                 continue
             bad = case.find('failure') is not None or case.find('error') is not None
+            if name.startswith('rostest-') and not bad:
+                continue
             failed += bad
             passed += not bad
             if bad:
