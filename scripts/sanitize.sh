@@ -9,7 +9,7 @@
 set -uo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 ws=${PF_ASAN_WS:-$repo/.ws_asan}
-tests=(pf_core_test pf_sim_test pf_ros_test)
+tests=(pf_core_test pf_sim_test pf_ros_test pf_fuzz_replay_test)
 start=$(date +%s)
 
 echo "sanitize: building ${tests[*]} with PF_SANITIZE=ON in $ws"

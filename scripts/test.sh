@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Installs the dependencies, builds the package and runs every test: the
 # GoogleTest unit tests, the rostest integration tests on the bundled bags,
-# the Python unit tests and the source checks (clang-format, a ROS-free core).
+# the Python unit tests, the source checks (clang-format, a ROS-free core) and
+# the unit tests once more under AddressSanitizer + UndefinedBehaviorSanitizer.
 # Ends with one line "N passed, N failed"; exits non-zero when anything failed
 # or when no test ran at all.
 set -uo pipefail
@@ -57,6 +58,11 @@ clang_format_clean() {
   return 1
 }
 check "the core and the simulator include no ROS header" core_is_ros_free
+# The unit tests again, built with AddressSanitizer and UndefinedBehaviorSanitizer
+# (about 10 minutes from cold; PF_SKIP_SANITIZE=1 skips it in a hurry).
+if [ "${PF_SKIP_SANITIZE:-0}" != 1 ]; then
+  check "unit tests under ASan + UBSan (scripts/sanitize.sh)" bash scripts/sanitize.sh
+fi
 check "clang-format clean" clang_format_clean
 
 echo "$passed passed, $failed failed"

@@ -93,13 +93,22 @@ void validate(const ParticleFilterParams& p) {
 }
 
 ParticleFilter::ParticleFilter(const ParticleFilterParams& params)
-    : params_((validate(params), params)), random_(params.seed), motion_model_(params.motion) {}
+    : params_((validate(params), params)), random_(params.seed), motion_model_(params.motion) {
+  // Room for the largest cloud from the start: the particle count swings
+  // between min and max particles, and reallocating would make the process's
+  // memory swing with it (and allocate on the update path).
+  const auto max = static_cast<std::size_t>(params_.kld.max_particles);
+  for (ParticleSet* set : {&particles_, &spare_}) {
+    for (std::vector<double>* v : {&set->x, &set->y, &set->yaw, &set->weight}) v->reserve(max);
+  }
+  for (std::vector<double>* v : {&scratch_, &log_prior_, &log_likelihood_}) v->reserve(max);
+}
 
 bool ParticleFilter::setMap(const OccupancyGrid& grid) {
   if (grid.empty()) throw std::invalid_argument("the map is empty");
   model_ = std::make_unique<LikelihoodFieldModel>(grid, params_.sensor);
   if (isInitialized() && grid.isFreeAt(estimate_.pose.x, estimate_.pose.y)) return true;
-  particles_ = ParticleSet();
+  particles_.resize(0);  // keeps the reserved storage
   estimate_ = PoseEstimate();
   has_estimate_ = false;
   return false;
@@ -334,7 +343,8 @@ void ParticleFilter::resample(UpdateReport* report) {
       max, static_cast<std::size_t>(std::floor(inject_probability * max + random_.uniform())));
   const std::size_t kept = std::min(
       max - injected, static_cast<std::size_t>(std::ceil((1.0 - inject_probability) * target)));
-  systematicResample(&particles_, kept, &random_);
+  systematicResample(particles_, kept, &random_, &spare_);
+  std::swap(particles_, spare_);
   particles_.resize(kept + injected);
   for (std::size_t i = kept; i < kept + injected; ++i) particles_.setPose(i, randomFreePose());
   particles_.setUniformWeights();

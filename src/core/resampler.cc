@@ -15,15 +15,9 @@ double effectiveSampleSize(const std::vector<double>& weights) {
   return sum_sq > 0.0 ? 1.0 / sum_sq : 0.0;
 }
 
-void systematicResample(ParticleSet* particles, std::size_t n, Random* random) {
-  const ParticleSet& in = *particles;
-  ParticleSet out;
-  out.resize(n);
-  if (in.empty() || n == 0) {
-    out.resize(0);
-    *particles = std::move(out);
-    return;
-  }
+void systematicResample(const ParticleSet& in, std::size_t n, Random* random, ParticleSet* out) {
+  out->resize(in.empty() ? 0 : n);
+  if (out->empty()) return;
   double total = 0.0;
   for (double w : in.weight) total += w;
   const double step = total / static_cast<double>(n);
@@ -36,11 +30,16 @@ void systematicResample(ParticleSet* particles, std::size_t n, Random* random) {
     const double pointer = (offset + static_cast<double>(i)) * step;
     // The last particle absorbs rounding in the cumulative sum.
     while (pointer >= cumulative && j + 1 < in.size()) cumulative += in.weight[++j];
-    out.x[i] = in.x[j];
-    out.y[i] = in.y[j];
-    out.yaw[i] = in.yaw[j];
+    out->x[i] = in.x[j];
+    out->y[i] = in.y[j];
+    out->yaw[i] = in.yaw[j];
   }
-  out.setUniformWeights();
+  out->setUniformWeights();
+}
+
+void systematicResample(ParticleSet* particles, std::size_t n, Random* random) {
+  ParticleSet out;
+  systematicResample(*particles, n, random, &out);
   *particles = std::move(out);
 }
 

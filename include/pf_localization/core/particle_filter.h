@@ -139,6 +139,7 @@ class ParticleFilter {
   OdometryMotionModel motion_model_;
   std::unique_ptr<LikelihoodFieldModel> model_;
   ParticleSet particles_;
+  ParticleSet spare_;  // the resampler's output, swapped with particles_
   PoseEstimate estimate_;
   Confidence confidence_;
   std::optional<Pose2> odom_at_update_;

@@ -30,6 +30,9 @@ double effectiveSampleSize(const std::vector<double>& weights);
 /// Replaces `particles` with `n` survivors drawn systematically by weight;
 /// the survivors get uniform weights.
 void systematicResample(ParticleSet* particles, std::size_t n, Random* random);
+/// The same into `out` (not `in`), whose storage is reused: a filter that
+/// alternates two sets allocates nothing per update.
+void systematicResample(const ParticleSet& in, std::size_t n, Random* random, ParticleSet* out);
 
 struct KldParams {
   int min_particles = 500;
