@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <unordered_map>
 
 #include "pf_localization/core/bin_index.h"
+#include "pf_localization/core/bin_table.h"
 
 namespace pf {
 namespace {
@@ -13,19 +13,6 @@ namespace {
 struct BinKey {
   int64_t x, y, yaw;
   bool operator==(const BinKey& o) const { return x == o.x && y == o.y && yaw == o.yaw; }
-};
-
-struct BinKeyHash {
-  std::size_t operator()(const BinKey& k) const {
-    // splitmix64's finaliser over the packed key: neighbouring bins must not
-    // collide, as they would with a plain XOR of scaled coordinates.
-    uint64_t z = (static_cast<uint64_t>(k.x) * 0x9e3779b97f4a7c15ULL) ^
-                 (static_cast<uint64_t>(k.y) * 0xc2b2ae3d27d4eb4fULL) ^
-                 static_cast<uint64_t>(k.yaw);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return static_cast<std::size_t>(z ^ (z >> 31));
-  }
 };
 
 int find(std::vector<int>& parent, int i) {
@@ -62,23 +49,28 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
   PoseEstimate estimate;
   if (particles.empty()) return estimate;
 
-  // Bin every particle; yaw bins wrap around, so the last bin touches the first.
+  // Bin every particle; yaw bins wrap around, so the last bin touches the
+  // first. The working storage is kept between calls (per thread), so that
+  // estimating allocates nothing once the widest cloud has been seen.
   const int64_t yaw_bins = std::max<int64_t>(1, std::llround(2.0 * M_PI / params.cell_yaw));
-  std::unordered_map<BinKey, int, BinKeyHash> bin_of;
-  std::vector<BinKey> keys;
-  std::vector<int> particle_bin(particles.size());
+  thread_local BinTable bin_of;
+  thread_local std::vector<BinKey> keys;
+  thread_local std::vector<int> particle_bin, parent, cluster_of_root, cluster;
+  bin_of.reset(particles.size());
+  keys.clear();
+  particle_bin.resize(particles.size());
   for (std::size_t i = 0; i < particles.size(); ++i) {
     const double yaw01 = (normalizeAngle(particles.yaw[i]) + M_PI) / (2.0 * M_PI);
     const BinKey key{binIndex(particles.x[i], params.cell_xy),
                      binIndex(particles.y[i], params.cell_xy),
                      std::clamp<int64_t>(binIndex(yaw01, 1.0 / yaw_bins), 0, yaw_bins - 1)};
-    auto [it, inserted] = bin_of.try_emplace(key, static_cast<int>(keys.size()));
-    if (inserted) keys.push_back(key);
-    particle_bin[i] = it->second;
+    const int id = bin_of.insert(BinTable::key(key.x, key.y, key.yaw));
+    if (static_cast<std::size_t>(id) == keys.size()) keys.push_back(key);
+    particle_bin[i] = id;
   }
 
   // Join occupied bins that touch (26-neighbourhood) into clusters.
-  std::vector<int> parent(keys.size());
+  parent.resize(keys.size());
   std::iota(parent.begin(), parent.end(), 0);
   for (std::size_t b = 0; b < keys.size(); ++b) {
     for (int dx = -1; dx <= 1; ++dx) {
@@ -86,11 +78,10 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
         for (int dt = -1; dt <= 1; ++dt) {
           // Joining is symmetric: half the neighbourhood is enough.
           if (dx < 0 || (dx == 0 && (dy < 0 || (dy == 0 && dt <= 0)))) continue;
-          const BinKey n{keys[b].x + dx, keys[b].y + dy,
-                         ((keys[b].yaw + dt) % yaw_bins + yaw_bins) % yaw_bins};
-          const auto it = bin_of.find(n);
-          if (it != bin_of.end())
-            parent[find(parent, static_cast<int>(b))] = find(parent, it->second);
+          const int n =
+              bin_of.find(BinTable::key(keys[b].x + dx, keys[b].y + dy,
+                                        ((keys[b].yaw + dt) % yaw_bins + yaw_bins) % yaw_bins));
+          if (n >= 0) parent[find(parent, static_cast<int>(b))] = find(parent, n);
         }
       }
     }
@@ -98,8 +89,8 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
 
   // Cluster ids in order of first appearance, then the weighted sums of each
   // cluster in two passes (means, then covariances) over flat arrays.
-  std::vector<int> cluster_of_root(keys.size(), -1);
-  std::vector<int> cluster(particles.size());
+  cluster_of_root.assign(keys.size(), -1);
+  cluster.resize(particles.size());
   int clusters = 0;
   for (std::size_t i = 0; i < particles.size(); ++i) {
     int& id = cluster_of_root[find(parent, particle_bin[i])];

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
-#include <unordered_map>
 
 #include "pf_localization/core/bin_index.h"
+#include "pf_localization/core/bin_table.h"
 
 namespace pf {
 
@@ -88,19 +88,20 @@ std::size_t kldParticleCount(const ParticleSet& particles, const KldParams& para
   // resample of the current size: bins holding only negligible particles
   // will be empty after resampling and must not inflate k.
   const double threshold = particles.empty() ? 0.0 : 1.0 / static_cast<double>(particles.size());
-  std::unordered_map<uint64_t, double> bins;
-  bins.reserve(particles.size());
+  // Kept between calls (per thread), so that binning allocates nothing.
+  thread_local BinTable bins;
+  thread_local std::vector<double> bin_weight;
+  bins.reset(particles.size());
+  bin_weight.clear();
   for (std::size_t i = 0; i < particles.size(); ++i) {
-    const int64_t bx = binIndex(particles.x[i], params.bin_xy);
-    const int64_t by = binIndex(particles.y[i], params.bin_xy);
-    const int64_t bt = binIndex(particles.yaw[i], params.bin_yaw);
-    const uint64_t key = (static_cast<uint64_t>(bx & 0x1FFFFF) << 42) |
-                         (static_cast<uint64_t>(by & 0x1FFFFF) << 21) |
-                         static_cast<uint64_t>(bt & 0x1FFFFF);
-    bins[key] += particles.weight[i];
+    const int id = bins.insert(BinTable::key(binIndex(particles.x[i], params.bin_xy),
+                                             binIndex(particles.y[i], params.bin_xy),
+                                             binIndex(particles.yaw[i], params.bin_yaw)));
+    if (static_cast<std::size_t>(id) == bin_weight.size()) bin_weight.push_back(0.0);
+    bin_weight[id] += particles.weight[i];
   }
   std::size_t k = 0;
-  for (const auto& bin : bins) k += bin.second >= threshold ? 1 : 0;
+  for (double w : bin_weight) k += w >= threshold ? 1 : 0;
   const double n = std::ceil(kldBound(k, params.kld_err, params.confidence));
   const double lo = params.min_particles, hi = params.max_particles;
   return static_cast<std::size_t>(std::clamp(n, lo, hi));

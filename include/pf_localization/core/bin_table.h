@@ -1,0 +1,80 @@
+// Dense ids for the occupied bins of an (x, y, yaw) histogram.
+//
+// The clustering and KLD-sampling bin every particle on every update. A
+// node-based hash map allocates once per new bin, so a wide cloud (global
+// localization, recovery) left the process's heap fragmented and its memory
+// higher for good. This is an open-addressing table whose storage is kept
+// between updates: after the widest cloud it has seen, it allocates nothing.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace pf {
+
+class BinTable {
+ public:
+  /// Packs three bin indices (each clamped to +-2^20) into one key.
+  static uint64_t key(int64_t x, int64_t y, int64_t yaw) {
+    return (field(x) << 42) | (field(y) << 21) | field(yaw);
+  }
+
+  /// Empties the table, with room for `expected` bins.
+  void reset(std::size_t expected) {
+    std::size_t capacity = 16;
+    while (capacity < 2 * expected) capacity *= 2;
+    if (slots_.size() < capacity) slots_.resize(capacity);
+    mask_ = capacity - 1;
+    for (std::size_t i = 0; i <= mask_; ++i) slots_[i].key = kEmpty;
+    size_ = 0;
+  }
+
+  /// The id of `key`, 0, 1, 2, ... in order of first insertion.
+  int insert(uint64_t key) {
+    std::size_t i = slot(key);
+    while (slots_[i].key != kEmpty) {
+      if (slots_[i].key == key) return slots_[i].id;
+      i = (i + 1) & mask_;
+    }
+    slots_[i] = {key, static_cast<int>(size_)};
+    return static_cast<int>(size_++);
+  }
+
+  /// The id of `key`, or -1 when absent.
+  int find(uint64_t key) const {
+    for (std::size_t i = slot(key); slots_[i].key != kEmpty; i = (i + 1) & mask_) {
+      if (slots_[i].key == key) return slots_[i].id;
+    }
+    return -1;
+  }
+
+  std::size_t size() const { return size_; }
+
+ private:
+  // Keys use 63 bits, so all ones never occurs.
+  static constexpr uint64_t kEmpty = ~uint64_t{0};
+  static constexpr int64_t kHalfRange = int64_t{1} << 20;
+
+  struct Slot {
+    uint64_t key;
+    int id;
+  };
+
+  static uint64_t field(int64_t v) {
+    const int64_t clamped = v < -kHalfRange ? -kHalfRange : (v >= kHalfRange ? kHalfRange - 1 : v);
+    return static_cast<uint64_t>(clamped + kHalfRange);
+  }
+
+  std::size_t slot(uint64_t key) const {
+    // splitmix64's finaliser: neighbouring bins must land far apart.
+    key = (key ^ (key >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    key = (key ^ (key >> 27)) * 0x94d049bb133111ebULL;
+    return static_cast<std::size_t>(key ^ (key >> 31)) & mask_;
+  }
+
+  std::vector<Slot> slots_;
+  std::size_t mask_ = 0;
+  std::size_t size_ = 0;
+};
+
+}  // namespace pf
