@@ -23,6 +23,9 @@ packages=(
   python3-tf2-ros
   # evaluation reports
   python3-numpy python3-matplotlib python3-pil python3-yaml
+  # rviz test (scripts/rviz_click_test.sh): rviz under a virtual X server,
+  # driven by xdotool, its window found by xwininfo, screenshots by import
+  rviz xvfb xdotool x11-utils imagemagick
 )
 
 missing=()

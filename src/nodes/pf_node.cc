@@ -1,14 +1,18 @@
 // pf_node: the live ROS front door of the particle filter.
 //
 // Subscribes scan, odom, map (latched) and initialpose; publishes map -> odom
-// on tf, the particles on particlecloud and the estimate on pf_pose. All the
-// localization itself happens in pf_ros::ScanLocalizer and the core; this file
-// only moves messages, waits for tf and tells the user what is wrong.
+// on tf, the particles on particlecloud and the estimate on pf_pose and, for
+// amcl's users, amcl_pose. All the localization itself happens in
+// pf_ros::ScanLocalizer and the core; this file only moves messages, waits
+// for tf and tells the user what is wrong. It speaks amcl's interface too
+// (topics, services, parameter names, the pose saved to the parameter
+// server), so that it can replace amcl in an existing bringup.
 #include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <message_filters/subscriber.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <nav_msgs/Odometry.h>
+#include <nav_msgs/SetMap.h>
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
 #include <std_srvs/Empty.h>
@@ -18,8 +22,10 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <csignal>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "pf_localization/ros/conversions.h"
@@ -66,11 +72,16 @@ constexpr double kOdomSourceGrace = 0.5;
 // s a scan may be older than the previous one before time counts as jumping back.
 constexpr double kTimeJumpTolerance = 1.0;
 
+// Set by SIGINT; the running node saves its pose, then shuts down (see main()).
+volatile std::sig_atomic_t g_sigint = 0;
+volatile std::sig_atomic_t g_node_running = 0;
+
 class PfNode {
  public:
-  PfNode(const LocalizerConfig& config, ros::NodeHandle nh)
+  PfNode(const LocalizerConfig& config, ros::NodeHandle nh, ros::NodeHandle pnh)
       : config_(config),
         nh_(nh),
+        pnh_(pnh),
         buffer_(ros::Duration(30.0)),
         listener_(buffer_),
         localizer_(config, &buffer_),
@@ -87,12 +98,21 @@ class PfNode {
     map_sub_ = nh_.subscribe("map", 1, &PfNode::onMap, this);
     initial_pose_sub_ = nh_.subscribe("initialpose", 2, &PfNode::onInitialPose, this);
     pose_pub_ = nh_.advertise<geometry_msgs::PoseWithCovarianceStamped>("pf_pose", 2, true);
+    // amcl's name for the same message, so that its users' tools keep working.
+    amcl_pose_pub_ = nh_.advertise<geometry_msgs::PoseWithCovarianceStamped>("amcl_pose", 2, true);
     cloud_pub_ = nh_.advertise<geometry_msgs::PoseArray>("particlecloud", 2, true);
     global_srv_ = nh_.advertiseService("global_localization", &PfNode::onGlobalLocalization, this);
     nomotion_srv_ =
         nh_.advertiseService("request_nomotion_update", &PfNode::onNoMotionUpdate, this);
+    set_map_srv_ = nh_.advertiseService("set_map", &PfNode::onSetMap, this);
     tf_timer_ =
         nh_.createTimer(ros::Duration(1.0 / config.tf_publish_rate), &PfNode::onTfTimer, this);
+    if (config.save_pose_rate > 0.0) {
+      save_timer_ = nh_.createTimer(ros::Duration(1.0 / config.save_pose_rate),
+                                    [this](const ros::TimerEvent&) { savePose(); });
+    }
+    // Wall time: a paused bag clock must not keep Ctrl-C waiting.
+    sigint_timer_ = nh_.createWallTimer(ros::WallDuration(0.1), &PfNode::onSigintCheck, this);
     if (config.initial_pose) {
       ROS_INFO("pf_node: initial pose (%.3f, %.3f, %.3f) in %s; waiting for a map",
                config.initial_pose->x, config.initial_pose->y, config.initial_pose->yaw,
@@ -104,14 +124,27 @@ class PfNode {
 
  private:
   void onMap(const nav_msgs::OccupancyGridConstPtr& msg) {
-    const std::string error = localizer_.setMap(*msg);
-    if (!error.empty()) {
-      ROS_ERROR("pf_node: %s", error.c_str());
+    if (config_.first_map_only && have_map_) {
+      if (log_.due("first_map_only")) {
+        ROS_INFO("pf_node: first_map_only: ignoring a new map on %s (set_map still replaces it)",
+                 map_sub_.getTopic().c_str());
+      }
       return;
     }
-    ROS_INFO("pf_node: map %u x %u cells at %.3f m; %zu particles", msg->info.width,
-             msg->info.height, msg->info.resolution, localizer_.filter().particles().size());
-    publishEstimate(msg->header.stamp);
+    installMap(*msg);
+  }
+
+  bool installMap(const nav_msgs::OccupancyGrid& map) {
+    const std::string error = localizer_.setMap(map);
+    if (!error.empty()) {
+      ROS_ERROR("pf_node: %s", error.c_str());
+      return false;
+    }
+    have_map_ = true;
+    ROS_INFO("pf_node: map %u x %u cells at %.3f m; %zu particles", map.info.width, map.info.height,
+             map.info.resolution, localizer_.filter().particles().size());
+    publishEstimate(map.header.stamp, true);
+    return true;
   }
 
   void onOdom(const nav_msgs::OdometryConstPtr& msg) {
@@ -155,8 +188,9 @@ class PfNode {
       return;
     }
     const pf::UpdateReport& r = result.report;
+    last_odom_ = result.odom;
     if (r.updated) {
-      publishEstimate(scan->header.stamp);
+      publishEstimate(scan->header.stamp, false);
       ROS_DEBUG("pf_node: update with %d beams, %zu particles, ESS %.0f%s", r.beams_used,
                 r.particles, r.ess, r.resampled ? ", resampled" : "");
     } else if (r.skip_reason.rfind("not moved", 0) != 0) {
@@ -181,6 +215,7 @@ class PfNode {
         (last_scan_stamp_ - stamp).toSec(),
         config_.initial_pose ? "from the initial pose" : "with global localization");
     buffer_.clear();
+    last_odom_.reset();
     const std::string error = localizer_.restart();
     if (!error.empty()) ROS_WARN("pf_node: %s", error.c_str());
     last_scan_stamp_ = ros::Time();
@@ -198,22 +233,34 @@ class PfNode {
   }
 
   void onInitialPose(const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg) {
-    geometry_msgs::PoseWithCovarianceStamped pose = *msg;
+    applyInitialPose(*msg);
+  }
+
+  bool applyInitialPose(geometry_msgs::PoseWithCovarianceStamped pose) {
     if (pose.header.frame_id.empty()) {
       warn("initialpose frame",
            "initial pose with an empty frame_id: taken to be in " + config_.global_frame);
     } else if (pose.header.frame_id != config_.global_frame) {
-      if (!transformToGlobal(&pose)) return;
+      if (!transformToGlobal(&pose)) return false;
     }
     const std::string error = localizer_.setInitialPose(pose);
     if (!error.empty()) {
       warn("initialpose", error);
-      return;
+      return false;
     }
     const pf::Pose2 p = toPose2(pose.pose.pose);
     ROS_INFO("pf_node: re-initialised at (%.3f, %.3f, %.3f) in %s", p.x, p.y, p.yaw,
              config_.global_frame.c_str());
-    publishEstimate(msg->header.stamp);
+    publishEstimate(pose.header.stamp, true);
+    return true;
+  }
+
+  // amcl's set_map: a new map and the pose on it in one call (a robot moved
+  // to another floor). The map is installed even when first_map_only is set:
+  // that guards against map topic updates, not against an explicit request.
+  bool onSetMap(nav_msgs::SetMap::Request& req, nav_msgs::SetMap::Response& res) {
+    res.success = installMap(req.map) && applyInitialPose(req.initial_pose);
+    return true;
   }
 
   // An initial pose given in another frame (say odom, or base_link) is moved
@@ -248,7 +295,7 @@ class PfNode {
     }
     ROS_INFO("pf_node: global localization: %zu particles over the free space",
              localizer_.filter().particles().size());
-    publishEstimate(ros::Time::now());
+    publishEstimate(ros::Time::now(), true);
     return true;
   }
 
@@ -264,9 +311,49 @@ class PfNode {
     publishMapToOdom(std::max(now, last_scan_stamp_) + ros::Duration(config_.transform_tolerance));
   }
 
-  void publishEstimate(const ros::Time& stamp) {
-    if (const auto pose = localizer_.estimate(stamp)) pose_pub_.publish(*pose);
+  // `always`: a re-initialisation, shown even when gui_publish_rate would
+  // hold the cloud back (that limit is for the stream of updates).
+  void publishEstimate(const ros::Time& stamp, bool always) {
+    if (const auto pose = localizer_.estimate(stamp)) {
+      pose_pub_.publish(*pose);
+      amcl_pose_pub_.publish(*pose);
+    }
+    const double period = config_.gui_publish_rate > 0.0 ? 1.0 / config_.gui_publish_rate : 0.0;
+    const bool due = always || last_cloud_stamp_.isZero() || stamp < last_cloud_stamp_ ||
+                     (stamp - last_cloud_stamp_).toSec() >= period;
+    if (!due) return;
     cloud_pub_.publish(localizer_.particleCloud(stamp));
+    last_cloud_stamp_ = stamp;
+  }
+
+  // As amcl does: the pose goes to ~initial_pose_* and its variances to
+  // ~initial_cov_*, where readConfig finds them, so that a node restarted
+  // under the same master (respawn, a crash, a relaunch of this node alone)
+  // resumes where the robot is instead of starting over.
+  void savePose() {
+    const auto estimate = localizer_.estimate(ros::Time());
+    if (!estimate) return;
+    pf::Pose2 pose = toPose2(estimate->pose.pose);
+    // The estimate is as old as the last filter update; the odometry since
+    // then carries it to the robot's latest pose.
+    const auto map_to_odom = localizer_.filter().mapToOdom();
+    if (map_to_odom && last_odom_) pose = pf::compose(*map_to_odom, *last_odom_);
+    if (!pose.isFinite()) return;
+    pnh_.setParam("initial_pose_x", pose.x);
+    pnh_.setParam("initial_pose_y", pose.y);
+    pnh_.setParam("initial_pose_a", pose.yaw);
+    pnh_.setParam("initial_cov_xx", estimate->pose.covariance[0]);
+    pnh_.setParam("initial_cov_yy", estimate->pose.covariance[7]);
+    pnh_.setParam("initial_cov_aa", estimate->pose.covariance[35]);
+  }
+
+  // Ctrl-C (and roslaunch's shutdown) saves the latest pose before the node
+  // goes: the periodic save may be up to 1 / save_pose_rate old.
+  void onSigintCheck(const ros::WallTimerEvent&) {
+    if (!g_sigint) return;
+    // Without a master the save would block, waiting for one.
+    if (config_.save_pose_rate > 0.0 && ros::master::check()) savePose();
+    ros::shutdown();
   }
 
   void publishMapToOdom(const ros::Time& stamp) {
@@ -282,7 +369,7 @@ class PfNode {
   }
 
   LocalizerConfig config_;
-  ros::NodeHandle nh_;
+  ros::NodeHandle nh_, pnh_;
   tf2_ros::Buffer buffer_;
   tf2_ros::TransformListener listener_;
   tf2_ros::TransformBroadcaster broadcaster_;
@@ -291,11 +378,14 @@ class PfNode {
   tf2_ros::MessageFilter<sensor_msgs::LaserScan> scan_filter_;
   ros::Subscriber odom_sub_, map_sub_, initial_pose_sub_, tf_watch_sub_;
   bool odom_on_tf_ = false;
+  bool have_map_ = false;
   ros::Time first_odom_stamp_;
-  ros::Publisher pose_pub_, cloud_pub_;
-  ros::ServiceServer global_srv_, nomotion_srv_;
-  ros::Timer tf_timer_;
-  ros::Time last_scan_stamp_, last_tf_stamp_;
+  std::optional<pf::Pose2> last_odom_;  // odom -> base at the latest scan used
+  ros::Publisher pose_pub_, amcl_pose_pub_, cloud_pub_;
+  ros::ServiceServer global_srv_, nomotion_srv_, set_map_srv_;
+  ros::Timer tf_timer_, save_timer_;
+  ros::WallTimer sigint_timer_;
+  ros::Time last_scan_stamp_, last_tf_stamp_, last_cloud_stamp_;
   LimitedLog log_{5.0};
 };
 
@@ -303,16 +393,32 @@ class PfNode {
 }  // namespace pf_ros
 
 int main(int argc, char** argv) {
-  ros::init(argc, argv, "pf_node");
+  // roscpp's own SIGINT handler would shut down before the pose is saved.
+  ros::init(argc, argv, "pf_node", ros::init_options::NoSigintHandler);
+  std::signal(SIGINT, [](int) {
+    pf_ros::g_sigint = 1;
+    // Before the node runs (waiting for a master, say) there is nothing to
+    // save: stop at once, as roscpp's handler does.
+    if (!pf_ros::g_node_running) ros::requestShutdown();
+  });
   ros::NodeHandle nh, pnh("~");
   pf_ros::LocalizerConfig config;
   try {
-    config = pf_ros::readConfig(*pf_ros::rosParamSource(pnh));
+    // ~defaults (launch/amcl_compatible.launch loads config/pf.yaml there)
+    // sits under everything else, so that amcl's names in ~ override it.
+    std::unique_ptr<pf_ros::ParamSource> defaults;
+    if (pnh.hasParam("defaults"))
+      defaults = pf_ros::rosParamSource(ros::NodeHandle(pnh, "defaults"));
+    pf_ros::ConfigNotes notes;
+    config = pf_ros::readConfig(*pf_ros::rosParamSource(pnh), defaults.get(), &notes);
+    for (const std::string& w : notes.warnings) ROS_WARN("pf_node: %s", w.c_str());
+    for (const std::string& i : notes.infos) ROS_INFO("pf_node: %s", i.c_str());
   } catch (const std::exception& e) {
     ROS_FATAL("pf_node: refusing to start: %s", e.what());
     return 1;
   }
-  pf_ros::PfNode node(config, nh);
+  pf_ros::PfNode node(config, nh, pnh);
+  pf_ros::g_node_running = 1;
   ros::spin();
   return 0;
 }

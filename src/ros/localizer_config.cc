@@ -1,10 +1,15 @@
 #include "pf_localization/ros/localizer_config.h"
 
+#include <ros/console.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cmath>
+#include <set>
+#include <sstream>
 #include <stdexcept>
+
+#include "pf_localization/ros/amcl_params.h"
 
 namespace pf_ros {
 namespace {
@@ -42,6 +47,13 @@ class YamlParamSource : public TypedParamSource<YamlParamSource> {
     return true;
   }
 
+  std::vector<std::string> keys() const override {
+    std::vector<std::string> names;
+    if (!root_.IsMap()) return names;
+    for (const auto& entry : root_) names.push_back(entry.first.as<std::string>());
+    return names;
+  }
+
  private:
   YAML::Node root_;
   std::string path_;
@@ -60,12 +72,111 @@ class RosParamSource : public TypedParamSource<RosParamSource> {
     return true;
   }
 
+  std::vector<std::string> keys() const override {
+    // The master lists every parameter by its full name; ours are the first
+    // name component under the node's namespace (a nested ~a/b counts as a).
+    std::vector<std::string> all, names;
+    if (!nh_.getParamNames(all)) return names;
+    const std::string prefix = nh_.getNamespace() + "/";
+    for (const std::string& full : all) {
+      if (full.compare(0, prefix.size(), prefix) != 0) continue;
+      const std::string name =
+          full.substr(prefix.size(), full.find('/', prefix.size()) - prefix.size());
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+    }
+    return names;
+  }
+
  private:
   ros::NodeHandle nh_;
 };
 
 void require(bool ok, const std::string& name, const std::string& range) {
   if (!ok) throw std::invalid_argument("invalid parameter " + name + ": must be " + range);
+}
+
+template <typename T>
+std::string show(const T& value) {
+  std::ostringstream s;
+  s << std::boolalpha << value;
+  return s.str();
+}
+
+// Looks each setting up under our name and amcl's, in the user's source
+// before the defaults, and remembers every name asked for: whatever else the
+// source holds is reported as unknown (a misspelt name would otherwise be
+// silently ignored, the classic amcl configuration bug).
+class ParamReader {
+ public:
+  ParamReader(const ParamSource& source, const ParamSource* defaults, ConfigNotes* notes)
+      : source_(source), defaults_(defaults), notes_(notes) {}
+
+  /// The name the value was found under; empty when absent (value untouched).
+  template <typename T>
+  std::string get(const std::string& name, T* value) {
+    known_.insert(name);
+    const std::optional<std::string> alias = amclAliasOf(name);
+    if (alias) known_.insert(*alias);
+    for (const ParamSource* layer : {&source_, defaults_}) {
+      if (layer == nullptr) continue;
+      const bool ours = layer->get(name, value);
+      T amcl_value{};
+      if (alias && layer->get(*alias, &amcl_value)) {
+        if (!ours) {
+          *value = amcl_value;
+          return *alias;
+        }
+        notes_->warnings.push_back("both " + name + " (" + show(*value) + ") and amcl's " + *alias +
+                                   " (" + show(amcl_value) + ") are set: using " + name);
+      }
+      if (ours) return name;
+    }
+    return "";
+  }
+
+  /// Unknown names in the source, and the amcl parameters it sets that have no effect here.
+  void reportLeftovers() {
+    std::set<std::string> unused_amcl;
+    for (const AmclOnlyParam& p : amclOnlyParams()) {
+      if (known_.count(p.name)) continue;
+      if (present(p.name)) {
+        notes_->infos.push_back(std::string("amcl parameter ") + p.name + " ignored: " + p.why);
+      }
+      unused_amcl.insert(p.name);
+    }
+    std::string unknown;
+    for (const std::string& key : source_.keys()) {
+      // "defaults" is the namespace launch/amcl_compatible.launch loads config/pf.yaml into.
+      if (known_.count(key) || unused_amcl.count(key) || key == "defaults") continue;
+      unknown += (unknown.empty() ? "" : ", ") + key;
+    }
+    if (!unknown.empty()) {
+      notes_->warnings.push_back(
+          "unknown parameters ignored (misspelt?): " + unknown +
+          ". config/pf.yaml lists every parameter; README.md, \"Switching from amcl\", amcl's");
+    }
+  }
+
+ private:
+  // Whatever its type: a getter throws only for a name that is there.
+  bool present(const std::string& name) const {
+    std::string ignored;
+    try {
+      return source_.get(name, &ignored);
+    } catch (const std::invalid_argument&) {
+      return true;
+    }
+  }
+
+  const ParamSource& source_;
+  const ParamSource* defaults_;
+  ConfigNotes* notes_;
+  std::set<std::string> known_;
+};
+
+void logNotes(const ConfigNotes& notes) {
+  for (const std::string& w : notes.warnings) ROS_WARN("%s", w.c_str());
+  for (const std::string& i : notes.infos) ROS_INFO("%s", i.c_str());
 }
 
 }  // namespace
@@ -85,11 +196,20 @@ std::unique_ptr<ParamSource> rosParamSource(const ros::NodeHandle& nh) {
   return std::make_unique<RosParamSource>(nh);
 }
 
-LocalizerConfig readConfig(const ParamSource& p) {
+LocalizerConfig readConfig(const ParamSource& source, const ParamSource* defaults,
+                           ConfigNotes* notes) {
+  ConfigNotes own_notes;
+  ConfigNotes* out = notes != nullptr ? notes : &own_notes;
+  ParamReader p(source, defaults, out);
   LocalizerConfig c;
   p.get("global_frame", &c.global_frame);
   p.get("odom_frame", &c.odom_frame);
   p.get("base_frame", &c.base_frame);
+  // tf2 refuses frame ids with a leading slash, which tf (and so many amcl
+  // configurations) used; amcl strips it too.
+  for (std::string* frame : {&c.global_frame, &c.odom_frame, &c.base_frame}) {
+    if (!frame->empty() && frame->front() == '/') frame->erase(0, 1);
+  }
   p.get("tf_broadcast", &c.tf_broadcast);
   p.get("transform_tolerance", &c.transform_tolerance);
   p.get("tf_publish_rate", &c.tf_publish_rate);
@@ -115,7 +235,14 @@ LocalizerConfig readConfig(const ParamSource& p) {
   p.get("min_particles", &f.kld.min_particles);
   p.get("max_particles", &f.kld.max_particles);
   p.get("kld_err", &f.kld.kld_err);
-  p.get("kld_confidence", &f.kld.confidence);
+  double kld = f.kld.confidence;
+  if (p.get("kld_confidence", &kld) == "kld_z") {
+    const double z = kld;
+    kld = kldConfidenceFromZ(z);
+    require(std::isfinite(z) && kld > 0.0 && kld < 1.0, "kld_z",
+            "a finite normal quantile between -8 and 8 (amcl's default: 0.99)");
+  }
+  f.kld.confidence = kld;
   p.get("kld_bin_xy", &f.kld.bin_xy);
   p.get("kld_bin_yaw", &f.kld.bin_yaw);
   p.get("update_min_d", &f.update_min_d);
@@ -131,7 +258,7 @@ LocalizerConfig readConfig(const ParamSource& p) {
   p.get("confidence_localized_std_yaw", &f.confidence.localized_std_yaw);
   p.get("confidence_rival_weight_ratio", &f.confidence.rival_weight_ratio);
   int seed = 0;
-  if (p.get("seed", &seed)) {
+  if (!p.get("seed", &seed).empty()) {
     require(seed >= 0, "seed", ">= 0");
     f.seed = static_cast<uint64_t>(seed);
   }
@@ -169,6 +296,25 @@ LocalizerConfig readConfig(const ParamSource& p) {
   // amcl spells "use the scan's own limit" as -1; accept that spelling too.
   f.sensor.range_min = std::max(f.sensor.range_min, 0.0);
   f.sensor.range_max = std::max(f.sensor.range_max, 0.0);
+  std::string laser_model = "likelihood_field";
+  p.get("laser_model_type", &laser_model);
+  const std::string laser_model_error = laserModelTypeError(laser_model);
+  if (!laser_model_error.empty()) throw std::invalid_argument(laser_model_error);
+
+  p.get("gui_publish_rate", &c.gui_publish_rate);
+  p.get("save_pose_rate", &c.save_pose_rate);
+  p.get("first_map_only", &c.first_map_only);
+  bool use_map_topic = true;
+  if (!p.get("use_map_topic", &use_map_topic).empty() && !use_map_topic && !c.first_map_only) {
+    // amcl then asks map_server's static_map service once and never updates
+    // its map. map_server publishes the same map latched on the map topic, so
+    // taking the first map from there and keeping it behaves the same.
+    c.first_map_only = true;
+    out->infos.push_back(
+        "use_map_topic is false: as amcl then does, the first map is kept (it is read from the "
+        "map topic, which map_server and map_publisher latch, instead of the static_map service)");
+  }
+  p.reportLeftovers();
 
   require(!c.global_frame.empty(), "global_frame", "a frame name");
   require(!c.odom_frame.empty(), "odom_frame", "a frame name");
@@ -177,7 +323,10 @@ LocalizerConfig readConfig(const ParamSource& p) {
           "transform_tolerance", ">= 0 (s)");
   require(c.tf_publish_rate > 0.0 && std::isfinite(c.tf_publish_rate), "tf_publish_rate",
           "> 0 (Hz)");
+  require(std::isfinite(c.gui_publish_rate), "gui_publish_rate", "finite (Hz; <= 0: no limit)");
+  require(std::isfinite(c.save_pose_rate), "save_pose_rate", "finite (Hz; <= 0: never)");
   pf::validate(f);
+  if (notes == nullptr) logNotes(own_notes);
   return c;
 }
 

@@ -1,7 +1,8 @@
 // Every tunable of the localizer, read from one place, with the same names in
 // config/pf.yaml, on the ROS parameter server and in pf_bag_runner's
 // --params file. Each parameter's meaning, unit and default is documented in
-// config/pf.yaml.
+// config/pf.yaml. amcl's names for the same settings are accepted too (see
+// amcl_params.h), so that an amcl configuration works unchanged.
 #pragma once
 
 #include <ros/node_handle.h>
@@ -10,6 +11,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "pf_localization/core/particle_filter.h"
 
@@ -25,6 +27,19 @@ struct LocalizerConfig {
   std::optional<pf::Pose2> initial_pose;  // none: global localization
   Eigen::Matrix3d initial_cov = Eigen::Vector3d(0.25, 0.25, 0.0685).asDiagonal();
   pf::ParticleFilterParams filter;
+
+  // pf_node only: pf_bag_runner has neither topics to throttle nor a
+  // parameter server to save to.
+  double gui_publish_rate = -1.0;  // Hz limit of particlecloud; <= 0: after every update
+  double save_pose_rate = 0.5;     // Hz the estimate is saved to ~initial_pose_*; <= 0: never
+  bool first_map_only = false;     // keep the first map; ignore later ones on the map topic
+};
+
+/// What readConfig has to tell besides errors: amcl parameters that are
+/// ignored and why, a setting given under both names, unknown names.
+struct ConfigNotes {
+  std::vector<std::string> warnings;
+  std::vector<std::string> infos;
 };
 
 /// Where parameters come from: the ROS parameter server, or a YAML file.
@@ -36,6 +51,9 @@ class ParamSource {
   virtual bool get(const std::string& key, int* value) const = 0;
   virtual bool get(const std::string& key, bool* value) const = 0;
   virtual bool get(const std::string& key, std::string* value) const = 0;
+  /// The names present at the top level, for the unknown-parameter warning
+  /// (a source that cannot list them returns none, and nothing is warned about).
+  virtual std::vector<std::string> keys() const { return {}; }
 };
 
 /// A ParamSource over a flat YAML mapping (config/pf.yaml's format).
@@ -47,6 +65,16 @@ std::unique_ptr<ParamSource> rosParamSource(const ros::NodeHandle& nh);
 
 /// Reads every parameter (absent ones keep their defaults) and validates the
 /// result. Throws std::invalid_argument naming the parameter and its valid range.
-LocalizerConfig readConfig(const ParamSource& source);
+///
+/// Each setting is looked up under our name, then under amcl's (odom_frame_id,
+/// kld_z, ...): in `source` first, then in `defaults` (optional). So amcl's
+/// name in `source` overrides our name in `defaults`, which is how
+/// launch/amcl_compatible.launch puts config/pf.yaml under an amcl
+/// configuration. Both names in the same source: ours wins, with a warning.
+///
+/// `notes` receives the warnings and information for the user; without it
+/// they are logged through rosconsole.
+LocalizerConfig readConfig(const ParamSource& source, const ParamSource* defaults = nullptr,
+                           ConfigNotes* notes = nullptr);
 
 }  // namespace pf_ros
