@@ -20,6 +20,7 @@ packages=(
   # tests and benchmarks
   libgtest-dev libgmock-dev librostest-dev python3-rostest python3-rosunit libbenchmark-dev
   python3-std-srvs python3-geometry-msgs python3-nav-msgs python3-sensor-msgs python3-tf2-msgs
+  python3-diagnostic-msgs
   python3-tf2-ros
   # evaluation reports
   python3-numpy python3-matplotlib python3-pil python3-yaml

@@ -1,6 +1,7 @@
 #include "pf_localization/core/confidence.h"
 
 #include <cmath>
+#include <iomanip>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
@@ -66,7 +67,7 @@ Confidence assessConfidence(const ParticleSet& particles, const PoseEstimate& es
   }
 
   std::ostringstream why;
-  why.precision(2);
+  why << std::fixed << std::setprecision(0);
   if (hit_fraction < params.lost_hit_fraction) {
     c.state = LocalizationState::kLost;
     why << "only " << 100.0 * hit_fraction << " % of the beams fit the map at the estimate";
@@ -79,8 +80,8 @@ Confidence assessConfidence(const ParticleSet& particles, const PoseEstimate& es
   } else if (std::max(c.std_x, c.std_y) > params.localized_std_xy ||
              c.std_yaw > params.localized_std_yaw) {
     c.state = LocalizationState::kUncertain;
-    why << "the particles are spread (std " << std::max(c.std_x, c.std_y) << " m, "
-        << c.std_yaw * 180.0 / M_PI << " deg)";
+    why << "the particles are spread (std " << std::setprecision(2) << std::max(c.std_x, c.std_y)
+        << " m, " << std::setprecision(0) << c.std_yaw * 180.0 / M_PI << " deg)";
   } else {
     c.state = LocalizationState::kLocalized;
     why << 100.0 * hit_fraction << " % of the beams fit, one hypothesis";

@@ -7,6 +7,7 @@
 // for tf and tells the user what is wrong. It speaks amcl's interface too
 // (topics, services, parameter names, the pose saved to the parameter
 // server), so that it can replace amcl in an existing bringup.
+#include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <message_filters/subscriber.h>
@@ -29,6 +30,7 @@
 #include <string>
 
 #include "pf_localization/ros/conversions.h"
+#include "pf_localization/ros/diagnostics.h"
 #include "pf_localization/ros/localizer_config.h"
 #include "pf_localization/ros/scan_localizer.h"
 
@@ -101,6 +103,11 @@ class PfNode {
     // amcl's name for the same message, so that its users' tools keep working.
     amcl_pose_pub_ = nh_.advertise<geometry_msgs::PoseWithCovarianceStamped>("amcl_pose", 2, true);
     cloud_pub_ = nh_.advertise<geometry_msgs::PoseArray>("particlecloud", 2, true);
+    // How far to trust the estimate, after every update: the standard
+    // /diagnostics for robot monitors, and pf_status for anything that only
+    // wants this node's verdict.
+    diagnostics_pub_ = nh_.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 5);
+    status_pub_ = nh_.advertise<diagnostic_msgs::DiagnosticStatus>("pf_status", 5, true);
     global_srv_ = nh_.advertiseService("global_localization", &PfNode::onGlobalLocalization, this);
     nomotion_srv_ =
         nh_.advertiseService("request_nomotion_update", &PfNode::onNoMotionUpdate, this);
@@ -187,10 +194,12 @@ class PfNode {
       warn(result.error.substr(0, 24), result.error);
       return;
     }
+    if (!result.warning.empty()) warn("scan inconsistent", result.warning);
     const pf::UpdateReport& r = result.report;
     last_odom_ = result.odom;
     if (r.updated) {
       publishEstimate(scan->header.stamp, false);
+      publishConfidence(scan->header.stamp, r);
       ROS_DEBUG("pf_node: update with %d beams, %zu particles, ESS %.0f%s", r.beams_used,
                 r.particles, r.ess, r.resampled ? ", resampled" : "");
     } else if (r.skip_reason.rfind("not moved", 0) != 0) {
@@ -311,6 +320,24 @@ class PfNode {
     publishMapToOdom(std::max(now, last_scan_stamp_) + ros::Duration(config_.transform_tolerance));
   }
 
+  void publishConfidence(const ros::Time& stamp, const pf::UpdateReport& report) {
+    const std::string name = ros::this_node::getName() + ": localization";
+    diagnostic_msgs::DiagnosticArray array;
+    array.header.stamp = stamp;
+    array.status.push_back(toDiagnosticStatus(localizer_.filter(), report, name));
+    diagnostics_pub_.publish(array);
+    status_pub_.publish(array.status.front());
+    // A change of state is news; the same state on every scan is not.
+    const pf::Confidence& c = localizer_.filter().confidence();
+    if (c.state == last_state_) return;
+    last_state_ = c.state;
+    if (c.state == pf::LocalizationState::kLocalized) {
+      ROS_INFO("pf_node: localized: %s", c.reason.c_str());
+    } else {
+      ROS_WARN("pf_node: %s: %s", pf::toString(c.state), c.reason.c_str());
+    }
+  }
+
   // `always`: a re-initialisation, shown even when gui_publish_rate would
   // hold the cloud back (that limit is for the stream of updates).
   void publishEstimate(const ros::Time& stamp, bool always) {
@@ -381,7 +408,8 @@ class PfNode {
   bool have_map_ = false;
   ros::Time first_odom_stamp_;
   std::optional<pf::Pose2> last_odom_;  // odom -> base at the latest scan used
-  ros::Publisher pose_pub_, amcl_pose_pub_, cloud_pub_;
+  ros::Publisher pose_pub_, amcl_pose_pub_, cloud_pub_, diagnostics_pub_, status_pub_;
+  std::optional<pf::LocalizationState> last_state_;
   ros::ServiceServer global_srv_, nomotion_srv_, set_map_srv_;
   ros::Timer tf_timer_, save_timer_;
   ros::WallTimer sigint_timer_;

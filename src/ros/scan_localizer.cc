@@ -148,7 +148,9 @@ std::optional<geometry_msgs::PoseWithCovarianceStamped> ScanLocalizer::estimate(
   msg.header.stamp = stamp;
   msg.header.frame_id = config_.global_frame;
   msg.pose.pose = toPoseMsg(filter_.estimate().pose);
-  msg.pose.covariance = toRosCovariance(filter_.estimate().covariance);
+  // The confidence's covariance: the whole cloud's when rival hypotheses
+  // exist, so that an ambiguous estimate never looks precise.
+  msg.pose.covariance = toRosCovariance(filter_.confidence().covariance);
   return msg;
 }
 
