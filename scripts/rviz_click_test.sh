@@ -53,14 +53,9 @@ for tool in rviz Xvfb xdotool xwininfo import; do
     exit 2
   fi
 done
-if [ ! -f "$ws/devel/setup.bash" ]; then
-  echo "rviz_click_test: no workspace at $ws: build first (bash scripts/build.sh)" >&2
-  exit 2
-fi
-set +u  # catkin's setup scripts read unset variables
-# shellcheck disable=SC1091
-source "$ws/devel/setup.bash"
-set -u
+# shellcheck source=scripts/workspace.bash
+source "$repo/scripts/workspace.bash"
+pf_source_workspace "$ws" rviz_click_test || exit 2
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
 

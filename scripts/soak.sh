@@ -39,14 +39,9 @@ read -r px py pa <<<"$pose"
 mark=300  # s of simulated time at which the reference RSS is taken
 
 export PATH=/usr/bin:$PATH
-if [ ! -f "$ws/devel/setup.bash" ]; then
-  echo "soak: no workspace at $ws: run scripts/build.sh first (or set PF_WS)" >&2
-  exit 2
-fi
-set +u  # ROS's setup scripts read unset variables
-# shellcheck disable=SC1091
-source "$ws/devel/setup.bash"
-set -u
+# shellcheck source=scripts/workspace.bash
+source "$repo/scripts/workspace.bash"
+pf_source_workspace "$ws" soak || exit 2
 
 tmp=$(mktemp -d /tmp/pf_soak.XXXXXX)
 port=$((20000 + RANDOM % 20000))

@@ -26,11 +26,9 @@ check() {  # check NAME COMMAND...: a source check counted as one test
 
 # --- GoogleTest and rostest, through catkin ---------------------------------
 bash scripts/build.sh run_tests -j1 2>&1 | tee "$ws/run_tests.log" | grep -E "^\[ *(OK|FAILED|PASSED) *\]|^\[ROSTEST\]|^\[Testcase|FAILURE|Error" || true
-# catkin's setup scripts read unset variables.
-set +u
-# shellcheck disable=SC1091
-source "$ws/devel/setup.bash"
-set -u
+# shellcheck source=scripts/workspace.bash
+source scripts/workspace.bash
+pf_source_workspace "$ws" test || failed=$((failed + 1))
 catkin_test_results "$ws/build/test_results" 2>&1 | grep -vE "^Skipping" | tail -n 20
 read -r ok bad < <(/usr/bin/python3 scripts/count_test_results.py "$ws/build/test_results")
 passed=$((passed + ${ok:-0}))

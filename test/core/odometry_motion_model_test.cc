@@ -9,16 +9,16 @@
 #include <string>
 #include <vector>
 
+#include "expect_pose.h"
+
 namespace pf {
 namespace {
 
 constexpr double kTol = 1e-12;
 
-void expectPoseNear(const Pose2& expected, const Pose2& actual, double tol = kTol) {
-  EXPECT_NEAR(expected.x, actual.x, tol);
-  EXPECT_NEAR(expected.y, actual.y, tol);
-  EXPECT_NEAR(0.0, angleDiff(expected.yaw, actual.yaw), tol)
-      << "yaw " << actual.yaw << ", expected " << expected.yaw;
+// A moved particle: the pose, and a yaw kept in (-pi, pi].
+void expectMovedTo(const Pose2& expected, const Pose2& actual, double tol = kTol) {
+  expectPoseNear(expected, actual, tol);
   EXPECT_GT(actual.yaw, -M_PI);
   EXPECT_LE(actual.yaw, M_PI);
 }
@@ -122,10 +122,10 @@ TEST(ApplyNoiseless, ForwardMovesEveryParticleAlongItsHeading) {
   // The odometry frame differs from the map frame: only the relative motion
   // (1 m forward) matters.
   model.apply({10, 10, 0}, {11, 10, 0}, &p, &random);
-  expectPoseNear({1, 0, 0}, p.pose(0));
-  expectPoseNear({1, 2, M_PI / 2}, p.pose(1));
-  expectPoseNear({-3, 3, M_PI}, p.pose(2));
-  expectPoseNear({0.5, -1.5, -M_PI / 2}, p.pose(3));
+  expectMovedTo({1, 0, 0}, p.pose(0));
+  expectMovedTo({1, 2, M_PI / 2}, p.pose(1));
+  expectMovedTo({-3, 3, M_PI}, p.pose(2));
+  expectMovedTo({0.5, -1.5, -M_PI / 2}, p.pose(3));
   // Weights are not the motion model's business.
   for (double w : p.weight) EXPECT_EQ(0.25, w);
 }
@@ -135,9 +135,9 @@ TEST(ApplyNoiseless, BackwardMovesEveryParticleBackwards) {
   ParticleSet p = particlesAt({{0, 0, 0}, {1, 1, M_PI / 2}, {-2, 3, M_PI}});
   Random random(1);
   model.apply({0, 0, 0}, {-1, 0, 0}, &p, &random);
-  expectPoseNear({-1, 0, 0}, p.pose(0));
-  expectPoseNear({1, 0, M_PI / 2}, p.pose(1));
-  expectPoseNear({-1, 3, M_PI}, p.pose(2));
+  expectMovedTo({-1, 0, 0}, p.pose(0));
+  expectMovedTo({1, 0, M_PI / 2}, p.pose(1));
+  expectMovedTo({-1, 3, M_PI}, p.pose(2));
 }
 
 TEST(ApplyNoiseless, PureRotationAcrossPi) {
@@ -170,7 +170,7 @@ TEST(ApplyNoiseless, EqualsComposingTheOdometryDelta) {
       const Pose2 start{coord(rng), coord(rng), angle(rng)};
       ParticleSet p = particlesAt({start});
       model.apply(from, to, &p, &random);
-      expectPoseNear(compose(start, delta), p.pose(0), 1e-9);
+      expectMovedTo(compose(start, delta), p.pose(0), 1e-9);
     }
   }
 }
@@ -182,15 +182,15 @@ TEST(ApplyNoiseless, OmniMovesSideways) {
   // 1 m to the robot's left without turning: for a particle facing +y that is
   // 1 m towards -x.
   model.apply({0, 0, 0}, {0, 1, 0}, &p, &random);
-  expectPoseNear({0, 1, M_PI / 2}, p.pose(0));
-  expectPoseNear({0, 1, 0}, p.pose(1));
+  expectMovedTo({0, 1, M_PI / 2}, p.pose(0));
+  expectMovedTo({0, 1, 0}, p.pose(1));
   // Diagonally while turning a quarter: (1, 1) in the robot frame.
   model.apply({0, 0, 0}, {1, 1, M_PI / 2}, &p, &random);
-  expectPoseNear({-1, 2, M_PI}, p.pose(0));
-  expectPoseNear({1, 2, M_PI / 2}, p.pose(1));
+  expectMovedTo({-1, 2, M_PI}, p.pose(0));
+  expectMovedTo({1, 2, M_PI / 2}, p.pose(1));
   // In-place rotation across pi.
   model.apply({0, 0, M_PI - 0.1}, {0, 0, -M_PI + 0.1}, &p, &random);
-  expectPoseNear({-1, 2, -M_PI + 0.2}, p.pose(0));
+  expectMovedTo({-1, 2, -M_PI + 0.2}, p.pose(0));
 }
 
 // --- apply with noise ---------------------------------------------------------

@@ -5,17 +5,12 @@
 #include <cmath>
 #include <random>
 
+#include "expect_pose.h"
+
 namespace pf {
 namespace {
 
 constexpr double kTol = 1e-12;
-
-void expectPoseNear(const Pose2& expected, const Pose2& actual, double tol = kTol) {
-  EXPECT_NEAR(expected.x, actual.x, tol);
-  EXPECT_NEAR(expected.y, actual.y, tol);
-  EXPECT_NEAR(0.0, angleDiff(expected.yaw, actual.yaw), tol)
-      << "yaw " << actual.yaw << ", expected " << expected.yaw;
-}
 
 // The (-pi, pi] contract.
 void expectInRange(double a) {
