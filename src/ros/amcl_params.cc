@@ -40,6 +40,9 @@ std::string laserModelTypeError(const std::string& type) {
 }
 
 const std::vector<AmclOnlyParam>& amclOnlyParams() {
+  static const char* const kStdWarnWhy =
+      "thresholds of amcl's standard-deviation diagnostic; pf_node's /diagnostics use "
+      "confidence_localized_std_xy and confidence_localized_std_yaw instead";
   static const std::vector<AmclOnlyParam> params = {
       {"resample_interval",
        "amcl resamples every N updates; this filter resamples when the effective sample size "
@@ -60,9 +63,9 @@ const std::vector<AmclOnlyParam>& amclOnlyParams() {
       // amcl reads this misspelling first; configurations written for it exist.
       {"beam_skip_error_threshold_",
        "beam skipping (amcl's likelihood_field_prob) is not implemented"},
-      {"std_warn_level_x", "amcl's diagnostics thresholds; pf_node publishes no diagnostics"},
-      {"std_warn_level_y", "amcl's diagnostics thresholds; pf_node publishes no diagnostics"},
-      {"std_warn_level_yaw", "amcl's diagnostics thresholds; pf_node publishes no diagnostics"},
+      {"std_warn_level_x", kStdWarnWhy},
+      {"std_warn_level_y", kStdWarnWhy},
+      {"std_warn_level_yaw", kStdWarnWhy},
       {"bag_scan_period", "for amcl --run-from-bag; pf_bag_runner replays a bag instead"},
       {"restore_defaults", "a dynamic_reconfigure action; pf_node reads its parameters at start"},
   };
