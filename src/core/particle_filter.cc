@@ -68,6 +68,12 @@ void validate(const ParticleFilterParams& p) {
           "in [0, 1]", p.recovery.alpha_fast);
   require(p.recovery.trigger_ratio > 0.0 && p.recovery.trigger_ratio <= 1.0,
           "recovery_trigger_ratio", "in (0, 1]", p.recovery.trigger_ratio);
+  require(p.recovery.expansion_ratio >= 0.0 && p.recovery.expansion_ratio < 1.0,
+          "recovery_expansion_ratio", "in [0, 1)", p.recovery.expansion_ratio);
+  require(p.recovery.expansion_std_xy >= 0.0 && finite(p.recovery.expansion_std_xy),
+          "recovery_expansion_std_xy", ">= 0", p.recovery.expansion_std_xy);
+  require(p.recovery.expansion_std_yaw >= 0.0 && finite(p.recovery.expansion_std_yaw),
+          "recovery_expansion_std_yaw", ">= 0", p.recovery.expansion_std_yaw);
   require(p.recovery.alpha_slow == 0.0 || p.recovery.alpha_fast > p.recovery.alpha_slow,
           "recovery_alpha_fast", "> recovery_alpha_slow when recovery is on",
           p.recovery.alpha_fast);
@@ -312,6 +318,8 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
   }
   report->mean_beam_likelihood = mean_beam;
 
+  expand_ = params_.recovery.expansion_ratio > 0.0 && w_slow_ > 0.0 &&
+            mean_beam < params_.recovery.expansion_ratio * w_slow_;
   if (params_.recovery.alpha_slow > 0.0) {
     if (w_slow_ == 0.0) {
       w_slow_ = w_fast_ = mean_beam;
@@ -332,7 +340,9 @@ void ParticleFilter::resample(UpdateReport* report) {
   const double usual = params_.recovery.trigger_ratio * w_slow_;
   const double inject_probability = usual > 0.0 ? std::max(0.0, 1.0 - w_fast_ / usual) : 0.0;
   const std::size_t n = particles_.size();
-  if (report->ess >= params_.resample_ess_fraction * n && inject_probability < 0.01) return;
+  if (report->ess >= params_.resample_ess_fraction * n && inject_probability < 0.01 && !expand_) {
+    return;
+  }
 
   const std::size_t target = kldParticleCount(particles_, params_.kld);
   // Random particles are spread over the whole map, so they are counted
@@ -345,6 +355,15 @@ void ParticleFilter::resample(UpdateReport* report) {
       max - injected, static_cast<std::size_t>(std::ceil((1.0 - inject_probability) * target)));
   systematicResample(particles_, kept, &random_, &spare_);
   std::swap(particles_, spare_);
+  if (expand_) {
+    const RecoveryParams& r = params_.recovery;
+    for (std::size_t i = 0; i < kept; ++i) {
+      particles_.x[i] += random_.gaussian(r.expansion_std_xy);
+      particles_.y[i] += random_.gaussian(r.expansion_std_xy);
+      particles_.yaw[i] = normalizeAngle(particles_.yaw[i] + random_.gaussian(r.expansion_std_yaw));
+    }
+    report->expanded = true;
+  }
   particles_.resize(kept + injected);
   for (std::size_t i = kept; i < kept + injected; ++i) particles_.setPose(i, randomFreePose());
   particles_.setUniformWeights();

@@ -267,6 +267,9 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
   p.get("recovery_alpha_slow", &f.recovery.alpha_slow);
   p.get("recovery_alpha_fast", &f.recovery.alpha_fast);
   p.get("recovery_trigger_ratio", &f.recovery.trigger_ratio);
+  p.get("recovery_expansion_ratio", &f.recovery.expansion_ratio);
+  p.get("recovery_expansion_std_xy", &f.recovery.expansion_std_xy);
+  p.get("recovery_expansion_std_yaw", &f.recovery.expansion_std_yaw);
 
   std::string odom_model = "diff";
   p.get("odom_model_type", &odom_model);

@@ -404,7 +404,43 @@ ParticleFilterParams exactParams() {
   p.kld.min_particles = 10;
   p.kld.max_particles = 10;
   p.motion.alpha1 = p.motion.alpha2 = p.motion.alpha3 = p.motion.alpha4 = p.motion.alpha5 = 0.0;
+  // Nor may recovery: the scans below deliberately disagree with the motion.
+  p.recovery.alpha_slow = p.recovery.alpha_fast = 0.0;
+  p.recovery.expansion_ratio = 0.0;
   return p;
+}
+
+TEST(ParticleFilterUpdate, ACollapsedFitSpreadsTheSurvivors) {
+  // Expansion resetting: tracking well at `start`, then the robot is pushed
+  // 0.5 m sideways without odometry seeing it. That scan fits far worse than
+  // usual, and the resampled particles are spread to search nearby.
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilterParams params = exactParams();
+  params.kld.min_particles = params.kld.max_particles = 500;
+  params.recovery.expansion_ratio = 0.3;
+  params.recovery.expansion_std_xy = 0.3;
+  params.recovery.alpha_slow = 0.01;
+  params.recovery.alpha_fast = 0.2;
+  params.update_min_d = params.update_min_a = 0.0;
+  ParticleFilter filter(params);
+  filter.setMap(grid);
+  const Pose2 start{1.0, 1.5, 0.2};
+  filter.initializeGaussian(start, Eigen::Matrix3d::Zero());
+  const LaserScan scan = simulateScan(grid, start);
+  for (int k = 0; k < 3; ++k) {
+    const UpdateReport r = filter.update({0.0, 0.0, 0.0}, scan);
+    ASSERT_TRUE(r.updated);
+    EXPECT_FALSE(r.expanded) << "update " << k;
+  }
+  const UpdateReport pushed = filter.update({0.0, 0.0, 0.0}, simulateScan(grid, {1.0, 2.0, 0.2}));
+  ASSERT_TRUE(pushed.updated);
+  EXPECT_TRUE(pushed.expanded);
+  double spread = 0.0;
+  for (std::size_t i = 0; i < filter.particles().size(); ++i) {
+    spread = std::max(
+        spread, std::hypot(filter.particles().x[i] - start.x, filter.particles().y[i] - start.y));
+  }
+  EXPECT_GT(spread, 0.5);  // all particles sat exactly at `start` before
 }
 
 TEST(ParticleFilterUpdate, MotionIsAppliedFromTheLastUpdateOnly) {

@@ -46,6 +46,15 @@ struct RecoveryParams {
   double alpha_slow = 0.01;    // long-term average rate, per update (0 disables recovery)
   double alpha_fast = 0.2;     // short-term average rate, per update
   double trigger_ratio = 0.7;  // (0, 1]: 1 injects on any dip, as amcl does
+  // Expansion resetting (Ueda et al., "Expansion resetting for recovery
+  // from fatal error in Monte Carlo localization", IROS 2004): when a single
+  // scan fits below expansion_ratio times the long-term average, the robot
+  // has probably slipped or been pushed a little, and the survivors of the
+  // next resampling are spread by these standard deviations, which finds it
+  // again nearby long before random particles would. 0 disables.
+  double expansion_ratio = 0.3;    // [0, 1)
+  double expansion_std_xy = 0.3;   // m
+  double expansion_std_yaw = 0.3;  // rad
 };
 
 struct ParticleFilterParams {
@@ -85,6 +94,7 @@ struct UpdateReport {
   double mean_beam_likelihood = 0.0;  // geometric mean over beams, weighted over particles
   std::size_t injected = 0;           // random particles added by recovery
   double tempering = 1.0;             // exponent applied to this scan's likelihood (1: none)
+  bool expanded = false;              // the survivors were spread by expansion resetting
 };
 
 class ParticleFilter {
@@ -148,6 +158,7 @@ class ParticleFilter {
   bool has_estimate_ = false;
   double w_slow_ = 0.0;
   double w_fast_ = 0.0;
+  bool expand_ = false;  // this scan's fit collapsed: spread the survivors
   std::vector<double> scratch_;
   std::vector<double> log_prior_;
   std::vector<double> log_likelihood_;
