@@ -339,13 +339,22 @@ int8_t cellValue(int color_sum, int channels, const MapMetadata& meta) {
 }
 
 std::string readFile(const std::string& path, const char* what) {
+  // A directory opens as a stream on Linux and then throws on the first read.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) {
+    throw MapLoadError(path + ": the " + std::string(what) + " is a directory, not a file");
+  }
   std::ifstream in(path, std::ios::binary);
   if (!in) {
     throw MapLoadError(path + ": cannot open " + what + " (" + std::strerror(errno) + ")");
   }
-  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  if (in.bad()) throw MapLoadError(path + ": error while reading " + what);
-  return bytes;
+  try {
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    if (in.bad()) throw MapLoadError(path + ": error while reading " + what);
+    return bytes;
+  } catch (const std::ios_base::failure& e) {
+    throw MapLoadError(path + ": error while reading " + what + " (" + e.what() + ")");
+  }
 }
 
 // Plain when that is unambiguous (as map_saver writes it), else double-quoted.

@@ -50,4 +50,8 @@ TEST(FuzzReplay, MapLoaderSeedCorpus) {
 
 TEST(FuzzReplay, FixedCoreCrashes) { replay(inputs("crashes", "fuzz_core-"), FuzzCoreOneInput); }
 
+TEST(FuzzReplay, FixedMapLoaderCrashes) {
+  replay(inputs("crashes", "fuzz_map_loader-"), FuzzMapLoaderOneInput);
+}
+
 }  // namespace
