@@ -215,10 +215,7 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
                            " m): treated as an odometry fault, particles not moved";
       return report;
     }
-  }
-  if (!first && !force_update_) {
-    const Pose2 delta = between(*odom_at_update_, odom);
-    if (std::hypot(delta.x, delta.y) < params_.update_min_d &&
+    if (!force_update_ && step < params_.update_min_d &&
         std::fabs(delta.yaw) < params_.update_min_a) {
       report.skip_reason = "not moved enough since the last update";
       return report;
