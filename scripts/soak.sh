@@ -122,13 +122,15 @@ play_pid=$!
 pids+=($play_pid)
 
 rss() { awk '/^VmRSS/ {print $2}' "/proc/$1/status" 2>/dev/null; }
+# Anonymous (heap, stacks) and file-backed (code, mapped files) parts of the RSS.
+rss_parts() { awk '/^RssAnon/ {a = $2} /^RssFile/ {f = $2} END {print a + 0, f + 0}' "/proc/$1/status" 2>/dev/null; }
 start=$(date +%s)
 rss_mark=""
 died=0
 last_print=0
 samples=$tmp/samples.txt
 : >"$samples"
-printf 'soak: %6s %8s %10s %8s %6s\n' wall_s sim_s rss_kB pf_pose loops
+printf 'soak: %6s %8s %10s %10s %10s %8s %6s\n' wall_s sim_s rss_kB anon_kB file_kB pf_pose loops
 while :; do
   sleep 1
   now=$(($(date +%s) - start))
@@ -139,12 +141,14 @@ while :; do
     echo "soak: pf_node (pid $node_pid) died at ${sim} s of simulated time"
     break
   fi
-  echo "$now $sim $r $poses $jumps" >>"$samples"
+  read -r anon file <<<"$(rss_parts "$node_pid")"
+  echo "$now $sim $r $poses $jumps $anon $file" >>"$samples"
   if [ -z "$rss_mark" ] && awk -v s="$sim" -v m="$mark" 'BEGIN {exit !(s >= m)}'; then
     rss_mark=$r
+    cp "/proc/$node_pid/smaps" "$tmp/smaps.mark" 2>/dev/null
   fi
   if [ $((now - last_print)) -ge 10 ]; then
-    printf 'soak: %6d %8.0f %10d %8d %6d\n' "$now" "$sim" "$r" "$poses" "$jumps"
+    printf 'soak: %6d %8.0f %10d %10d %10d %8d %6d\n' "$now" "$sim" "$r" "$anon" "$file" "$poses" "$jumps"
     last_print=$now
   fi
   awk -v s="$sim" -v e="$sim_seconds" 'BEGIN {exit !(s >= e)}' && break
@@ -155,6 +159,7 @@ while :; do
 done
 
 read -r sim_end poses_end jumps_end <"$tmp/progress"
+cp "/proc/$node_pid/smaps" "$tmp/smaps.end" 2>/dev/null
 rss_end=$(tail -1 "$samples" | awk '{print $3}')
 wall=$(($(date +%s) - start))
 # pf_pose messages in the last tenth of the simulated time.
