@@ -342,8 +342,12 @@ void ParticleFilter::resample(UpdateReport* report) {
   // Dips of a few tenths come and go in normal tracking (a person in front
   // of the laser, a doorway); only a fit below trigger_ratio times the usual
   // one injects anything.
+  // A map without free cells (a Gaussian start is allowed on one) has nowhere
+  // to draw random particles from: then recovery relies on expansion alone.
   const double usual = params_.recovery.trigger_ratio * w_slow_;
-  const double inject_probability = usual > 0.0 ? std::max(0.0, 1.0 - w_fast_ / usual) : 0.0;
+  const bool can_inject = !model_->field().grid().freeCells().empty();
+  const double inject_probability =
+      usual > 0.0 && can_inject ? std::max(0.0, 1.0 - w_fast_ / usual) : 0.0;
   const std::size_t n = particles_.size();
   if (report->ess >= params_.resample_ess_fraction * n && inject_probability < 0.01 && !expand_) {
     return;

@@ -443,6 +443,46 @@ TEST(ParticleFilterUpdate, ACollapsedFitSpreadsTheSurvivors) {
   EXPECT_GT(spread, 0.5);  // all particles sat exactly at `start` before
 }
 
+// Tracks at `start` on `grid`, then feeds scans taken 1 m away that fit far
+// worse than the usual ones; returns the random particles recovery injected.
+std::size_t injectedAfterScansStopFitting(const OccupancyGrid& grid) {
+  ParticleFilterParams params = exactParams();
+  params.kld.min_particles = params.kld.max_particles = 500;
+  params.recovery.alpha_slow = 0.01;
+  params.recovery.alpha_fast = 0.2;
+  params.update_min_d = params.update_min_a = 0.0;
+  ParticleFilter filter(params);
+  filter.setMap(grid);
+  const Pose2 start{1.0, 1.5, 0.2};
+  filter.initializeGaussian(start, Eigen::Matrix3d::Zero());
+  const LaserScan good = simulateScan(trackingRoom(), start);
+  for (int k = 0; k < 5; ++k) EXPECT_TRUE(filter.update({0.0, 0.0, 0.0}, good).updated);
+  const LaserScan moved = simulateScan(trackingRoom(), {2.0, 2.2, 1.5});
+  std::size_t injected = 0;
+  for (int k = 0; k < 5; ++k) {
+    const UpdateReport r = filter.update({0.0, 0.0, 0.0}, moved);
+    EXPECT_TRUE(r.updated) << r.skip_reason;
+    injected += r.injected;
+  }
+  for (std::size_t i = 0; i < filter.particles().size(); ++i) {
+    EXPECT_TRUE(filter.particles().pose(i).isFinite());
+  }
+  EXPECT_TRUE(filter.estimate().pose.isFinite());
+  return injected;
+}
+
+TEST(ParticleFilterUpdate, RecoveryInjectsOnlyWhereThereIsFreeSpace) {
+  // The same room and scans, once as mapped and once with every free cell
+  // unknown (found by fuzz_core: drawing from an empty free-cell list).
+  const OccupancyGrid mapped = trackingRoom();
+  std::vector<int8_t> data(mapped.data());
+  for (int8_t& v : data) v = v == 0 ? -1 : v;
+  const OccupancyGrid no_free(mapped.width(), mapped.height(), kRes, {}, data);
+  ASSERT_TRUE(no_free.freeCells().empty());
+  EXPECT_GT(injectedAfterScansStopFitting(mapped), 0u);
+  EXPECT_EQ(injectedAfterScansStopFitting(no_free), 0u);
+}
+
 TEST(ParticleFilterUpdate, MotionIsAppliedFromTheLastUpdateOnly) {
   const OccupancyGrid grid = trackingRoom();
   ParticleFilter filter(exactParams());

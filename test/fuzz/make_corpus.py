@@ -217,6 +217,17 @@ def crash_inputs():
     b += (u8(2) + num(0.7, -4, 4) + num(0.1, -0.2, 0.2) + num(0.05, 0, 1) + raw(1e39)
           + pose(0, 0, 0, 0.5, 4.0) + raw(3e38) + num(1.0, 0, 12))
     seeds["fuzz_core-scan_endpoint_overflow"] = b
+    # A 3 x 1 map with no free cell, a Gaussian start on it, then scans that stop
+    # fitting: recovery drew random particles from the empty free-cell list.
+    # Found by the 10-minute run of 2026-11-30 and minimised by libFuzzer
+    # (-minimize_crash=1), so kept as its bytes.
+    seeds["fuzz_core-injection_without_free_cells"] = bytes.fromhex(
+        "0031641023191070fd10093f10602910333310cc4c100033073310331080334f"
+        "63637570616e637947726964cd0c0b21003238422210133b10724f0b02001005"
+        "2f1000801000801000800010ae87101e85100080109a1910fffffffeffffffff"
+        "d5d5d5d5d5d5d5ffffffffffffff00101910271b10df1d10792a101212121212"
+        "121212f0696effff070000000000e5e59a19109a1910e5e5e5e5e5e510000100"
+        "0041100010008010999910000010")
     return seeds
 
 
