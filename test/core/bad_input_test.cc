@@ -205,6 +205,32 @@ TEST_F(BadOdometry, NonFiniteOdometrySkipsWithReasonThenGoodOdometryWorks) {
             0.3);
 }
 
+TEST_F(BadOdometry, TenMetreJumpIsAFaultThatSkipsOneUpdate) {
+  // The odometry frame coincides with the map until the jump; then odometry
+  // reads 10 m further along x than the robot went (a reset, a glitch).
+  ASSERT_TRUE(goodUpdate(kStart).updated);
+  const Pose2 estimate_before = filter.estimate().pose;
+  const Pose2 jump{10.0, 0.0, 0.0};
+  const UpdateReport r = filter.update(compose(jump, kStart), scanAt(kStart));
+  EXPECT_FALSE(r.updated);
+  EXPECT_NE(r.skip_reason.find("odometry jumped 10.0"), std::string::npos) << r.skip_reason;
+  EXPECT_NE(r.skip_reason.find("odom_jump_limit 5.0"), std::string::npos) << r.skip_reason;
+  EXPECT_NE(r.skip_reason.find("odometry fault"), std::string::npos) << r.skip_reason;
+  // The particles stayed where they were...
+  EXPECT_EQ(filter.estimate().pose.x, estimate_before.x);
+  EXPECT_EQ(filter.estimate().pose.y, estimate_before.y);
+  // ...and the next step is measured from the odometry after the jump: the
+  // robot drives 0.4 m, the odometry says the same, and tracking carries on.
+  const Pose2 moved = compose(kStart, {0.4, 0.0, 0.0});
+  const UpdateReport good = filter.update(compose(jump, moved), scanAt(moved));
+  EXPECT_TRUE(good.updated) << good.skip_reason;
+  EXPECT_LT(std::hypot(filter.estimate().pose.x - moved.x, filter.estimate().pose.y - moved.y),
+            0.1);
+  // map -> odom now accounts for the jump.
+  ASSERT_TRUE(filter.mapToOdom().has_value());
+  EXPECT_NEAR(filter.mapToOdom()->x, -10.0, 0.1);
+}
+
 TEST(BadOdometryNoFilter, UpdateBeforeMapAndBeforeInitialisationSaySo) {
   ParticleFilter filter(smallParams());
   UpdateReport r = filter.update(kStart, scanAt(kStart));
