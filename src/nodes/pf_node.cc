@@ -38,22 +38,34 @@ namespace pf_ros {
 namespace {
 
 // Bad input tends to repeat on every message; one line per kind and period
-// tells the user without drowning the log. Wall time, so the limit also holds
-// while a bag is paused or replayed fast.
+// tells the user without drowning the log, and counts what it held back, so
+// that nothing is dropped silently. Wall time, so the limit also holds while a
+// bag is paused or replayed fast.
 class LimitedLog {
  public:
   explicit LimitedLog(double period) : period_(period) {}
-  bool due(const std::string& key) {
+
+  /// Whether a message of this kind is due now; if so, `suppressed` is how
+  /// many of its kind were held back since the last one logged.
+  bool due(const std::string& key, int* suppressed = nullptr) {
     const ros::WallTime now = ros::WallTime::now();
-    auto it = last_.find(key);
-    if (it != last_.end() && (now - it->second).toSec() < period_) return false;
-    last_[key] = now;
+    Entry& e = entries_[key];
+    if (!e.last.isZero() && (now - e.last).toSec() < period_) {
+      ++e.suppressed;
+      return false;
+    }
+    if (suppressed) *suppressed = e.suppressed;
+    e = Entry{now, 0};
     return true;
   }
 
  private:
+  struct Entry {
+    ros::WallTime last;
+    int suppressed = 0;
+  };
   double period_;
-  std::map<std::string, ros::WallTime> last_;
+  std::map<std::string, Entry> entries_;
 };
 
 std::string failureText(tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
@@ -70,6 +82,9 @@ std::string failureText(tf2_ros::filter_failure_reasons::FilterFailureReason rea
 // s of odometry messages to wait for odom -> base on /tf before the odometry
 // topic is taken as the source instead.
 constexpr double kOdomSourceGrace = 0.5;
+
+// s between two log lines about the same kind of bad input.
+constexpr double kLogPeriod = 5.0;
 
 // s a scan may be older than the previous one before time counts as jumping back.
 constexpr double kTimeJumpTolerance = 1.0;
@@ -392,7 +407,13 @@ class PfNode {
   }
 
   void warn(const std::string& key, const std::string& text) {
-    if (log_.due(key)) ROS_WARN("pf_node: %s", text.c_str());
+    int suppressed = 0;
+    if (!log_.due(key, &suppressed)) return;
+    if (suppressed > 0) {
+      ROS_WARN("pf_node: %s (%d more like it since the last such line)", text.c_str(), suppressed);
+    } else {
+      ROS_WARN("pf_node: %s", text.c_str());
+    }
   }
 
   LocalizerConfig config_;
@@ -414,7 +435,7 @@ class PfNode {
   ros::Timer tf_timer_, save_timer_;
   ros::WallTimer sigint_timer_;
   ros::Time last_scan_stamp_, last_tf_stamp_, last_cloud_stamp_;
-  LimitedLog log_{5.0};
+  LimitedLog log_{kLogPeriod};
 };
 
 }  // namespace
