@@ -89,6 +89,12 @@ constexpr double kLogPeriod = 5.0;
 // s a scan may be older than the previous one before time counts as jumping back.
 constexpr double kTimeJumpTolerance = 1.0;
 
+// s of simulated time a scan may be stamped ahead of /clock. rosbag play
+// publishes /clock at 100 Hz of wall time, so at rate r the clock lags the
+// messages by up to r / 100 s; a scan further ahead than this is left over
+// from before time jumped back.
+constexpr double kSimClockLead = 2.0;
+
 // Set by SIGINT; the running node saves its pose, then shuts down (see main()).
 volatile std::sig_atomic_t g_sigint = 0;
 volatile std::sig_atomic_t g_node_running = 0;
@@ -203,6 +209,7 @@ class PfNode {
   }
 
   void onScan(const sensor_msgs::LaserScanConstPtr& scan) {
+    if (fromBeforeTheJump(scan->header.stamp)) return;
     if (timeJumpedBack(scan->header.stamp)) return;
     const ScanResult result = localizer_.processScan(*scan);
     if (!result.error.empty()) {
@@ -247,8 +254,43 @@ class PfNode {
     return true;
   }
 
+  // When a bag starts over, messages of the old timeline are still queued in
+  // this node's subscriptions and tf's: they arrive after the jump back, stamped
+  // ahead of the clock. A scan among them would restart the filter a second
+  // time, at the wrong place; they are dropped instead. Only under simulated
+  // time: with wall time, a scan ahead of the clock means unsynchronised
+  // computers, and dropping all of them would be worse.
+  bool fromBeforeTheJump(const ros::Time& stamp) {
+    if (!ros::Time::isSimTime()) return false;
+    const ros::Time now = ros::Time::now();
+    if (now.isZero() || stamp <= now + ros::Duration(kSimClockLead)) return false;
+    warn("scan ahead of clock", "scan ignored: stamped " + std::to_string((stamp - now).toSec()) +
+                                    " s ahead of /clock, so it is from before time jumped back");
+    return true;
+  }
+
+  // The same leftovers on tf: an old-timeline transform that reached the
+  // buffer after it was cleared holds the buffer's time far ahead, and tf2
+  // then refuses every new transform as too old for its cache, which would
+  // drop the scans for the length of the cache. A current scan refused as
+  // older than the buffer shows exactly that, and the buffer is cleared again.
+  void clearStaleBuffer(const sensor_msgs::LaserScan& scan) {
+    if (!ros::Time::isSimTime()) return;
+    const ros::Time now = ros::Time::now();
+    if (now.isZero() || scan.header.stamp + ros::Duration(kSimClockLead) < now) return;
+    warn("stale tf", "clearing tf again: it still held transforms from before time jumped back");
+    buffer_.clear();
+  }
+
   void onScanDropped(const sensor_msgs::LaserScanConstPtr& scan,
                      tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+    // The first scans after a bag starts over often land here, as tf still
+    // holds the old timeline: the jump back is detected on them too, so that
+    // the filter restarts on the first scan of the new timeline.
+    if (reason == tf2_ros::filter_failure_reasons::OutTheBack && ros::Time::isSimTime()) {
+      if (timeJumpedBack(scan->header.stamp)) return;
+      clearStaleBuffer(*scan);
+    }
     warn("scan dropped " + scan->header.frame_id,
          "scan dropped: " + failureText(reason) + ". It needs tf from '" + scan->header.frame_id +
              "' to '" + config_.base_frame + "' (the laser's mounting) and '" + config_.base_frame +
