@@ -170,6 +170,12 @@ echo "soak: ---"
 echo "soak: $sim_end s simulated in $wall s wall; the bag looped $jumps_end times"
 echo "soak: pf_pose messages: $poses_end in total, $recent in the last tenth of the run"
 echo "soak: pf_node RSS: ${rss_mark:-n/a} kB at ${mark} s simulated, ${rss_end:-n/a} kB at the end"
+# Every scan pf_node could not use is logged, or counted on the next line of
+# its kind ("N more like it"): their sum is the number of scans dropped.
+drop_lines=$(sed -E 's/\x1b\[[0-9;]*m//g' "$tmp/launch.log" | grep -aE 'pf_node: scan (dropped|not used|ignored)')
+dropped=$(( $(printf '%s\n' "$drop_lines" | grep -c . || true) +
+  $(printf '%s\n' "$drop_lines" | grep -oE '\([0-9]+ more like it' | tr -dc '0-9\n' | awk '{s += $1} END {print s + 0}') ))
+echo "soak: scans pf_node dropped and said so: $dropped"
 echo "soak: pf_node warnings and errors (count, first text):"
 sed -E 's/\x1b\[[0-9;]*m//g' "$tmp/launch.log" | grep -aE '^\[ *(WARN|ERROR|FATAL)' |
   sed -E 's/\[[0-9.]+(, [0-9.]+)?\]: //' |
