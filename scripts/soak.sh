@@ -177,7 +177,7 @@ dropped=$(( $(printf '%s\n' "$drop_lines" | grep -c . || true) +
   $(printf '%s\n' "$drop_lines" | grep -oE '\([0-9]+ more like it' | tr -dc '0-9\n' | awk '{s += $1} END {print s + 0}') ))
 echo "soak: scans pf_node dropped and said so: $dropped"
 echo "soak: pf_node warnings and errors (count, first text):"
-sed -E 's/\x1b\[[0-9;]*m//g' "$tmp/launch.log" | grep -aE '^\[ *(WARN|ERROR|FATAL)' |
+sed -E 's/\x1b\[[0-9;]*m//g' "$tmp/launch.log" | grep -aoE '\[ *(WARN|ERROR|FATAL)\].*' |
   sed -E 's/\[[0-9.]+(, [0-9.]+)?\]: //' |
   sed -E 's/t=[0-9.]+/t=.../; s/[0-9]+\.[0-9]+/N/g' | sort | uniq -c | sort -rn | head -15 |
   sed 's/^/  /'

@@ -23,11 +23,13 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
+#include <algorithm>
 #include <csignal>
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
+#include <utility>
 
 #include "pf_localization/ros/conversions.h"
 #include "pf_localization/ros/diagnostics.h"
@@ -235,9 +237,8 @@ class PfNode {
   // went back (a bag restarted, with --loop or by hand): tf data and the
   // filter's odometry reference belong to the old timeline, so both start
   // over, as tf itself does on such a jump.
-  bool timeJumpedBack(const ros::Time& stamp) {
-    if (last_scan_stamp_.isZero() ||
-        stamp + ros::Duration(kTimeJumpTolerance) >= last_scan_stamp_) {
+  bool timeJumpedBack(const ros::Time& stamp, double tolerance = kTimeJumpTolerance) {
+    if (last_scan_stamp_.isZero() || stamp + ros::Duration(tolerance) >= last_scan_stamp_) {
       return false;
     }
     ROS_WARN(
@@ -270,26 +271,44 @@ class PfNode {
   }
 
   // The same leftovers on tf: an old-timeline transform that reached the
-  // buffer after it was cleared holds the buffer's time far ahead, and tf2
-  // then refuses every new transform as too old for its cache, which would
-  // drop the scans for the length of the cache. A current scan refused as
-  // older than the buffer shows exactly that, and the buffer is cleared again.
-  void clearStaleBuffer(const sensor_msgs::LaserScan& scan) {
+  // buffer after it was cleared holds its frame's time far ahead, and tf2
+  // then refuses every new transform of that frame as too old for its cache
+  // (TF_OLD_DATA), which would drop the scans for the length of the cache.
+  // A link of the scan's chain (odometry, or the laser's mounting) stamped
+  // ahead of /clock shows exactly that, and the buffer is cleared again.
+  void clearStaleBuffer(const std::string& laser_frame) {
     if (!ros::Time::isSimTime()) return;
     const ros::Time now = ros::Time::now();
-    if (now.isZero() || scan.header.stamp + ros::Duration(kSimClockLead) < now) return;
-    warn("stale tf", "clearing tf again: it still held transforms from before time jumped back");
+    if (now.isZero()) return;
+    ros::Time latest;
+    for (const auto& [parent, child] : {std::pair{config_.odom_frame, config_.base_frame},
+                                        std::pair{config_.base_frame, laser_frame}}) {
+      try {
+        latest =
+            std::max(latest, buffer_.lookupTransform(parent, child, ros::Time(0)).header.stamp);
+      } catch (const tf2::TransformException&) {
+        // A link missing altogether is not this problem; the drop says so.
+      }
+    }
+    if (latest <= now + ros::Duration(kSimClockLead)) return;
+    warn("stale tf", "clearing tf again: it still held transforms from before time jumped back (" +
+                         std::to_string((latest - now).toSec()) + " s ahead of /clock)");
     buffer_.clear();
   }
 
   void onScanDropped(const sensor_msgs::LaserScanConstPtr& scan,
                      tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-    // The first scans after a bag starts over often land here, as tf still
-    // holds the old timeline: the jump back is detected on them too, so that
-    // the filter restarts on the first scan of the new timeline.
-    if (reason == tf2_ros::filter_failure_reasons::OutTheBack && ros::Time::isSimTime()) {
-      if (timeJumpedBack(scan->header.stamp)) return;
-      clearStaleBuffer(*scan);
+    // The first scans after a bag starts over often land here as older than
+    // the buffer, which still holds the old timeline: the jump back is
+    // detected on them too, so that the filter restarts on the first scan of
+    // the new timeline. (Not on scans dropped from a full queue: those are
+    // the oldest waiting, legitimately older than the last scan used.)
+    if (ros::Time::isSimTime()) {
+      if (reason == tf2_ros::filter_failure_reasons::OutTheBack &&
+          timeJumpedBack(scan->header.stamp)) {
+        return;
+      }
+      if (!scan->header.frame_id.empty()) clearStaleBuffer(scan->header.frame_id);
     }
     warn("scan dropped " + scan->header.frame_id,
          "scan dropped: " + failureText(reason) + ". It needs tf from '" + scan->header.frame_id +
@@ -374,6 +393,10 @@ class PfNode {
     // Between scans, keep map -> odom fresh so no tf user has to extrapolate.
     const ros::Time now = ros::Time::now();
     if (now.isZero()) return;  // simulated time has not started
+    // Under simulated time the clock itself shows a bag starting over, often
+    // before any scan of the new timeline gets through tf. (It lags the
+    // messages a little, hence the wider tolerance.)
+    if (ros::Time::isSimTime()) timeJumpedBack(now, kSimClockLead);
     publishMapToOdom(std::max(now, last_scan_stamp_) + ros::Duration(config_.transform_tolerance));
   }
 
