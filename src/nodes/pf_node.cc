@@ -255,6 +255,16 @@ class PfNode {
     return true;
   }
 
+  // How far `stamp` lies ahead of /clock, when it is further ahead than the
+  // clock's normal lag (kSimClockLead); nothing with wall time or a clock
+  // that has not started.
+  static std::optional<double> aheadOfSimClock(const ros::Time& stamp) {
+    if (!ros::Time::isSimTime()) return std::nullopt;
+    const ros::Time now = ros::Time::now();
+    if (now.isZero() || stamp <= now + ros::Duration(kSimClockLead)) return std::nullopt;
+    return (stamp - now).toSec();
+  }
+
   // When a bag starts over, messages of the old timeline are still queued in
   // this node's subscriptions and tf's: they arrive after the jump back, stamped
   // ahead of the clock. A scan among them would restart the filter a second
@@ -262,10 +272,9 @@ class PfNode {
   // time: with wall time, a scan ahead of the clock means unsynchronised
   // computers, and dropping all of them would be worse.
   bool fromBeforeTheJump(const ros::Time& stamp) {
-    if (!ros::Time::isSimTime()) return false;
-    const ros::Time now = ros::Time::now();
-    if (now.isZero() || stamp <= now + ros::Duration(kSimClockLead)) return false;
-    warn("scan ahead of clock", "scan ignored: stamped " + std::to_string((stamp - now).toSec()) +
+    const auto ahead = aheadOfSimClock(stamp);
+    if (!ahead) return false;
+    warn("scan ahead of clock", "scan ignored: stamped " + std::to_string(*ahead) +
                                     " s ahead of /clock, so it is from before time jumped back");
     return true;
   }
@@ -277,9 +286,6 @@ class PfNode {
   // A link of the scan's chain (odometry, or the laser's mounting) stamped
   // ahead of /clock shows exactly that, and the buffer is cleared again.
   void clearStaleBuffer(const std::string& laser_frame) {
-    if (!ros::Time::isSimTime()) return;
-    const ros::Time now = ros::Time::now();
-    if (now.isZero()) return;
     ros::Time latest;
     for (const auto& [parent, child] : {std::pair{config_.odom_frame, config_.base_frame},
                                         std::pair{config_.base_frame, laser_frame}}) {
@@ -290,9 +296,10 @@ class PfNode {
         // A link missing altogether is not this problem; the drop says so.
       }
     }
-    if (latest <= now + ros::Duration(kSimClockLead)) return;
+    const auto ahead = aheadOfSimClock(latest);
+    if (!ahead) return;
     warn("stale tf", "clearing tf again: it still held transforms from before time jumped back (" +
-                         std::to_string((latest - now).toSec()) + " s ahead of /clock)");
+                         std::to_string(*ahead) + " s ahead of /clock)");
     buffer_.clear();
   }
 
