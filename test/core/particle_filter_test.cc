@@ -410,18 +410,25 @@ ParticleFilterParams exactParams() {
   return p;
 }
 
+// exactParams with 500 particles, an update on every scan and augmented
+// MCL's averages on (expansion resetting stays off): for the recovery tests.
+ParticleFilterParams recoveryParams() {
+  ParticleFilterParams p = exactParams();
+  p.kld.min_particles = p.kld.max_particles = 500;
+  p.recovery.alpha_slow = 0.01;
+  p.recovery.alpha_fast = 0.2;
+  p.update_min_d = p.update_min_a = 0.0;
+  return p;
+}
+
 TEST(ParticleFilterUpdate, ACollapsedFitSpreadsTheSurvivors) {
   // Expansion resetting: tracking well at `start`, then the robot is pushed
   // 0.5 m sideways without odometry seeing it. That scan fits far worse than
   // usual, and the resampled particles are spread to search nearby.
   const OccupancyGrid grid = trackingRoom();
-  ParticleFilterParams params = exactParams();
-  params.kld.min_particles = params.kld.max_particles = 500;
+  ParticleFilterParams params = recoveryParams();
   params.recovery.expansion_ratio = 0.3;
   params.recovery.expansion_std_xy = 0.3;
-  params.recovery.alpha_slow = 0.01;
-  params.recovery.alpha_fast = 0.2;
-  params.update_min_d = params.update_min_a = 0.0;
   ParticleFilter filter(params);
   filter.setMap(grid);
   const Pose2 start{1.0, 1.5, 0.2};
@@ -446,12 +453,7 @@ TEST(ParticleFilterUpdate, ACollapsedFitSpreadsTheSurvivors) {
 // Tracks at `start` on `grid`, then feeds scans taken 1 m away that fit far
 // worse than the usual ones; returns the random particles recovery injected.
 std::size_t injectedAfterScansStopFitting(const OccupancyGrid& grid) {
-  ParticleFilterParams params = exactParams();
-  params.kld.min_particles = params.kld.max_particles = 500;
-  params.recovery.alpha_slow = 0.01;
-  params.recovery.alpha_fast = 0.2;
-  params.update_min_d = params.update_min_a = 0.0;
-  ParticleFilter filter(params);
+  ParticleFilter filter(recoveryParams());
   filter.setMap(grid);
   const Pose2 start{1.0, 1.5, 0.2};
   filter.initializeGaussian(start, Eigen::Matrix3d::Zero());
