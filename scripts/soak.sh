@@ -121,9 +121,13 @@ rosbag play --clock --loop -q -r "$rate" "$bag" >"$tmp/play.log" 2>&1 &
 play_pid=$!
 pids+=($play_pid)
 
-rss() { awk '/^VmRSS/ {print $2}' "/proc/$1/status" 2>/dev/null; }
-# Anonymous (heap, stacks) and file-backed (code, mapped files) parts of the RSS.
-rss_parts() { awk '/^RssAnon/ {a = $2} /^RssFile/ {f = $2} END {print a + 0, f + 0}' "/proc/$1/status" 2>/dev/null; }
+# VmRSS, then its anonymous (heap, stacks) and file-backed (code, mapped
+# files) parts, in kB, from one read of the status file; nothing once the
+# process is gone.
+rss() {
+  awk '/^VmRSS/ {r = $2} /^RssAnon/ {a = $2} /^RssFile/ {f = $2}
+       END {if (r != "") print r, a + 0, f + 0}' "/proc/$1/status" 2>/dev/null
+}
 start=$(date +%s)
 rss_mark=""
 died=0
@@ -135,13 +139,12 @@ while :; do
   sleep 1
   now=$(($(date +%s) - start))
   read -r sim poses jumps <"$tmp/progress" 2>/dev/null || continue
-  r=$(rss "$node_pid")
+  read -r r anon file <<<"$(rss "$node_pid")"
   if [ -z "$r" ]; then
     died=1
     echo "soak: pf_node (pid $node_pid) died at ${sim} s of simulated time"
     break
   fi
-  read -r anon file <<<"$(rss_parts "$node_pid")"
   echo "$now $sim $r $poses $jumps $anon $file" >>"$samples"
   if [ -z "$rss_mark" ] && awk -v s="$sim" -v m="$mark" 'BEGIN {exit !(s >= m)}'; then
     rss_mark=$r
