@@ -32,6 +32,11 @@ OdometryMotionModel::OdometryMotionModel(const OdometryMotionParams& params) : p
   checkAlpha("odom_alpha3", params.alpha3);
   checkAlpha("odom_alpha4", params.alpha4);
   checkAlpha("odom_alpha5", params.alpha5);
+  if (!(params.fault_fraction >= 0.0 && params.fault_fraction < 1.0)) {
+    throw std::invalid_argument("motion model: odom_fault_fraction must be in [0, 1), got " +
+                                std::to_string(params.fault_fraction));
+  }
+  checkAlpha("odom_fault_margin", params.fault_margin);
 }
 
 OdometryStep OdometryMotionModel::decompose(const Pose2& from, const Pose2& to) {
@@ -64,10 +69,15 @@ void OdometryMotionModel::applyDifferential(const Pose2& from, const Pose2& to,
       std::sqrt(params_.alpha3 * trans2 + params_.alpha4 * (rot1 * rot1 + rot2 * rot2));
   const double sigma_rot2 = std::sqrt(params_.alpha1 * rot2 * rot2 + params_.alpha2 * trans2);
 
+  const double fault_fraction = params_.fault_fraction;
+  const double fault_reach = step.trans + params_.fault_margin;
+
   ParticleSet& p = *particles;
   for (std::size_t i = 0; i < p.size(); ++i) {
     const double r1 = step.rot1 - random->gaussian(sigma_rot1);
-    const double t = step.trans - random->gaussian(sigma_trans);
+    const double t = fault_fraction > 0.0 && random->uniform() < fault_fraction
+                         ? random->uniform(-fault_reach, fault_reach)
+                         : step.trans - random->gaussian(sigma_trans);
     const double r2 = step.rot2 - random->gaussian(sigma_rot2);
     const double heading = p.yaw[i] + r1;
     p.x[i] += t * std::cos(heading);
@@ -90,9 +100,14 @@ void OdometryMotionModel::applyOmni(const Pose2& from, const Pose2& to, Particle
   const double sigma_rot = std::sqrt(params_.alpha4 * rot2 + params_.alpha2 * trans2);
   const double sigma_strafe = std::sqrt(params_.alpha1 * rot2 + params_.alpha5 * trans2);
 
+  const double fault_fraction = params_.fault_fraction;
+  const double fault_reach = trans + params_.fault_margin;
+
   ParticleSet& p = *particles;
   for (std::size_t i = 0; i < p.size(); ++i) {
-    const double t = trans + random->gaussian(sigma_trans);
+    const double t = fault_fraction > 0.0 && random->uniform() < fault_fraction
+                         ? random->uniform(-fault_reach, fault_reach)
+                         : trans + random->gaussian(sigma_trans);
     const double s = random->gaussian(sigma_strafe);
     const double heading = p.yaw[i] + bearing;
     p.x[i] += t * std::cos(heading) - s * std::sin(heading);

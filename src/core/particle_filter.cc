@@ -62,12 +62,16 @@ void validate(const ParticleFilterParams& p) {
           p.clusters.cell_xy);
   require(p.clusters.cell_yaw > 0.0 && finite(p.clusters.cell_yaw), "cluster_yaw", "> 0",
           p.clusters.cell_yaw);
+  require(p.clusters.join_weight_ratio >= 0.0 && p.clusters.join_weight_ratio <= 1.0,
+          "cluster_join_weight_ratio", "in [0, 1]", p.clusters.join_weight_ratio);
   require(p.recovery.alpha_slow >= 0.0 && p.recovery.alpha_slow <= 1.0, "recovery_alpha_slow",
           "in [0, 1]", p.recovery.alpha_slow);
   require(p.recovery.alpha_fast >= 0.0 && p.recovery.alpha_fast <= 1.0, "recovery_alpha_fast",
           "in [0, 1]", p.recovery.alpha_fast);
   require(p.recovery.trigger_ratio > 0.0 && p.recovery.trigger_ratio <= 1.0,
           "recovery_trigger_ratio", "in (0, 1]", p.recovery.trigger_ratio);
+  require(p.recovery.kidnap_prior > 0.0 && p.recovery.kidnap_prior <= 1.0, "recovery_kidnap_prior",
+          "in (0, 1]", p.recovery.kidnap_prior);
   require(p.recovery.expansion_ratio >= 0.0 && p.recovery.expansion_ratio < 1.0,
           "recovery_expansion_ratio", "in [0, 1)", p.recovery.expansion_ratio);
   require(p.recovery.expansion_std_xy >= 0.0 && finite(p.recovery.expansion_std_xy),
@@ -96,6 +100,10 @@ void validate(const ParticleFilterParams& p) {
     require(alphas[i] >= 0.0 && finite(alphas[i]), "odom_alpha" + std::to_string(i + 1), ">= 0",
             alphas[i]);
   }
+  require(m.fault_fraction >= 0.0 && m.fault_fraction < 1.0, "odom_fault_fraction", "in [0, 1)",
+          m.fault_fraction);
+  require(m.fault_margin >= 0.0 && finite(m.fault_margin), "odom_fault_margin", ">= 0",
+          m.fault_margin);
 }
 
 ParticleFilter::ParticleFilter(const ParticleFilterParams& params)
@@ -344,8 +352,15 @@ void ParticleFilter::resample(UpdateReport* report) {
   // one injects anything.
   // A map without free cells (a Gaussian start is allowed on one) has nowhere
   // to draw random particles from: then recovery relies on expansion alone.
+  // And only while the filter doubts its estimate: in a large building the
+  // fit sags for many seconds wherever the map is poor (open space, clutter,
+  // people), and random guesses then only add rivals that happen to fit a
+  // few scans better; a robot that is really lost or kidnapped is soon not
+  // "localized" (see Confidence).
   const double usual = params_.recovery.trigger_ratio * w_slow_;
-  const bool can_inject = !model_->field().grid().freeCells().empty();
+  const bool can_inject =
+      !model_->field().grid().freeCells().empty() &&
+      (!params_.recovery.only_when_doubtful || confidence_.state != LocalizationState::kLocalized);
   const double inject_probability =
       usual > 0.0 && can_inject ? std::max(0.0, 1.0 - w_fast_ / usual) : 0.0;
   const std::size_t n = particles_.size();
@@ -376,6 +391,13 @@ void ParticleFilter::resample(UpdateReport* report) {
   particles_.resize(kept + injected);
   for (std::size_t i = kept; i < kept + injected; ++i) particles_.setPose(i, randomFreePose());
   particles_.setUniformWeights();
+  if (injected > 0 && kept > 0) {
+    const double prior = params_.recovery.kidnap_prior;
+    const double w_kept = (1.0 - prior) / static_cast<double>(kept);
+    const double w_injected = prior / static_cast<double>(injected);
+    std::fill(particles_.weight.begin(), particles_.weight.begin() + kept, w_kept);
+    std::fill(particles_.weight.begin() + kept, particles_.weight.end(), w_injected);
+  }
   report->resampled = true;
   report->injected = injected;
 }

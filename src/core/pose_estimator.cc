@@ -56,6 +56,7 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
   thread_local BinTable bin_of;
   thread_local std::vector<BinKey> keys;
   thread_local std::vector<int> particle_bin, parent, cluster_of_root, cluster;
+  thread_local std::vector<double> bin_weight;
   bin_of.reset(particles.size());
   keys.clear();
   particle_bin.resize(particles.size());
@@ -69,10 +70,18 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
     particle_bin[i] = id;
   }
 
-  // Join occupied bins that touch (26-neighbourhood) into clusters.
+  // Join occupied bins that touch (26-neighbourhood) into clusters, but only
+  // bins that carry weight (see ClusterParams::join_weight_ratio).
+  bin_weight.assign(keys.size(), 0.0);
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    bin_weight[particle_bin[i]] += particles.weight[i];
+  }
+  const double join_weight =
+      params.join_weight_ratio * *std::max_element(bin_weight.begin(), bin_weight.end());
   parent.resize(keys.size());
   std::iota(parent.begin(), parent.end(), 0);
   for (std::size_t b = 0; b < keys.size(); ++b) {
+    if (bin_weight[b] < join_weight) continue;
     for (int dx = -1; dx <= 1; ++dx) {
       for (int dy = -1; dy <= 1; ++dy) {
         for (int dt = -1; dt <= 1; ++dt) {
@@ -81,7 +90,9 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
           const int n =
               bin_of.find(BinTable::key(keys[b].x + dx, keys[b].y + dy,
                                         ((keys[b].yaw + dt) % yaw_bins + yaw_bins) % yaw_bins));
-          if (n >= 0) parent[find(parent, static_cast<int>(b))] = find(parent, n);
+          if (n >= 0 && bin_weight[n] >= join_weight) {
+            parent[find(parent, static_cast<int>(b))] = find(parent, n);
+          }
         }
       }
     }

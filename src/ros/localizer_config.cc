@@ -264,9 +264,12 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
   }
   p.get("cluster_xy", &f.clusters.cell_xy);
   p.get("cluster_yaw", &f.clusters.cell_yaw);
+  p.get("cluster_join_weight_ratio", &f.clusters.join_weight_ratio);
   p.get("recovery_alpha_slow", &f.recovery.alpha_slow);
   p.get("recovery_alpha_fast", &f.recovery.alpha_fast);
   p.get("recovery_trigger_ratio", &f.recovery.trigger_ratio);
+  p.get("recovery_kidnap_prior", &f.recovery.kidnap_prior);
+  p.get("recovery_only_when_doubtful", &f.recovery.only_when_doubtful);
   p.get("recovery_expansion_ratio", &f.recovery.expansion_ratio);
   p.get("recovery_expansion_std_xy", &f.recovery.expansion_std_xy);
   p.get("recovery_expansion_std_yaw", &f.recovery.expansion_std_yaw);
@@ -286,6 +289,8 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
   p.get("odom_alpha3", &f.motion.alpha3);
   p.get("odom_alpha4", &f.motion.alpha4);
   p.get("odom_alpha5", &f.motion.alpha5);
+  p.get("odom_fault_fraction", &f.motion.fault_fraction);
+  p.get("odom_fault_margin", &f.motion.fault_margin);
 
   p.get("laser_max_beams", &f.sensor.max_beams);
   p.get("sensor_threads", &f.sensor.threads);

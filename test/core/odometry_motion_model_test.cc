@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -199,11 +200,12 @@ constexpr std::size_t kSamples = 40000;
 
 OdometryMotionParams noisy() {
   OdometryMotionParams p;
-  p.alpha1 = 0.1;   // rot from rot
-  p.alpha2 = 0.01;  // rot from trans
-  p.alpha3 = 0.04;  // trans from trans
-  p.alpha4 = 0.02;  // trans from rot
-  p.alpha5 = 0.09;  // strafe (omni)
+  p.alpha1 = 0.1;          // rot from rot
+  p.alpha2 = 0.01;         // rot from trans
+  p.alpha3 = 0.04;         // trans from trans
+  p.alpha4 = 0.02;         // trans from rot
+  p.alpha5 = 0.09;         // strafe (omni)
+  p.fault_fraction = 0.0;  // the textbook model; the fault mixture has its own tests
   return p;
 }
 
@@ -291,6 +293,71 @@ TEST(ApplyNoisy, OmniSpreadMatchesTheModel) {
   EXPECT_NEAR(0.3, y.stddev, 0.015);
   EXPECT_NEAR(0.0, yaw.mean, 0.003);
   EXPECT_NEAR(0.1, yaw.stddev, 0.005);
+}
+
+// The fault mixture: with noise-free alphas, a particle either moves exactly
+// by the odometry or is one of the faulty share, whose translation is uniform
+// over [-(trans + margin), trans + margin] along its heading.
+TEST(ApplyFaults, AShareOfTheParticlesTakesAUniformTranslation) {
+  OdometryMotionParams params;
+  params.alpha1 = params.alpha2 = params.alpha3 = params.alpha4 = 0.0;
+  params.fault_fraction = 0.25;
+  params.fault_margin = 0.1;
+  const OdometryMotionModel model(params);
+  ParticleSet p = manyAt({0, 0, 0}, kSamples);
+  Random random(21);
+  model.apply({0, 0, 0}, {1, 0, 0}, &p, &random);
+  std::vector<double> faulty;
+  for (std::size_t i = 0; i < kSamples; ++i) {
+    ASSERT_EQ(0.0, p.y[i]);  // the heading is exact: only the translation is in doubt
+    ASSERT_EQ(0.0, p.yaw[i]);
+    if (p.x[i] != 1.0) faulty.push_back(p.x[i]);
+  }
+  // 25 % of 40000 = 10000, binomial std 87.
+  EXPECT_NEAR(10000.0, static_cast<double>(faulty.size()), 350.0);
+  const Stats f = stats(faulty.size(), [&](std::size_t i) { return faulty[i]; });
+  EXPECT_NEAR(0.0, f.mean, 0.02);
+  EXPECT_NEAR(2.2 / std::sqrt(12.0), f.stddev, 0.01);  // uniform over [-1.1, 1.1]
+  EXPECT_GE(*std::min_element(faulty.begin(), faulty.end()), -1.1);
+  EXPECT_LE(*std::max_element(faulty.begin(), faulty.end()), 1.1);
+  // A reversing robot logged as driving 1 m forwards is at x = -1: a tenth of
+  // the faulty particles lie within 0.11 m of it, where the textbook model
+  // (std 0 here, 0.2 m with noisy()'s alpha3) puts none.
+  const auto near_reverse = std::count_if(faulty.begin(), faulty.end(),
+                                          [](double x) { return std::fabs(x + 1.0) < 0.11; });
+  EXPECT_NEAR(0.1 * faulty.size(), static_cast<double>(near_reverse), 100.0);
+}
+
+TEST(ApplyFaults, AStalledOdometryStillSpreadsByTheMargin) {
+  OdometryMotionParams params;
+  params.alpha1 = params.alpha2 = params.alpha3 = params.alpha4 = 0.0;
+  params.fault_fraction = 0.5;
+  params.fault_margin = 0.2;
+  const OdometryMotionModel model(params);
+  ParticleSet p = manyAt({0, 0, 0}, kSamples);
+  Random random(22);
+  model.apply({0, 0, 0}, {0, 0, 0.3}, &p, &random);  // a turn on the spot: trans = 0
+  double lo = 0.0, hi = 0.0;
+  std::size_t moved = 0;
+  for (std::size_t i = 0; i < kSamples; ++i) {
+    moved += p.x[i] != 0.0 ? 1 : 0;
+    lo = std::min(lo, p.x[i]);
+    hi = std::max(hi, p.x[i]);
+  }
+  EXPECT_NEAR(20000.0, static_cast<double>(moved), 400.0);
+  EXPECT_GE(lo, -0.2);
+  EXPECT_LT(lo, -0.19);
+  EXPECT_LE(hi, 0.2);
+  EXPECT_GT(hi, 0.19);
+}
+
+TEST(ApplyFaults, RefusesAFractionOfOne) {
+  OdometryMotionParams params;
+  params.fault_fraction = 1.0;
+  EXPECT_THROW(OdometryMotionModel{params}, std::invalid_argument);
+  params.fault_fraction = 0.1;
+  params.fault_margin = -0.1;
+  EXPECT_THROW(OdometryMotionModel{params}, std::invalid_argument);
 }
 
 TEST(ApplyNoisy, SameSeedSameParticles) {

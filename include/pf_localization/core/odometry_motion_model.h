@@ -17,6 +17,21 @@
 //   trans:  sqrt(alpha3 * trans^2 + alpha1 * rot^2)
 //   rot:    sqrt(alpha4 * rot^2 + alpha2 * trans^2)
 //   strafe: sqrt(alpha1 * rot^2 + alpha5 * trans^2)
+//
+// Odometry faults: the Gaussian above assumes that the wheels report the
+// motion up to a few per cent. Real odometry sometimes does not: wheels slip
+// on a threshold, a stalled robot's wheels spin, a pushed robot moves without
+// them, and some logs record a reversing robot as driving forwards (the
+// CARMEN logs do, a few per cent of their steps). A Gaussian puts no
+// particle where the robot then is, and the filter drifts away while every
+// scan still fits roughly. So the model is a mixture (the robust motion model
+// of Thrun, Burgard & Fox, section 5.4.4, "mixture of a reliable and an
+// unreliable component"): a share fault_fraction of the particles take a
+// translation drawn uniformly from [-(|trans| + fault_margin),
+// +(|trans| + fault_margin)] along their heading instead, which covers a
+// robot that stood still, went back or went further. The scans decide which
+// particles were right; when the odometry was, the few faulty ones die at the
+// next resampling.
 #pragma once
 
 #include "pf_localization/core/particle_set.h"
@@ -33,6 +48,12 @@ struct OdometryMotionParams {
   double alpha3 = 0.2;  // translation noise from translation (m^2/m^2)
   double alpha4 = 0.2;  // translation noise from rotation   (m^2/rad^2)
   double alpha5 = 0.2;  // strafe noise from translation, omni only (m^2/m^2)
+  // Share of the particles that assume the odometry's translation was wrong
+  // this step (see above). 0 is the textbook model. [0, 1)
+  double fault_fraction = 0.05;
+  // Beyond the reported translation, how much further a faulty step may
+  // have gone (m), so that a stalled odometry (trans = 0) still spreads. >= 0
+  double fault_margin = 0.1;
 };
 
 /// The odometry step split into rotation, translation, rotation.

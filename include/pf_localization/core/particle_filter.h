@@ -46,6 +46,23 @@ struct RecoveryParams {
   double alpha_slow = 0.01;    // long-term average rate, per update (0 disables recovery)
   double alpha_fast = 0.2;     // short-term average rate, per update
   double trigger_ratio = 0.7;  // (0, 1]: 1 injects on any dip, as amcl does
+  // How much the injected particles are believed, together: the prior
+  // probability that the robot is somewhere else than the tracked particles
+  // say. Augmented MCL gives a random particle the weight of a tracked one,
+  // so in a large building, where many places fit one scan roughly, one of
+  // thousands of random guesses often fits a single scan better than the
+  // spread-out tracked cloud and takes over the estimate: a jump across the
+  // building. Treated as what it is, a mixture proposal (Thrun, Fox, Burgard
+  // & Dellaert, "Robust Monte Carlo localization for mobile robots", AIJ
+  // 128, 2001), each injected particle weighs kidnap_prior / injected and
+  // each kept one (1 - kidnap_prior) / kept. A rival place must then explain
+  // the scans better by about log(injected / kidnap_prior) nats before it
+  // wins, which a real kidnapping does within a scan or two and aliasing does
+  // not; and a larger particle budget, which injects more guesses, discounts
+  // each guess by as much, so it finds more without jumping more. (0, 1]
+  double kidnap_prior = 1e-3;
+  // Inject only while the confidence state is not "localized".
+  bool only_when_doubtful = true;
   // Expansion resetting (Ueda et al., "Expansion resetting for recovery
   // from fatal error in Monte Carlo localization", IROS 2004): when a single
   // scan fits below expansion_ratio times the long-term average, the robot

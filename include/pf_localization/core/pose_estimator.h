@@ -18,6 +18,12 @@ namespace pf {
 struct ClusterParams {
   double cell_xy = 0.5;      // bin size (m)
   double cell_yaw = 0.5236;  // bin size (rad), 30 degrees
+  // Bins holding less than this fraction of the heaviest bin's weight are
+  // not joined to their neighbours. Thousands of barely weighted particles
+  // (recovery's random guesses) touch each other all over a map; joined, they
+  // made one cluster the size of the building, whose weighted mean was
+  // dragged metres away from the particles that carry the weight. [0, 1]
+  double join_weight_ratio = 1e-3;
 };
 
 struct Cluster {
