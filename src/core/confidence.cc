@@ -42,6 +42,10 @@ void validate(const ConfidenceParams& p) {
   require(p.localized_std_yaw > 0.0, "confidence_localized_std_yaw", "> 0", p.localized_std_yaw);
   require(p.rival_weight_ratio > 0.0 && p.rival_weight_ratio <= 1.0,
           "confidence_rival_weight_ratio", "in (0, 1]", p.rival_weight_ratio);
+  require(p.jump_distance > 0.0 && std::isfinite(p.jump_distance), "confidence_jump_distance",
+          "> 0", p.jump_distance);
+  require(p.jump_yaw > 0.0 && std::isfinite(p.jump_yaw), "confidence_jump_yaw", "> 0", p.jump_yaw);
+  require(p.settle_updates >= 0, "confidence_settle_updates", ">= 0", p.settle_updates);
 }
 
 Confidence assessConfidence(const ParticleSet& particles, const PoseEstimate& estimate,
@@ -88,6 +92,24 @@ Confidence assessConfidence(const ParticleSet& particles, const PoseEstimate& es
   }
   c.reason = why.str();
   return c;
+}
+
+void holdAfterJump(const Pose2& predicted, const Pose2& estimate, const ConfidenceParams& params,
+                   int* settle_left, Confidence* confidence) {
+  const Pose2 d = between(predicted, estimate);
+  const double jump = std::hypot(d.x, d.y);
+  if (jump > params.jump_distance || std::fabs(d.yaw) > params.jump_yaw) {
+    *settle_left = params.settle_updates;
+  } else if (*settle_left > 0) {
+    --*settle_left;
+  }
+  if (*settle_left > 0 && confidence->state == LocalizationState::kLocalized) {
+    confidence->state = LocalizationState::kUncertain;
+    std::ostringstream why;
+    why << "the estimate jumped recently: " << *settle_left << " more update"
+        << (*settle_left == 1 ? "" : "s") << " to confirm it";
+    confidence->reason = why.str();
+  }
 }
 
 }  // namespace pf

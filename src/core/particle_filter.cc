@@ -72,6 +72,8 @@ void validate(const ParticleFilterParams& p) {
           "recovery_trigger_ratio", "in (0, 1]", p.recovery.trigger_ratio);
   require(p.recovery.kidnap_prior > 0.0 && p.recovery.kidnap_prior <= 1.0, "recovery_kidnap_prior",
           "in (0, 1]", p.recovery.kidnap_prior);
+  require(p.recovery.localized_patience >= 0, "recovery_localized_patience", ">= 0",
+          p.recovery.localized_patience);
   require(p.recovery.expansion_ratio >= 0.0 && p.recovery.expansion_ratio < 1.0,
           "recovery_expansion_ratio", "in [0, 1)", p.recovery.expansion_ratio);
   require(p.recovery.expansion_std_xy >= 0.0 && finite(p.recovery.expansion_std_xy),
@@ -180,9 +182,12 @@ void ParticleFilter::restartAfterInitialization() {
   has_estimate_ = false;
   confidence_ = Confidence();
   confidence_.state = LocalizationState::kUncertain;
+  fit_state_ = confidence_.state;
   confidence_.reason = "no scan since the initialisation";
   confidence_.covariance = estimate_.covariance;
   w_slow_ = w_fast_ = 0.0;
+  low_fit_updates_ = 0;
+  settle_left_ = 0;
 }
 
 Pose2 ParticleFilter::randomFreePose() {
@@ -249,6 +254,8 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
     return report;
   }
 
+  // Where the last estimate would be now had the odometry been right.
+  const std::optional<Pose2> before = mapToOdom();
   if (!first) motion_model_.apply(*odom_at_update_, odom, &particles_, &random_);
   odom_at_update_ = odom;
   restart_ = false;
@@ -263,6 +270,13 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
       particles_, estimate_,
       model_->hitFraction(prepared, estimate_.pose, params_.confidence.hit_distance),
       params_.confidence);
+  // Tempering and recovery follow the evidence of this scan; only the
+  // published verdict waits for a jumped estimate to be confirmed.
+  fit_state_ = confidence_.state;
+  if (before) {
+    holdAfterJump(compose(*before, odom), estimate_.pose, params_.confidence, &settle_left_,
+                  &confidence_);
+  }
   resample(&report);
   has_estimate_ = true;
   report.updated = true;
@@ -286,7 +300,7 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
   // A filter that is not sure of itself weighs evidence more cautiously:
   // rival hypotheses (twin rooms) then survive until the scans really
   // separate them, instead of the luckiest one winning outright.
-  const double fraction = confidence_.state == LocalizationState::kLocalized
+  const double fraction = fit_state_ == LocalizationState::kLocalized
                               ? params_.tempering_ess_fraction
                               : params_.tempering_ess_fraction_uncertain;
   const double min_ess = fraction * static_cast<double>(particles_.size());
@@ -352,17 +366,20 @@ void ParticleFilter::resample(UpdateReport* report) {
   // one injects anything.
   // A map without free cells (a Gaussian start is allowed on one) has nowhere
   // to draw random particles from: then recovery relies on expansion alone.
-  // And only while the filter doubts its estimate: in a large building the
-  // fit sags for many seconds wherever the map is poor (open space, clutter,
-  // people), and random guesses then only add rivals that happen to fit a
-  // few scans better; a robot that is really lost or kidnapped is soon not
-  // "localized" (see Confidence).
+  // A filter that says it is localized injects only once the fit has stayed
+  // low for more than localized_patience updates in a row: in a large
+  // building the fit sags for a few scans wherever the map is poor (open
+  // space, clutter, people), and random guesses then only add rivals that
+  // happen to fit those scans better. A robot that is really lost or
+  // kidnapped is soon not "localized" (see Confidence), or stays badly
+  // fitted for longer (a cloud that settled on a look-alike place).
   const double usual = params_.recovery.trigger_ratio * w_slow_;
-  const bool can_inject =
-      !model_->field().grid().freeCells().empty() &&
-      (!params_.recovery.only_when_doubtful || confidence_.state != LocalizationState::kLocalized);
-  const double inject_probability =
-      usual > 0.0 && can_inject ? std::max(0.0, 1.0 - w_fast_ / usual) : 0.0;
+  const double dip = usual > 0.0 ? std::max(0.0, 1.0 - w_fast_ / usual) : 0.0;
+  low_fit_updates_ = dip > 0.0 ? low_fit_updates_ + 1 : 0;
+  const bool patient = fit_state_ == LocalizationState::kLocalized &&
+                       low_fit_updates_ <= params_.recovery.localized_patience;
+  const bool can_inject = !model_->field().grid().freeCells().empty() && !patient;
+  const double inject_probability = can_inject ? dip : 0.0;
   const std::size_t n = particles_.size();
   if (report->ess >= params_.resample_ess_fraction * n && inject_probability < 0.01 && !expand_) {
     return;

@@ -257,6 +257,9 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
   p.get("confidence_localized_std_xy", &f.confidence.localized_std_xy);
   p.get("confidence_localized_std_yaw", &f.confidence.localized_std_yaw);
   p.get("confidence_rival_weight_ratio", &f.confidence.rival_weight_ratio);
+  p.get("confidence_jump_distance", &f.confidence.jump_distance);
+  p.get("confidence_jump_yaw", &f.confidence.jump_yaw);
+  p.get("confidence_settle_updates", &f.confidence.settle_updates);
   int seed = 0;
   if (!p.get("seed", &seed).empty()) {
     require(seed >= 0, "seed", ">= 0");
@@ -269,7 +272,7 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
   p.get("recovery_alpha_fast", &f.recovery.alpha_fast);
   p.get("recovery_trigger_ratio", &f.recovery.trigger_ratio);
   p.get("recovery_kidnap_prior", &f.recovery.kidnap_prior);
-  p.get("recovery_only_when_doubtful", &f.recovery.only_when_doubtful);
+  p.get("recovery_localized_patience", &f.recovery.localized_patience);
   p.get("recovery_expansion_ratio", &f.recovery.expansion_ratio);
   p.get("recovery_expansion_std_xy", &f.recovery.expansion_std_xy);
   p.get("recovery_expansion_std_yaw", &f.recovery.expansion_std_yaw);

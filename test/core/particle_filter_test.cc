@@ -485,6 +485,61 @@ TEST(ParticleFilterUpdate, RecoveryInjectsOnlyWhereThereIsFreeSpace) {
   EXPECT_EQ(injectedAfterScansStopFitting(no_free), 0u);
 }
 
+TEST(ParticleFilterUpdate, InjectedParticlesWeighTheKidnapPriorTogether) {
+  // Mixture-proposal weights: whatever their number, the random particles
+  // hold kidnap_prior of the weight and the survivors the rest.
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilterParams params = recoveryParams();
+  params.recovery.kidnap_prior = 0.01;
+  ParticleFilter filter(params);
+  filter.setMap(grid);
+  const Pose2 start{1.0, 1.5, 0.2};
+  filter.initializeGaussian(start, Eigen::Matrix3d::Zero());
+  for (int k = 0; k < 5; ++k) filter.update({0.0, 0.0, 0.0}, simulateScan(grid, start));
+  UpdateReport r;
+  for (int k = 0; k < 5 && r.injected == 0; ++k) {
+    r = filter.update({0.0, 0.0, 0.0}, simulateScan(grid, {2.0, 2.2, 1.5}));
+  }
+  ASSERT_GT(r.injected, 0u);
+  const ParticleSet& p = filter.particles();
+  const std::size_t kept = p.size() - r.injected;
+  double w_kept = 0.0, w_injected = 0.0;
+  for (std::size_t i = 0; i < p.size(); ++i) (i < kept ? w_kept : w_injected) += p.weight[i];
+  EXPECT_NEAR(0.99, w_kept, 1e-12);
+  EXPECT_NEAR(0.01, w_injected, 1e-12);
+  EXPECT_DOUBLE_EQ(0.01 / static_cast<double>(r.injected), p.weight.back());
+}
+
+// The number of updates with bad scans before recovery injects, for a filter
+// whose thresholds keep it "localized" whatever the fit.
+int updatesBeforeInjection(int patience) {
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilterParams params = recoveryParams();
+  params.recovery.localized_patience = patience;
+  params.confidence.lost_hit_fraction = params.confidence.localized_hit_fraction = 0.0;
+  params.confidence.localized_std_xy = params.confidence.localized_std_yaw = 100.0;
+  ParticleFilter filter(params);
+  filter.setMap(grid);
+  const Pose2 start{1.0, 1.5, 0.2};
+  filter.initializeGaussian(start, Eigen::Matrix3d::Zero());
+  for (int k = 0; k < 5; ++k) filter.update({0.0, 0.0, 0.0}, simulateScan(grid, start));
+  for (int k = 1; k <= 30; ++k) {
+    const UpdateReport r = filter.update({0.0, 0.0, 0.0}, simulateScan(grid, {2.0, 2.2, 1.5}));
+    EXPECT_EQ(LocalizationState::kLocalized, filter.confidence().state);
+    if (r.injected > 0) return k;
+  }
+  return -1;
+}
+
+TEST(ParticleFilterUpdate, ALocalizedFilterWaitsOutShortDipsBeforeInjecting) {
+  // The short-term fit (alpha_fast 0.2) falls below 0.7 of the long-term one
+  // at the second bad scan: without patience that update injects; with it,
+  // `patience` updates later.
+  EXPECT_EQ(2, updatesBeforeInjection(0));
+  EXPECT_EQ(5, updatesBeforeInjection(3));
+  EXPECT_EQ(12, updatesBeforeInjection(10));
+}
+
 TEST(ParticleFilterUpdate, MotionIsAppliedFromTheLastUpdateOnly) {
   const OccupancyGrid grid = trackingRoom();
   ParticleFilter filter(exactParams());

@@ -161,6 +161,25 @@ TEST(EstimatePose, ChainOfTouchingBinsIsOneCluster) {
   EXPECT_NEAR(1.0, e.pose.x, kTol);
 }
 
+TEST(EstimatePose, BarelyWeightedBinsDoNotJoinClusters) {
+  // A tracked pair in one bin holding weight 1, and a chain of particles
+  // 0.5 m apart running from it to x = 5.1, each in its own bin with 9e-4
+  // (recovery's random guesses): below 1e-3 of the heaviest bin, they stay
+  // apart, and the estimate is the pair's mean.
+  std::vector<Weighted> list = {{{0.1, 0.1, 0.0}, 0.5}, {{0.2, 0.1, 0.0}, 0.5}};
+  for (int k = 1; k <= 10; ++k) list.push_back({{0.1 + 0.5 * k, 0.1, 0.0}, 9e-4});
+  ParticleSet set = particles(list);
+  const PoseEstimate e = estimatePose(set, kParams);  // join_weight_ratio 1e-3 by default
+  ASSERT_EQ(11u, e.clusters.size());
+  EXPECT_EQ(2u, e.clusters[0].count);
+  expectEstimateNear({0.15, 0.1, 0.0}, e.pose, 1e-9);
+  // Every bin joined: one cluster, its mean dragged along the chain to
+  // (0.15 + 9e-4 * (10 * 0.1 + 0.5 * 55)) / (1 + 10 * 9e-4) = 0.174083.
+  const PoseEstimate joined = estimatePose(set, ClusterParams{0.5, 0.5236, 0.0});
+  ASSERT_EQ(1u, joined.clusters.size());
+  EXPECT_NEAR(0.17565 / 1.009, joined.pose.x, 1e-9);
+}
+
 TEST(EstimatePose, EmptySetHasNoClusters) {
   const PoseEstimate e = estimatePose(ParticleSet(), kParams);
   EXPECT_TRUE(e.clusters.empty());

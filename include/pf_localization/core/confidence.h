@@ -14,6 +14,11 @@
 // Lost: the fit is below lost_hit_fraction. Uncertain: the fit is below
 // localized_hit_fraction, the cluster is wide, or a rival holds at least
 // rival_weight_ratio of the heaviest cluster's weight. Localized otherwise.
+//
+// A fourth sign is history: an estimate that has just jumped (another
+// cluster won, recovery found a new place) has explained one scan, and in a
+// building full of look-alike rooms one scan proves little. So after a jump
+// the state is at best uncertain until settle_updates more updates agree.
 #pragma once
 
 #include <Eigen/Core>
@@ -34,6 +39,9 @@ struct ConfidenceParams {
   double localized_std_xy = 0.3;         // m: largest std dev of x or y of the heaviest cluster
   double localized_std_yaw = 0.2;        // rad: largest std dev of its yaw
   double rival_weight_ratio = 0.2;       // a cluster this heavy relative to the first is a rival
+  double jump_distance = 0.5;  // m: the estimate moved this far beyond the odometry: a jump
+  double jump_yaw = 0.5;       // rad: or turned this far beyond it
+  int settle_updates = 10;     // updates after a jump before the state may be localized again
 };
 
 struct Confidence {
@@ -56,5 +64,12 @@ void validate(const ConfidenceParams& params);
 /// and the fraction of the scan's beams that hit an obstacle from it.
 Confidence assessConfidence(const ParticleSet& particles, const PoseEstimate& estimate,
                             double hit_fraction, const ConfidenceParams& params);
+
+/// The history check: `predicted` is the previous estimate moved by the
+/// odometry since, `estimate` the new one. A jump between them starts
+/// `*settle_left` at settle_updates; while it is above zero a localized
+/// verdict becomes uncertain. Counts down by one per call without a jump.
+void holdAfterJump(const Pose2& predicted, const Pose2& estimate, const ConfidenceParams& params,
+                   int* settle_left, Confidence* confidence);
 
 }  // namespace pf

@@ -61,8 +61,9 @@ struct RecoveryParams {
   // not; and a larger particle budget, which injects more guesses, discounts
   // each guess by as much, so it finds more without jumping more. (0, 1]
   double kidnap_prior = 1e-3;
-  // Inject only while the confidence state is not "localized".
-  bool only_when_doubtful = true;
+  // While the confidence state is "localized", inject only after the fit has
+  // been below the trigger for more than this many updates in a row. >= 0
+  int localized_patience = 5;
   // Expansion resetting (Ueda et al., "Expansion resetting for recovery
   // from fatal error in Monte Carlo localization", IROS 2004): when a single
   // scan fits below expansion_ratio times the long-term average, the robot
@@ -175,6 +176,9 @@ class ParticleFilter {
   bool has_estimate_ = false;
   double w_slow_ = 0.0;
   double w_fast_ = 0.0;
+  int low_fit_updates_ = 0;  // consecutive updates with w_fast below the trigger
+  LocalizationState fit_state_ = LocalizationState::kLost;  // the verdict before holdAfterJump
+  int settle_left_ = 0;  // updates until a jumped estimate may be localized (holdAfterJump)
   bool expand_ = false;  // this scan's fit collapsed: spread the survivors
   std::vector<double> scratch_;
   std::vector<double> log_prior_;
