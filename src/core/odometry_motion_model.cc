@@ -17,6 +17,21 @@ double rotationMagnitude(double rot) {
   return std::min(std::fabs(rot), std::fabs(angleDiff(rot, M_PI)));
 }
 
+// The translation one particle takes: the odometry's with Gaussian noise,
+// or, for the share fault_fraction of the particles, half the time the
+// reversed one (with the same noise) and half the time none (uniform within
+// +-fault_margin). See the header.
+double sampleTranslation(double trans, double sigma, const OdometryMotionParams& params,
+                         Random* random) {
+  if (params.fault_fraction > 0.0) {
+    const double u = random->uniform();
+    if (u < 0.5 * params.fault_fraction) return -trans + random->gaussian(sigma);
+    if (u < params.fault_fraction)
+      return random->uniform(-params.fault_margin, params.fault_margin);
+  }
+  return trans - random->gaussian(sigma);
+}
+
 void checkAlpha(const char* name, double value) {
   if (!(value >= 0.0) || !std::isfinite(value)) {
     throw std::invalid_argument(std::string("motion model: ") + name +
@@ -69,15 +84,10 @@ void OdometryMotionModel::applyDifferential(const Pose2& from, const Pose2& to,
       std::sqrt(params_.alpha3 * trans2 + params_.alpha4 * (rot1 * rot1 + rot2 * rot2));
   const double sigma_rot2 = std::sqrt(params_.alpha1 * rot2 * rot2 + params_.alpha2 * trans2);
 
-  const double fault_fraction = params_.fault_fraction;
-  const double fault_reach = step.trans + params_.fault_margin;
-
   ParticleSet& p = *particles;
   for (std::size_t i = 0; i < p.size(); ++i) {
     const double r1 = step.rot1 - random->gaussian(sigma_rot1);
-    const double t = fault_fraction > 0.0 && random->uniform() < fault_fraction
-                         ? random->uniform(-fault_reach, fault_reach)
-                         : step.trans - random->gaussian(sigma_trans);
+    const double t = sampleTranslation(step.trans, sigma_trans, params_, random);
     const double r2 = step.rot2 - random->gaussian(sigma_rot2);
     const double heading = p.yaw[i] + r1;
     p.x[i] += t * std::cos(heading);
@@ -100,14 +110,9 @@ void OdometryMotionModel::applyOmni(const Pose2& from, const Pose2& to, Particle
   const double sigma_rot = std::sqrt(params_.alpha4 * rot2 + params_.alpha2 * trans2);
   const double sigma_strafe = std::sqrt(params_.alpha1 * rot2 + params_.alpha5 * trans2);
 
-  const double fault_fraction = params_.fault_fraction;
-  const double fault_reach = trans + params_.fault_margin;
-
   ParticleSet& p = *particles;
   for (std::size_t i = 0; i < p.size(); ++i) {
-    const double t = fault_fraction > 0.0 && random->uniform() < fault_fraction
-                         ? random->uniform(-fault_reach, fault_reach)
-                         : trans + random->gaussian(sigma_trans);
+    const double t = sampleTranslation(trans, sigma_trans, params_, random);
     const double s = random->gaussian(sigma_strafe);
     const double heading = p.yaw[i] + bearing;
     p.x[i] += t * std::cos(heading) - s * std::sin(heading);

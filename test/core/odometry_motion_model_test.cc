@@ -296,9 +296,9 @@ TEST(ApplyNoisy, OmniSpreadMatchesTheModel) {
 }
 
 // The fault mixture: with noise-free alphas, a particle either moves exactly
-// by the odometry or is one of the faulty share, whose translation is uniform
-// over [-(trans + margin), trans + margin] along its heading.
-TEST(ApplyFaults, AShareOfTheParticlesTakesAUniformTranslation) {
+// by the odometry, or (the faulty share) exactly the reverse, or stalls
+// within +-fault_margin, in equal halves of the faulty share.
+TEST(ApplyFaults, AShareOfTheParticlesReversesOrStalls) {
   OdometryMotionParams params;
   params.alpha1 = params.alpha2 = params.alpha3 = params.alpha4 = 0.0;
   params.fault_fraction = 0.25;
@@ -307,48 +307,47 @@ TEST(ApplyFaults, AShareOfTheParticlesTakesAUniformTranslation) {
   ParticleSet p = manyAt({0, 0, 0}, kSamples);
   Random random(21);
   model.apply({0, 0, 0}, {1, 0, 0}, &p, &random);
-  std::vector<double> faulty;
+  std::size_t forward = 0, reversed = 0, stalled = 0;
+  double stalled_sum = 0.0, stalled_sq = 0.0;
   for (std::size_t i = 0; i < kSamples; ++i) {
     ASSERT_EQ(0.0, p.y[i]);  // the heading is exact: only the translation is in doubt
     ASSERT_EQ(0.0, p.yaw[i]);
-    if (p.x[i] != 1.0) faulty.push_back(p.x[i]);
+    if (p.x[i] == 1.0) {
+      ++forward;
+    } else if (p.x[i] == -1.0) {
+      ++reversed;
+    } else {
+      ASSERT_LE(std::fabs(p.x[i]), 0.1) << i;
+      ++stalled;
+      stalled_sum += p.x[i];
+      stalled_sq += p.x[i] * p.x[i];
+    }
   }
-  // 25 % of 40000 = 10000, binomial std 87.
-  EXPECT_NEAR(10000.0, static_cast<double>(faulty.size()), 350.0);
-  const Stats f = stats(faulty.size(), [&](std::size_t i) { return faulty[i]; });
-  EXPECT_NEAR(0.0, f.mean, 0.02);
-  EXPECT_NEAR(2.2 / std::sqrt(12.0), f.stddev, 0.01);  // uniform over [-1.1, 1.1]
-  EXPECT_GE(*std::min_element(faulty.begin(), faulty.end()), -1.1);
-  EXPECT_LE(*std::max_element(faulty.begin(), faulty.end()), 1.1);
-  // A reversing robot logged as driving 1 m forwards is at x = -1: a tenth of
-  // the faulty particles lie within 0.11 m of it, where the textbook model
-  // (std 0 here, 0.2 m with noisy()'s alpha3) puts none.
-  const auto near_reverse = std::count_if(faulty.begin(), faulty.end(),
-                                          [](double x) { return std::fabs(x + 1.0) < 0.11; });
-  EXPECT_NEAR(0.1 * faulty.size(), static_cast<double>(near_reverse), 100.0);
+  // 75 %, 12.5 % and 12.5 % of 40000; binomial std 87, 66, 66.
+  EXPECT_NEAR(30000.0, static_cast<double>(forward), 350.0);
+  EXPECT_NEAR(5000.0, static_cast<double>(reversed), 270.0);
+  EXPECT_NEAR(5000.0, static_cast<double>(stalled), 270.0);
+  const double n = static_cast<double>(stalled);
+  EXPECT_NEAR(0.0, stalled_sum / n, 0.003);
+  EXPECT_NEAR(0.2 / std::sqrt(12.0), std::sqrt(stalled_sq / n), 0.002);  // uniform on +-0.1
 }
 
-TEST(ApplyFaults, AStalledOdometryStillSpreadsByTheMargin) {
-  OdometryMotionParams params;
-  params.alpha1 = params.alpha2 = params.alpha3 = params.alpha4 = 0.0;
+TEST(ApplyFaults, ReversedParticlesKeepTheTranslationNoise) {
+  OdometryMotionParams params = noisy();  // sigma_trans = sqrt(alpha3) = 0.2 for 1 m
   params.fault_fraction = 0.5;
-  params.fault_margin = 0.2;
+  params.fault_margin = 0.0;
   const OdometryMotionModel model(params);
   ParticleSet p = manyAt({0, 0, 0}, kSamples);
   Random random(22);
-  model.apply({0, 0, 0}, {0, 0, 0.3}, &p, &random);  // a turn on the spot: trans = 0
-  double lo = 0.0, hi = 0.0;
-  std::size_t moved = 0;
+  model.apply({0, 0, 0}, {1, 0, 0}, &p, &random);
+  std::vector<double> back;  // the reversed quarter: along -x
   for (std::size_t i = 0; i < kSamples; ++i) {
-    moved += p.x[i] != 0.0 ? 1 : 0;
-    lo = std::min(lo, p.x[i]);
-    hi = std::max(hi, p.x[i]);
+    if (p.x[i] < -0.3) back.push_back(-std::hypot(p.x[i], p.y[i]));
   }
-  EXPECT_NEAR(20000.0, static_cast<double>(moved), 400.0);
-  EXPECT_GE(lo, -0.2);
-  EXPECT_LT(lo, -0.19);
-  EXPECT_LE(hi, 0.2);
-  EXPECT_GT(hi, 0.19);
+  EXPECT_NEAR(10000.0, static_cast<double>(back.size()), 350.0);
+  const Stats b = stats(back.size(), [&](std::size_t i) { return back[i]; });
+  EXPECT_NEAR(-1.0, b.mean, 0.01);
+  EXPECT_NEAR(0.2, b.stddev, 0.01);
 }
 
 TEST(ApplyFaults, RefusesAFractionOfOne) {

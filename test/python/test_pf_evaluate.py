@@ -27,6 +27,36 @@ def traj(rows):
 
 
 class MetricsTest(unittest.TestCase):
+    def test_off_fraction_leaves_out_the_first_ten_seconds(self):
+        ref = traj([(t, 0.0, 0.0, 0.0) for t in range(30)])       # t = 0 .. 29 s
+        est = ref.copy()
+        est[:10, 1] = 5.0                                          # 5 m off while settling
+        est[[12, 20], 1] = 0.6                                     # two poses of 20 after it off
+        m, _ = pfe.evaluate(est, ref)
+        self.assertAlmostEqual(m['off_fraction_after_settle'], 2 / 20, places=12)
+
+    def test_confidently_wrong_counts_localized_updates_more_than_a_metre_off(self):
+        ref = traj([(t, 0.0, 0.0, 0.0) for t in range(10)])
+        est = ref.copy()
+        est[[3, 4, 5], 1] = [1.5, 2.0, 0.9]                        # 1.5 and 2 m off, then 0.9
+        _, match = pfe.evaluate(est, ref)
+        log = {'t': np.array([1.0, 3.0, 4.0, 5.0, 4.02]),
+               'state': np.array(['localized', 'localized', 'uncertain', 'localized', 'lost'])}
+        count, times = pfe.confidently_wrong(log, match)
+        self.assertEqual(count, 1)                                 # t = 3 only
+        self.assertEqual(times, [3.0])
+        self.assertEqual(pfe.confidently_wrong({'t': log['t']}, match), (None, []))
+
+    def test_update_log_keeps_the_state_column(self):
+        with tempfile.NamedTemporaryFile('w', suffix='.csv', delete=False) as f:
+            f.write('t,particles,state\n1.0,500,localized\n2.0,600,lost\n')
+        try:
+            log = pfe.read_update_log(f.name)
+        finally:
+            os.remove(f.name)
+        self.assertEqual(list(log['state']), ['localized', 'lost'])
+        self.assertEqual(list(log['particles']), [500.0, 600.0])
+
     def test_constant_offset(self):
         ref = traj([(t, t, 0.0, 0.0) for t in range(10)])
         est = ref + [0, 0.06, 0.08, 0]                       # 0.1 m off everywhere

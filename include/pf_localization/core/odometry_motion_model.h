@@ -19,19 +19,22 @@
 //   strafe: sqrt(alpha1 * rot^2 + alpha5 * trans^2)
 //
 // Odometry faults: the Gaussian above assumes that the wheels report the
-// motion up to a few per cent. Real odometry sometimes does not: wheels slip
-// on a threshold, a stalled robot's wheels spin, a pushed robot moves without
-// them, and some logs record a reversing robot as driving forwards (the
-// CARMEN logs do, a few per cent of their steps). A Gaussian puts no
-// particle where the robot then is, and the filter drifts away while every
-// scan still fits roughly. So the model is a mixture (the robust motion model
-// of Thrun, Burgard & Fox, section 5.4.4, "mixture of a reliable and an
-// unreliable component"): a share fault_fraction of the particles take a
-// translation drawn uniformly from [-(|trans| + fault_margin),
-// +(|trans| + fault_margin)] along their heading instead, which covers a
-// robot that stood still, went back or went further. The scans decide which
-// particles were right; when the odometry was, the few faulty ones die at the
-// next resampling.
+// motion up to a few per cent. Real odometry sometimes does not, in two ways
+// that a Gaussian cannot cover: it reports motion the robot did not make
+// (wheels spinning on a threshold, a stalled or held robot), and it reports
+// the wrong direction (encoders that count ticks without their sign, so a
+// reversing robot is logged as driving forwards: the CARMEN logs do this in
+// 5 % of their steps on fr079). A Gaussian then puts no particle where the
+// robot is, and the filter drifts away while every scan still fits roughly.
+// So the model is a mixture (Thrun, Burgard & Fox, section 6.3.1, applied to
+// motion: a reliable and an unreliable component): a share fault_fraction of
+// the particles take, half of them, the reversed translation (with the same
+// noise) and the other half no translation (uniform within +-fault_margin).
+// The scans decide which particles were right; when the odometry was, the
+// faulty ones die at the next resampling. A uniform spread over every
+// translation in between was tried: in long corridors, where the scans say
+// little about the position along them, it smeared the estimate along the
+// corridor (Intel lab) more than the two discrete faults do.
 #pragma once
 
 #include "pf_localization/core/particle_set.h"
@@ -51,8 +54,7 @@ struct OdometryMotionParams {
   // Share of the particles that assume the odometry's translation was wrong
   // this step (see above). 0 is the textbook model. [0, 1)
   double fault_fraction = 0.05;
-  // Beyond the reported translation, how much further a faulty step may
-  // have gone (m), so that a stalled odometry (trans = 0) still spreads. >= 0
+  // How far a robot whose odometry stalled may still have moved (m). >= 0
   double fault_margin = 0.1;
 };
 
