@@ -15,11 +15,13 @@ repo=$(cd "$(dirname "$0")/.." && pwd)
 ws=${PF_WS:-$repo/.ws}
 bin=$ws/devel/lib/pf_localization
 
-#     bag       map       seed
+#     bag       map       seed  simulator options
 bags="tracking  building  1
       global    building  2
       kidnap    building  3
-      small     small     4"
+      small     small     4
+      reverse   building  5     --unsigned-odometry
+      crowd     building  6"
 
 check=false
 case "${1:-}" in
@@ -44,9 +46,10 @@ if $check; then
 fi
 
 "$bin/pf_make_map" --out-dir "$out/maps"
-while read -r bag map seed; do
+while read -r bag map seed options; do
+  # shellcheck disable=SC2086  # the options are words
   "$bin/pf_simulator" --map "$out/maps/$map.yaml" --path "$repo/bags/$bag.path" \
-    --seed "$seed" --out "$out/bags/$bag.bag"
+    --seed "$seed" --out "$out/bags/$bag.bag" $options
 done <<<"$bags"
 
 if $check; then

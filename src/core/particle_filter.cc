@@ -72,8 +72,7 @@ void validate(const ParticleFilterParams& p) {
           "recovery_trigger_ratio", "in (0, 1]", p.recovery.trigger_ratio);
   require(p.recovery.kidnap_prior > 0.0 && p.recovery.kidnap_prior <= 1.0, "recovery_kidnap_prior",
           "in (0, 1]", p.recovery.kidnap_prior);
-  require(p.recovery.localized_patience >= 0, "recovery_localized_patience", ">= 0",
-          p.recovery.localized_patience);
+  require(p.recovery.patience >= 0, "recovery_patience", ">= 0", p.recovery.patience);
   require(p.recovery.expansion_ratio >= 0.0 && p.recovery.expansion_ratio < 1.0,
           "recovery_expansion_ratio", "in [0, 1)", p.recovery.expansion_ratio);
   require(p.recovery.expansion_std_xy >= 0.0 && finite(p.recovery.expansion_std_xy),
@@ -303,7 +302,12 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
   const double fraction = fit_state_ == LocalizationState::kLocalized
                               ? params_.tempering_ess_fraction
                               : params_.tempering_ess_fraction_uncertain;
-  const double min_ess = fraction * static_cast<double>(particles_.size());
+  // A share of the effective particles before the scan, not of all of them:
+  // recovery's barely weighted guesses count as particles but not as
+  // effective ones, and measured against N a cloud salted with them could
+  // never keep enough, so every scan was tempered away to nothing.
+  const double prior_ess = effectiveSampleSize(log_prior_, ll, 0.0);
+  const double min_ess = fraction * prior_ess;
   if (min_ess > 0.0 && effectiveSampleSize(log_prior_, ll, 1.0) < min_ess) {
     // Bisection for the largest exponent that keeps min_ess particles.
     double lo = 0.0, hi = 1.0;
@@ -366,18 +370,18 @@ void ParticleFilter::resample(UpdateReport* report) {
   // one injects anything.
   // A map without free cells (a Gaussian start is allowed on one) has nowhere
   // to draw random particles from: then recovery relies on expansion alone.
-  // A filter that says it is localized injects only once the fit has stayed
-  // low for more than localized_patience updates in a row: in a large
-  // building the fit sags for a few scans wherever the map is poor (open
-  // space, clutter, people), and random guesses then only add rivals that
-  // happen to fit those scans better. A robot that is really lost or
-  // kidnapped is soon not "localized" (see Confidence), or stays badly
-  // fitted for longer (a cloud that settled on a look-alike place).
+  // Unless the filter is lost, it injects only once the fit has stayed low
+  // for more than `patience` updates in a row: in a large building the fit
+  // sags for a few scans wherever the map is poor (open space, clutter,
+  // people walking by), and random guesses then only add rivals that happen
+  // to fit those scans better. A robot that is really lost or kidnapped is
+  // soon "lost" (see Confidence), or stays badly fitted for longer (a cloud
+  // that settled on a look-alike place).
   const double usual = params_.recovery.trigger_ratio * w_slow_;
   const double dip = usual > 0.0 ? std::max(0.0, 1.0 - w_fast_ / usual) : 0.0;
   low_fit_updates_ = dip > 0.0 ? low_fit_updates_ + 1 : 0;
-  const bool patient = fit_state_ == LocalizationState::kLocalized &&
-                       low_fit_updates_ <= params_.recovery.localized_patience;
+  const bool patient =
+      fit_state_ != LocalizationState::kLost && low_fit_updates_ <= params_.recovery.patience;
   const bool can_inject = !model_->field().grid().freeCells().empty() && !patient;
   const double inject_probability = can_inject ? dip : 0.0;
   const std::size_t n = particles_.size();

@@ -3,7 +3,8 @@
 //
 //   pf_simulator --map maps/building.yaml --path bags/tracking.path
 //                --seed 1 --out bags/tracking.bag [--compression bz2|lz4|none]
-//                [--odom-error K] [--no-people] [--start-time SECONDS]
+//                [--odom-error K] [--unsigned-odometry] [--no-people]
+//                [--start-time SECONDS]
 //
 // Topics, as on the real robot (see /work/shared/data/neato_ac109_1):
 //   /scan          sensor_msgs/LaserScan, base_laser_link, 5 Hz: 360 beams at
@@ -59,6 +60,7 @@ struct Options {
   uint64_t seed = 0;
   std::string compression = "bz2";
   double odom_error = 1.0;
+  bool unsigned_odometry = false;
   bool people = true;
   double start_time = 1000.0;
 };
@@ -68,6 +70,7 @@ struct Options {
   std::cerr << "usage: pf_simulator --map MAP.yaml --path SCRIPT.path --out OUT.bag\n"
                "                    [--seed N] [--compression bz2|lz4|none]\n"
                "                    [--odom-error K]   scale the odometry errors (0: perfect)\n"
+               "                    [--unsigned-odometry]  log reversing as driving forwards\n"
                "                    [--no-people]      ignore the script's 'person' lines\n"
                "                    [--start-time S]   first stamp, s (default 1000)\n";
   std::exit(2);
@@ -106,6 +109,8 @@ Options parseOptions(int argc, char** argv) {
     } else if (arg == "--odom-error") {
       o.odom_error = number();
       if (o.odom_error < 0.0) usage("--odom-error must not be negative");
+    } else if (arg == "--unsigned-odometry") {
+      o.unsigned_odometry = true;
     } else if (arg == "--no-people") {
       o.people = false;
     } else if (arg == "--start-time") {
@@ -149,7 +154,9 @@ double simulate(const Options& o, const pf::OccupancyGrid& map, const pf::sim::P
                 rosbag::Bag* bag) {
   // Separate streams, so that changing the laser model leaves the odometry alone.
   pf::sim::SimRandom odom_random(o.seed * 2 + 1), laser_random(o.seed * 2 + 2);
-  pf::sim::DiffDriveRobot robot(odometryErrors(o.odom_error), script.start);
+  pf::sim::DiffDriveParams odometry = odometryErrors(o.odom_error);
+  odometry.unsigned_translation = o.unsigned_odometry;
+  pf::sim::DiffDriveRobot robot(odometry, script.start);
   const pf::sim::RayCaster caster(map);
   const NeatoLaserParams laser;
   const std::vector<pf::sim::Person> people =

@@ -34,7 +34,8 @@ void DiffDriveRobot::step(double v, double w, double dt, SimRandom* random) {
   left /= 1.0 + params_.left_radius_error;
   right /= 1.0 + params_.right_radius_error;
 
-  const double ds_odom = 0.5 * (left + right);
+  const double ds_odom =
+      params_.unsigned_translation ? std::abs(0.5 * (left + right)) : 0.5 * (left + right);
   const double dtheta_odom = (right - left) / params_.track_width;
   odom_pose_ = integrateArc(odom_pose_, ds_odom, dtheta_odom);
   odom_v_ = dt > 0.0 ? ds_odom / dt : 0.0;

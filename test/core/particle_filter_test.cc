@@ -515,7 +515,7 @@ TEST(ParticleFilterUpdate, InjectedParticlesWeighTheKidnapPriorTogether) {
 int updatesBeforeInjection(int patience) {
   const OccupancyGrid grid = trackingRoom();
   ParticleFilterParams params = recoveryParams();
-  params.recovery.localized_patience = patience;
+  params.recovery.patience = patience;
   params.confidence.lost_hit_fraction = params.confidence.localized_hit_fraction = 0.0;
   params.confidence.localized_std_xy = params.confidence.localized_std_yaw = 100.0;
   ParticleFilter filter(params);
@@ -531,7 +531,7 @@ int updatesBeforeInjection(int patience) {
   return -1;
 }
 
-TEST(ParticleFilterUpdate, ALocalizedFilterWaitsOutShortDipsBeforeInjecting) {
+TEST(ParticleFilterUpdate, AFilterThatIsNotLostWaitsOutShortDipsBeforeInjecting) {
   // The short-term fit (alpha_fast 0.2) falls below 0.7 of the long-term one
   // at the second bad scan: without patience that update injects; with it,
   // `patience` updates later.

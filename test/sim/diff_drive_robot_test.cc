@@ -45,6 +45,18 @@ TEST(DiffDriveRobotTest, LargerWheelsMakeOdometryShortOfTheTruth) {
   expectPose(robot.odomPose(), 1.0 / 1.02, 0.0, 0.0);
 }
 
+TEST(DiffDriveRobotTest, UnsignedEncodersLogReversingAsDrivingForwards) {
+  DiffDriveParams params;
+  params.unsigned_translation = true;
+  DiffDriveRobot robot(params, {});
+  robot.step(-0.5, 0.0, 2.0, nullptr);  // 1 m backwards
+  expectPose(robot.truePose(), -1.0, 0.0, 0.0);
+  expectPose(robot.odomPose(), 1.0, 0.0, 0.0);
+  EXPECT_DOUBLE_EQ(robot.odomLinearVelocity(), 0.5);
+  robot.step(0.0, -0.5, 1.0, nullptr);  // turns keep their sign
+  expectPose(robot.odomPose(), 1.0, 0.0, -0.5);
+}
+
 TEST(DiffDriveRobotTest, WiderTrackMakesOdometryOverTurn) {
   DiffDriveParams params;
   params.track_width_error = 0.1;

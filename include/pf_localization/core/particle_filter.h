@@ -61,9 +61,9 @@ struct RecoveryParams {
   // not; and a larger particle budget, which injects more guesses, discounts
   // each guess by as much, so it finds more without jumping more. (0, 1]
   double kidnap_prior = 1e-3;
-  // While the confidence state is "localized", inject only after the fit has
+  // Unless the confidence state is "lost", inject only after the fit has
   // been below the trigger for more than this many updates in a row. >= 0
-  int localized_patience = 5;
+  int patience = 5;
   // Expansion resetting (Ueda et al., "Expansion resetting for recovery
   // from fatal error in Monte Carlo localization", IROS 2004): when a single
   // scan fits below expansion_ratio times the long-term average, the robot
@@ -81,9 +81,9 @@ struct ParticleFilterParams {
   double update_min_a = M_PI / 6.0;    // rad of rotation between updates
   double odom_jump_limit = 5.0;        // m; a longer odometry step between updates is a fault
   double resample_ess_fraction = 0.5;  // resample when ESS < this * N (0..1]
-  // When one scan would leave fewer than this fraction of N effective
-  // particles, its likelihood is tempered (raised to the largest power below 1
-  // that keeps that many). Evidence too strong for the cloud, as right after a
+  // When one scan would leave fewer than this fraction of the effective
+  // particles it found, its likelihood is tempered (raised to the largest
+  // power below 1 that keeps that many). Evidence too strong for the cloud, as right after a
   // global initialisation, then narrows it over several scans instead of
   // collapsing it onto one lucky particle. 0 disables. [0, 1]
   double tempering_ess_fraction = 0.02;

@@ -29,6 +29,10 @@ struct DiffDriveParams {
   double right_radius_error = 0.0;  // true right wheel radius = nominal * (1 + this)
   double track_width_error = 0.0;   // true track width = nominal * (1 + this)
   double slip_sigma = 0.0;          // m / sqrt(m): per-wheel slip std after 1 m of travel
+  // Encoders that count ticks without their direction, as the CARMEN logs
+  // show: the odometry's forward travel is always positive, so a reversing
+  // robot is logged as driving forwards (turns keep their sign).
+  bool unsigned_translation = false;
 };
 
 /// The pose reached from `p` by driving `ds` along a circular arc that turns
