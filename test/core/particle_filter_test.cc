@@ -510,6 +510,34 @@ TEST(ParticleFilterUpdate, InjectedParticlesWeighTheKidnapPriorTogether) {
   EXPECT_DOUBLE_EQ(0.01 / static_cast<double>(r.injected), p.weight.back());
 }
 
+TEST(ParticleFilterUpdate, RecoveryGuessesDoNotTemperTheNextScanAway) {
+  // After an injection some particles are barely weighted guesses, so the
+  // weights' effective sample size is below N. Tempering keeps a share of
+  // that ESS; measured against N instead, a share above ESS / N could never
+  // be kept, and every scan was tempered to an exponent of 0: ignored.
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilterParams params = recoveryParams();
+  params.tempering_ess_fraction = params.tempering_ess_fraction_uncertain = 0.99;
+  ParticleFilter filter(params);
+  filter.setMap(grid);
+  const Pose2 start{1.0, 1.5, 0.2};
+  filter.initializeGaussian(start, Eigen::Matrix3d::Zero());
+  for (int k = 0; k < 5; ++k) filter.update({0.0, 0.0, 0.0}, simulateScan(grid, start));
+  const Pose2 moved{2.0, 2.2, 1.5};
+  UpdateReport r;
+  for (int k = 0; k < 5 && r.injected == 0; ++k) {
+    r = filter.update({0.0, 0.0, 0.0}, simulateScan(grid, moved));
+  }
+  ASSERT_GT(r.injected, 0u);
+  const double prior_ess = effectiveSampleSize(filter.particles().weight);
+  ASSERT_LT(prior_ess, 0.99 * static_cast<double>(filter.particles().size()));
+  const UpdateReport next = filter.update({0.0, 0.0, 0.0}, simulateScan(grid, moved));
+  ASSERT_TRUE(next.updated);
+  EXPECT_GT(next.tempering, 0.0);
+  EXPECT_LT(next.tempering, 1.0);
+  EXPECT_NEAR(0.99 * prior_ess, next.ess, 0.01 * prior_ess);  // the bisection's target
+}
+
 // The number of updates with bad scans before recovery injects, for a filter
 // whose thresholds keep it "localized" whatever the fit.
 int updatesBeforeInjection(int patience) {
