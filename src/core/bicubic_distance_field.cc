@@ -30,8 +30,8 @@ FieldSample BicubicDistanceField::sample(double wx, double wy) const {
   // Continuous cell coordinates in which cell centres are integers.
   const double gx = (c * ox + s * oy) * inv_res - 0.5;
   const double gy = (-s * ox + c * oy) * inv_res - 0.5;
-  // Every sample of the stencil is off the map (this also catches NaN).
-  if (!(gx > -3.0 && gy > -3.0 && gx < grid.width() + 2.0 && gy < grid.height() + 2.0)) {
+  // Well off the map (or NaN): nothing there, as in the likelihood field.
+  if (!(gx > -2.0 && gy > -2.0 && gx < grid.width() + 1.0 && gy < grid.height() + 1.0)) {
     return {max_distance, 0.0, 0.0};
   }
   const int ix = static_cast<int>(std::floor(gx)), iy = static_cast<int>(std::floor(gy));
@@ -40,14 +40,16 @@ FieldSample BicubicDistanceField::sample(double wx, double wy) const {
   cubicWeights(gy - iy, wys, dwys);
   const std::vector<float>& d = field_.distances();
   double value = 0.0, dgx = 0.0, dgy = 0.0;
+  // A stencil that reaches past the map's edge repeats the edge cells.
+  // max_distance there instead would be a cliff next to a wall on the edge,
+  // which the cubic overshoots into negative distances, making false minima.
+  const auto clamp = [](int v, int size) { return v < 0 ? 0 : (v >= size ? size - 1 : v); };
   for (int j = 0; j < 4; ++j) {
-    const int y = iy - 1 + j;
+    const int y = clamp(iy - 1 + j, grid.height());
     double row = 0.0, drow = 0.0;
     for (int i = 0; i < 4; ++i) {
-      const int x = ix - 1 + i;
-      const double v = x >= 0 && y >= 0 && x < grid.width() && y < grid.height()
-                           ? d[static_cast<std::size_t>(y) * grid.width() + x]
-                           : max_distance;
+      const double v =
+          d[static_cast<std::size_t>(y) * grid.width() + clamp(ix - 1 + i, grid.width())];
       row += wxs[i] * v;
       drow += dwxs[i] * v;
     }

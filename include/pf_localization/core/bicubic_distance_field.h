@@ -10,7 +10,9 @@
 // way, so that Gauss-Newton sees a gradient that changes continuously instead
 // of the steps of a per-cell lookup, which has no useful gradient at all.
 //
-// Samples outside the map are max_distance, as in the likelihood field.
+// Within a cell and a half of the map's edge, the edge cells are repeated
+// outwards; further out the distance is max_distance, as in the likelihood
+// field.
 #pragma once
 
 #include "pf_localization/core/likelihood_field.h"
@@ -29,8 +31,9 @@ class BicubicDistanceField {
   /// Keeps a reference: `field` must outlive this object.
   explicit BicubicDistanceField(const LikelihoodField& field) : field_(field) {}
 
-  /// The distance at world point (wx, wy) and its gradient. Far outside the
-  /// map, or at a non-finite point: max_distance with a zero gradient.
+  /// The distance at world point (wx, wy) and its gradient. More than a
+  /// cell and a half off the map, or at a non-finite point: max_distance
+  /// with a zero gradient.
   FieldSample sample(double wx, double wy) const;
 
  private:
