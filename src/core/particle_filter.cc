@@ -78,6 +78,7 @@ void validate(const ParticleFilterParams& p) {
           "recovery_alpha_fast", "> recovery_alpha_slow when recovery is on",
           p.recovery.alpha_fast);
   validate(p.confidence);
+  validate(p.refiner);
   const auto& s = p.sensor;
   require(s.z_hit >= 0.0 && finite(s.z_hit), "laser_z_hit", ">= 0", s.z_hit);
   require(s.z_rand >= 0.0 && finite(s.z_rand), "laser_z_rand", ">= 0", s.z_rand);
@@ -255,6 +256,7 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
       particles_, estimate_,
       model_->hitFraction(prepared, estimate_.pose, params_.confidence.hit_distance),
       params_.confidence);
+  refineEstimate(prepared, &report);
   resample(&report);
   has_estimate_ = true;
   report.updated = true;
@@ -378,6 +380,28 @@ void ParticleFilter::resample(UpdateReport* report) {
   particles_.setUniformWeights();
   report->resampled = true;
   report->injected = injected;
+}
+
+void ParticleFilter::refineEstimate(const PreparedScan& scan, UpdateReport* report) {
+  ScanRefinement& r = report->refinement;
+  r.pose = estimate_.pose;
+  if (!params_.refine_estimate) {
+    r.rejection = "refine_estimate is off";
+    return;
+  }
+  // A lost filter's estimate is nowhere near the robot: a fit from there
+  // would only polish a wrong pose.
+  if (confidence_.state == LocalizationState::kLost) {
+    r.rejection = "the filter is lost";
+    return;
+  }
+  r = ScanRefiner(model_->field(), params_.refiner).refine(scan, estimate_.pose);
+  if (!r.accepted) return;
+  // The fit is sharper than the cloud, but the cloud's spread (or its
+  // rivals') is evidence too: what is published covers both.
+  estimate_.pose = r.pose;
+  estimate_.covariance = coveringCovariance(r.covariance, estimate_.covariance);
+  confidence_.covariance = coveringCovariance(r.covariance, confidence_.covariance);
 }
 
 std::optional<Pose2> ParticleFilter::mapToOdom() const {

@@ -32,6 +32,7 @@
 #include "pf_localization/core/pose_estimator.h"
 #include "pf_localization/core/random.h"
 #include "pf_localization/core/resampler.h"
+#include "pf_localization/core/scan_refiner.h"
 
 namespace pf {
 
@@ -77,6 +78,11 @@ struct ParticleFilterParams {
   ClusterParams clusters;
   RecoveryParams recovery;
   ConfidenceParams confidence;
+  // The published pose (and map -> odom) is the cloud's estimate refined
+  // against the map by a scan fit (scan_refiner.h), whenever the filter is
+  // not lost and the fit is accepted.
+  bool refine_estimate = true;
+  ScanRefinerParams refiner;
 };
 
 /// Throws std::invalid_argument naming the first parameter out of range and its valid range.
@@ -95,6 +101,9 @@ struct UpdateReport {
   std::size_t injected = 0;           // random particles added by recovery
   double tempering = 1.0;             // exponent applied to this scan's likelihood (1: none)
   bool expanded = false;              // the survivors were spread by expansion resetting
+  // The scan fit of the estimate (when refine_estimate is on): accepted, or
+  // the reason it was not, as in refinement.rejection.
+  ScanRefinement refinement;
 };
 
 class ParticleFilter {
@@ -130,6 +139,8 @@ class ParticleFilter {
   void requestNoMotionUpdate() { force_update_ = true; }
 
   const ParticleSet& particles() const { return particles_; }
+  /// The estimate: its pose and covariance are the refined ones when the
+  /// last update's scan fit was accepted; clusters[0].mean stays the cloud's.
   const PoseEstimate& estimate() const { return estimate_; }
   /// How far to trust the estimate, as of the last update.
   const Confidence& confidence() const { return confidence_; }
@@ -141,6 +152,7 @@ class ParticleFilter {
  private:
   void weigh(const PreparedScan& scan, UpdateReport* report);
   void resample(UpdateReport* report);
+  void refineEstimate(const PreparedScan& scan, UpdateReport* report);
   Pose2 randomFreePose();
   void restartAfterInitialization();
 
