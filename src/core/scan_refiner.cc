@@ -52,6 +52,7 @@ void validate(const ScanRefinerParams& p) {
           p.min_beam_std);
   require(p.degeneracy_ratio > 0.0 && p.degeneracy_ratio < 1.0, "refine_degeneracy_ratio",
           "in (0, 1)", p.degeneracy_ratio);
+  require(p.beam_std > 0.0 && finite(p.beam_std), "refine_beam_std", "> 0", p.beam_std);
   require(p.convergence > 0.0 && finite(p.convergence), "refine_convergence", "> 0", p.convergence);
 }
 
@@ -105,6 +106,11 @@ ScanRefiner::Evaluation ScanRefiner::evaluate(const PreparedScan& scan, const Po
 }
 
 ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start) const {
+  return refine(scan, start, std::nullopt);
+}
+
+ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start,
+                                   const std::optional<Eigen::Matrix3d>& prior_covariance) const {
   ScanRefinement out;
   out.pose = start;
   const int n = static_cast<int>(scan.size());
@@ -116,6 +122,23 @@ ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start)
            " needed): nothing to match";
   };
 
+  // The prior in the scaled coordinates (x, y, kYawScale yaw): a tiny floor
+  // keeps a zero covariance from becoming an infinite information.
+  Eigen::Matrix3d prior_information = Eigen::Matrix3d::Zero();
+  if (prior_covariance) {
+    const Eigen::DiagonalMatrix<double, 3> scale(1.0, 1.0, kYawScale);
+    const Eigen::Matrix3d scaled = scale * (*prior_covariance) * scale;
+    prior_information = (scaled + 1e-6 * Eigen::Matrix3d::Identity()).inverse();
+    if (!prior_information.allFinite()) prior_information.setZero();
+  }
+  const double inv_beam_variance = 1.0 / (params_.beam_std * params_.beam_std);
+  // The total cost: the scan's over beam_std^2, plus the prior's.
+  const auto total = [&](const Evaluation& ev, const Pose2& at) {
+    const Eigen::Vector3d d(at.x - start.x, at.y - start.y,
+                            kYawScale * angleDiff(at.yaw, start.yaw));
+    return ev.cost * inv_beam_variance + 0.5 * d.dot(prior_information * d);
+  };
+
   Pose2 pose = start;
   Evaluation e = evaluate(scan, pose, true);
   if (e.matched < needed) {
@@ -123,26 +146,24 @@ ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start)
     out.rejection = too_few(e.matched);
     return out;
   }
-  // The constrained directions, from the Hessian at the start: solving in
-  // them only keeps the filter's estimate along the rest, where noise alone
-  // would otherwise drag the fit.
-  Eigen::Matrix3d basis = Eigen::Matrix3d::Zero();  // columns: constrained eigenvectors
-  int rank = 0;
+  double cost = total(e, pose);
   for (int it = 0; it < params_.max_iterations; ++it) {
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(e.hessian);
+    const Eigen::Vector3d d(pose.x - start.x, pose.y - start.y,
+                            kYawScale * angleDiff(pose.yaw, start.yaw));
+    const Eigen::Matrix3d h = e.hessian * inv_beam_variance + prior_information;
+    const Eigen::Vector3d g = e.gradient * inv_beam_variance + prior_information * d;
+    // Gauss-Newton with the pseudo-inverse: a direction neither the scan nor
+    // the prior constrains (a corridor's length, without a prior) is not
+    // moved along, where noise alone would otherwise drag the fit.
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(h);
     const Eigen::Vector3d lambda = eig.eigenvalues();  // increasing
     if (!(lambda(2) > 0.0)) break;
-    if (it == 0) {
-      for (int i = 0; i < 3; ++i) {
-        if (lambda(i) >= params_.degeneracy_ratio * lambda(2))
-          basis.col(rank++) = eig.eigenvectors().col(i);
-      }
+    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 3; ++i) {
+      if (lambda(i) < params_.degeneracy_ratio * lambda(2)) continue;
+      const Eigen::Vector3d v = eig.eigenvectors().col(i);
+      step -= v * (v.dot(g) / lambda(i));
     }
-    // Gauss-Newton in the constrained subspace: H_b d = -B^T g.
-    const Eigen::MatrixXd b = basis.leftCols(rank);
-    const Eigen::MatrixXd hb = b.transpose() * e.hessian * b;
-    const Eigen::VectorXd db = hb.ldlt().solve(-(b.transpose() * e.gradient));
-    const Eigen::Vector3d step = b * db;
     if (!step.allFinite()) break;
     // Backtracking: a full Gauss-Newton step can overshoot where the field
     // bends (corners, the truncation).
@@ -152,9 +173,11 @@ ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start)
       const Pose2 trial{pose.x + scale * step(0), pose.y + scale * step(1),
                         normalizeAngle(pose.yaw + scale * step(2) / kYawScale)};
       const Evaluation te = evaluate(scan, trial, true);
-      if (te.cost < e.cost) {
+      const double trial_cost = total(te, trial);
+      if (trial_cost < cost) {
         pose = trial;
         e = te;
+        cost = trial_cost;
         improved = true;
         break;
       }
@@ -166,7 +189,10 @@ ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start)
   out.matched_beams = e.matched;
   out.translation = std::hypot(pose.x - start.x, pose.y - start.y);
   out.rotation = angleDiff(pose.yaw, start.yaw);
-  if (rank == 0) {
+  // The scan's own information, without the prior: what the fit adds.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(e.hessian);
+  const Eigen::Vector3d lambda = eig.eigenvalues();
+  if (!(lambda(2) > 0.0)) {
     out.rejection = "the scan constrains no direction of the pose";
     return out;
   }
@@ -181,14 +207,22 @@ ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start)
                     " rad): the scan fits another place better, which is for the filter to decide";
     return out;
   }
-  // Residual variance per unit weight, with the 3 (at most) fitted degrees of
-  // freedom taken off, and floored by the map's own precision.
+  // The fit's covariance: the residual variance per unit weight (with the
+  // fitted degrees of freedom taken off, floored by the map's own
+  // precision) times the pseudo-inverse of the scan's Hessian, which says
+  // nothing about the directions the scan does not constrain.
+  int rank = 0;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < 3; ++i) {
+    if (lambda(i) < params_.degeneracy_ratio * lambda(2)) continue;
+    const Eigen::Vector3d v = eig.eigenvectors().col(i);
+    cov += v * v.transpose() / lambda(i);
+    ++rank;
+  }
   const double dof = std::max(1.0, e.sum_weight - rank);
   const double variance =
       std::max(params_.min_beam_std * params_.min_beam_std, e.sum_weighted_sq / dof);
-  const Eigen::MatrixXd b = basis.leftCols(rank);
-  const Eigen::MatrixXd hb = b.transpose() * e.hessian * b;
-  Eigen::Matrix3d cov = b * hb.inverse() * b.transpose() * variance;
+  cov *= variance;
   // Back from the scaled yaw.
   cov.row(2) /= kYawScale;
   cov.col(2) /= kYawScale;

@@ -152,7 +152,9 @@ class ParticleFilter {
  private:
   void weigh(const PreparedScan& scan, UpdateReport* report);
   void resample(UpdateReport* report);
-  void refineEstimate(const PreparedScan& scan, UpdateReport* report);
+  void refineEstimate(const LaserScan& scan, UpdateReport* report);
+  void refineBetweenUpdates(const Pose2& odom, const LaserScan& scan, UpdateReport* report);
+  bool refinedIsCurrent() const;
   Pose2 randomFreePose();
   void restartAfterInitialization();
 
@@ -165,6 +167,15 @@ class ParticleFilter {
   PoseEstimate estimate_;
   Confidence confidence_;
   std::optional<Pose2> odom_at_update_;
+  // map -> odom of the latest accepted scan fit, which may be newer than the
+  // last update, and odom_at_update_ at that update. An update clears it
+  // before fitting; a rejected fit between updates leaves the last one.
+  struct RefinedMapToOdom {
+    Pose2 map_to_odom;
+    Pose2 odom_at_update;
+    Pose2 odom_at_fit;  // the odometry at the scan that was fitted
+  };
+  std::optional<RefinedMapToOdom> refined_;
   bool force_update_ = false;
   bool restart_ = false;  // the next update follows an initialisation
   bool has_estimate_ = false;

@@ -17,10 +17,13 @@
 // further from any obstacle (a person, a door opened since the map was made,
 // nothing mapped) are truncated: they cost a constant and do not pull.
 //
-// Directions the scan does not constrain (along a featureless corridor) are
-// left alone: the step is solved with the pseudo-inverse of the Gauss-Newton
-// Hessian, which keeps the filter's estimate there, and the fit's covariance
-// says nothing about them.
+// The filter's cloud can be passed as a Gaussian prior at the start (the
+// maximum a posteriori pose is found then): what the scan barely constrains,
+// such as the position along a corridor with a door frame or two, then stays
+// near the filter's estimate instead of following the scan's noise.
+// Directions that nothing constrains are left alone: the step is solved with
+// the pseudo-inverse of the Gauss-Newton Hessian. The fit's covariance says
+// nothing about the directions the scan does not constrain.
 //
 // The result is rejected, and the filter's estimate kept, when too few beams
 // match, when the fit constrains nothing, or when it moves further than
@@ -29,6 +32,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 
 #include "pf_localization/core/bicubic_distance_field.h"
@@ -38,6 +42,11 @@
 namespace pf {
 
 struct ScanRefinerParams {
+  // Beams fitted per scan, evenly spaced over the valid ones (<= 0: all).
+  // More than the particles are weighed with: the fit runs once per scan,
+  // not once per particle, and which few beams a dropout leaves would
+  // otherwise shift the fit from scan to scan.
+  int max_beams = 0;
   int max_iterations = 20;        // Gauss-Newton iterations at most
   double outlier_distance = 0.3;  // m: end points this far from any obstacle do not pull
   double cauchy_scale = 0.05;     // m: residuals well beyond this are down-weighted (Cauchy)
@@ -54,8 +63,11 @@ struct ScanRefinerParams {
   // cells quantise the walls (0.05 m cells: 0.014 m std), so no fit is
   // better than that however small its residuals.
   double min_beam_std = 0.015;
+  // m: the std dev of a beam's distance to the wall, which weighs the scan
+  // against the prior (the cloud's covariance) in the fit.
+  double beam_std = 0.03;
   // A direction whose Hessian eigenvalue is below this fraction of the
-  // largest one (yaw scaled by 1 m) is unconstrained by the scan.
+  // largest one (yaw scaled by 1 m) is unconstrained.
   double degeneracy_ratio = 1e-3;
   double convergence = 1e-6;  // m (and rad times 1 m): a smaller step ends the iterations
 };
@@ -89,6 +101,11 @@ class ScanRefiner {
   /// The pose near `start` that best fits `scan` to the map, or `start`
   /// with the reason the fit was rejected.
   ScanRefinement refine(const PreparedScan& scan, const Pose2& start) const;
+  /// The same with a Gaussian prior at `start` (x, y, yaw covariance; empty:
+  /// none): the maximum a posteriori pose, so that what the scan barely
+  /// constrains stays near the start instead of following the noise.
+  ScanRefinement refine(const PreparedScan& scan, const Pose2& start,
+                        const std::optional<Eigen::Matrix3d>& prior_covariance) const;
 
  private:
   struct Evaluation;
