@@ -283,6 +283,7 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
   p.get("refine_min_beam_std", &f.refiner.min_beam_std);
   p.get("refine_degeneracy_ratio", &f.refiner.degeneracy_ratio);
   p.get("refine_beam_std", &f.refiner.beam_std);
+  p.get("refine_convergence", &f.refiner.convergence);
 
   std::string odom_model = "diff";
   p.get("odom_model_type", &odom_model);
