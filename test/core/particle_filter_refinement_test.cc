@@ -62,6 +62,7 @@ ParticleFilterParams params() {
   p.kld.min_particles = 300;
   p.kld.max_particles = 2000;
   p.seed = 3;
+  p.refine_estimate = true;
   return p;
 }
 
