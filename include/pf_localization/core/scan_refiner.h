@@ -9,16 +9,17 @@
 // in 2D LIDAR SLAM", ICRA 2016), here on the distance field instead of a
 // probability grid. For end points p_i (robot frame) and the pose T, it
 // minimises
-//   sum_i rho(D(T p_i) - wall_offset)
+//   sum_i rho(D(T p_i) - wall_offset) / beam_std^2 + prior(T)
 // where D is the bicubic interpolation of the distance to the nearest
 // obstacle (bicubic_distance_field.h) and rho the Cauchy loss with scale
 // cauchy_scale, solved by iteratively reweighted Gauss-Newton with a
-// backtracking line search. Beams whose end point lies outside_distance or
+// backtracking line search. Beams whose end point lies outlier_distance or
 // further from any obstacle (a person, a door opened since the map was made,
 // nothing mapped) are truncated: they cost a constant and do not pull.
 //
-// The filter's cloud can be passed as a Gaussian prior at the start (the
-// maximum a posteriori pose is found then): what the scan barely constrains,
+// prior(T) is optional: 1/2 (T - start)^T C^-1 (T - start) for the filter's
+// cloud covariance C (the maximum a posteriori pose is found then): what the
+// scan barely constrains,
 // such as the position along a corridor with a door frame or two, then stays
 // near the filter's estimate instead of following the scan's noise.
 // Directions that nothing constrains are left alone: the step is solved with
