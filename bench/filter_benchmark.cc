@@ -11,6 +11,7 @@
 #include "pf_localization/core/likelihood_field_model.h"
 #include "pf_localization/core/particle_filter.h"
 #include "pf_localization/core/resampler.h"
+#include "pf_localization/core/scan_refiner.h"
 
 namespace {
 
@@ -94,6 +95,50 @@ void BM_FullUpdate(benchmark::State& state) {
 BENCHMARK(BM_FullUpdate)
     ->ArgsProduct({{1000, 10000, 100000, 1000000}, {60, 360}})
     ->Unit(benchmark::kMillisecond);
+
+// A scan of `beams` beams over a full turn, ray cast on `grid` from `pose`
+// in steps of 5 mm: every end point lies on a wall or a pillar.
+pf::LaserScan castScan(const pf::OccupancyGrid& grid, const pf::Pose2& pose, int beams) {
+  pf::LaserScan scan = fullScan(beams);
+  scan.range_max = 20.0;  // so that every beam finds a pillar or the outer wall
+  for (int i = 0; i < beams; ++i) {
+    const double a = pose.yaw + scan.angle_min + i * scan.angle_increment;
+    scan.ranges[i] = 0.0f;  // no return
+    for (double r = 0.05; r < scan.range_max; r += 0.005) {
+      const pf::CellIndex c = grid.worldToCell(pose.x + r * std::cos(a), pose.y + r * std::sin(a));
+      if (grid.state(c) == pf::CellState::kOccupied) {
+        scan.ranges[i] = static_cast<float>(r);
+        break;
+      }
+    }
+  }
+  return scan;
+}
+
+// One scan fitted to the map from a start 6 cm and 1.1 deg off, as
+// ParticleFilter does after each update (and for each scan between updates).
+void BM_ScanRefinement(benchmark::State& state) {
+  const int beams = static_cast<int>(state.range(0));
+  const pf::OccupancyGrid grid = pillarMap(400);
+  pf::LikelihoodFieldModelParams params;
+  params.max_beams = beams;
+  const pf::LikelihoodFieldModel model(grid, params);
+  const pf::ScanRefiner refiner(model.field(), pf::ScanRefinerParams());
+  const pf::Pose2 truth{9.0, 9.0, 0.3};
+  const pf::PreparedScan scan = model.prepare(castScan(grid, truth, beams));
+  const pf::Pose2 start{truth.x + 0.05, truth.y - 0.03, truth.yaw + 0.02};
+  const Eigen::Matrix3d cloud = Eigen::Vector3d(0.01, 0.01, 0.003).asDiagonal();
+  int iterations = 0;
+  for (auto _ : state) {
+    const pf::ScanRefinement r = refiner.refine(scan, start, cloud);
+    if (!r.accepted) state.SkipWithError(r.rejection.c_str());
+    iterations = r.iterations;
+    benchmark::DoNotOptimize(r.pose);
+  }
+  state.counters["beams"] = static_cast<double>(scan.size());
+  state.counters["gauss_newton_iterations"] = iterations;
+}
+BENCHMARK(BM_ScanRefinement)->Arg(60)->Arg(360)->Unit(benchmark::kMicrosecond);
 
 void BM_SystematicResample(benchmark::State& state) {
   pf::Random random(2);

@@ -40,10 +40,10 @@ double LikelihoodFieldModel::beamLogLikelihood(double distance, double range_max
   return std::log(params_.z_hit * gauss + params_.z_rand / range_max);
 }
 
-PreparedScan LikelihoodFieldModel::prepare(const LaserScan& scan) const {
+PreparedScan LikelihoodFieldModel::prepare(const LaserScan& scan, int max_beams) const {
   std::size_t valid = 0;
   const std::vector<Beam> beams =
-      selectBeams(scan, params_.max_beams, params_.range_min, params_.range_max, &valid);
+      selectBeams(scan, max_beams, params_.range_min, params_.range_max, &valid);
   PreparedScan out;
   out.range_max =
       params_.range_max > 0.0 ? std::min(params_.range_max, scan.range_max) : scan.range_max;

@@ -83,6 +83,7 @@ void validate(const ParticleFilterParams& p) {
           "recovery_alpha_fast", "> recovery_alpha_slow when recovery is on",
           p.recovery.alpha_fast);
   validate(p.confidence);
+  validate(p.refiner);
   const auto& s = p.sensor;
   require(s.z_hit >= 0.0 && finite(s.z_hit), "laser_z_hit", ">= 0", s.z_hit);
   require(s.z_rand >= 0.0 && finite(s.z_rand), "laser_z_rand", ">= 0", s.z_rand);
@@ -130,6 +131,7 @@ ParticleFilter::ParticleFilter(const ParticleFilterParams& params)
 bool ParticleFilter::setMap(const OccupancyGrid& grid) {
   if (grid.empty()) throw std::invalid_argument("the map is empty");
   model_ = std::make_unique<LikelihoodFieldModel>(grid, params_.sensor);
+  refined_.reset();  // fitted to the old map
   if (isInitialized() && grid.isFreeAt(estimate_.pose.x, estimate_.pose.y)) return true;
   particles_.resize(0);  // keeps the reserved storage
   estimate_ = PoseEstimate();
@@ -179,6 +181,7 @@ void ParticleFilter::restartAfterInitialization() {
   // last update must not move them again, so the next update skips motion.
   restart_ = true;
   has_estimate_ = false;
+  refined_.reset();
   confidence_ = Confidence();
   confidence_.state = LocalizationState::kUncertain;
   fit_state_ = confidence_.state;
@@ -238,6 +241,7 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
     if (!force_update_ && step < params_.update_min_d &&
         std::fabs(delta.yaw) < params_.update_min_a) {
       report.skip_reason = "not moved enough since the last update";
+      refineBetweenUpdates(odom, scan, &report);
       return report;
     }
   }
@@ -276,6 +280,7 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
     holdAfterJump(compose(*before, odom), estimate_.pose, params_.confidence, &settle_left_,
                   &confidence_);
   }
+  refineEstimate(scan, &report);
   resample(&report);
   has_estimate_ = true;
   report.updated = true;
@@ -423,8 +428,81 @@ void ParticleFilter::resample(UpdateReport* report) {
   report->injected = injected;
 }
 
+void ParticleFilter::refineEstimate(const LaserScan& scan, UpdateReport* report) {
+  refined_.reset();
+  ScanRefinement& r = report->refinement;
+  r.pose = estimate_.pose;
+  if (!params_.refine_estimate) {
+    r.rejection = "refine_estimate is off";
+    return;
+  }
+  // A lost filter's estimate is nowhere near the robot: a fit from there
+  // would only polish a wrong pose.
+  if (confidence_.state == LocalizationState::kLost) {
+    r.rejection = "the filter is lost";
+    return;
+  }
+  // The cloud is the prior: the fit moves the estimate only as far as the
+  // scan's evidence outweighs the cloud's.
+  r = ScanRefiner(model_->field(), params_.refiner)
+          .refine(model_->prepare(scan, params_.refiner.max_beams), estimate_.pose,
+                  estimate_.covariance);
+  if (!r.accepted) return;
+  refined_ = RefinedMapToOdom{compose(r.pose, inverse(*odom_at_update_)), *odom_at_update_,
+                              *odom_at_update_};
+  // The fit is sharper than the cloud, but the cloud's spread (or its
+  // rivals') is evidence too: what is published covers both.
+  estimate_.pose = r.pose;
+  estimate_.covariance = coveringCovariance(r.covariance, estimate_.covariance);
+  confidence_.covariance = coveringCovariance(r.covariance, confidence_.covariance);
+}
+
+void ParticleFilter::refineBetweenUpdates(const Pose2& odom, const LaserScan& scan,
+                                          UpdateReport* report) {
+  // The scans between filter updates place the robot too: each is fitted
+  // from the last update's estimate moved by the odometry since, so the
+  // published map -> odom follows the map instead of the odometry's drift.
+  // Each starts from the update's estimate, never from the previous fit, so
+  // fits cannot walk away from the cloud.
+  if (!params_.refine_estimate || !has_estimate_ || !odom_at_update_ ||
+      confidence_.state == LocalizationState::kLost) {
+    return;
+  }
+  ScanRefinement& r = report->refinement;
+  if (refinedIsCurrent()) {
+    // Standing still there is nothing new to place: another fit would only
+    // add this scan's noise to the published pose, which tf users see as
+    // jitter.
+    const Pose2 moved = between(refined_->odom_at_fit, odom);
+    if (std::hypot(moved.x, moved.y) < 1e-3 && std::fabs(moved.yaw) < 1e-3) {
+      r.pose = compose(refined_->map_to_odom, odom);
+      r.rejection = "not moved since the last fit, which stands";
+      return;
+    }
+  }
+  const Pose2 predicted = compose(compose(estimate_.pose, inverse(*odom_at_update_)), odom);
+  const std::optional<Eigen::Matrix3d> prior =
+      estimate_.clusters.empty() ? std::nullopt
+                                 : std::optional<Eigen::Matrix3d>(estimate_.clusters[0].covariance);
+  r = ScanRefiner(model_->field(), params_.refiner)
+          .refine(model_->prepare(scan, params_.refiner.max_beams), predicted, prior);
+  if (r.accepted) {
+    refined_ = RefinedMapToOdom{compose(r.pose, inverse(odom)), *odom_at_update_, odom};
+  }
+}
+
+bool ParticleFilter::refinedIsCurrent() const {
+  // A fit belongs to the update it started from: after an odometry fault (a
+  // new odom_at_update_ without an update) it is stale.
+  if (!refined_ || !odom_at_update_) return false;
+  const Pose2& at = *odom_at_update_;
+  return refined_->odom_at_update.x == at.x && refined_->odom_at_update.y == at.y &&
+         refined_->odom_at_update.yaw == at.yaw;
+}
+
 std::optional<Pose2> ParticleFilter::mapToOdom() const {
   if (!has_estimate_ || !odom_at_update_) return std::nullopt;
+  if (refinedIsCurrent()) return refined_->map_to_odom;
   return compose(estimate_.pose, inverse(*odom_at_update_));
 }
 

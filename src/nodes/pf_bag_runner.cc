@@ -215,7 +215,8 @@ int main(int argc, char** argv) {
     log.open(opt.log);
     if (!log) fail(opt.log + ": cannot write");
     log << "t,particles,ess,cpu_ms,mean_beam_likelihood,std_x,std_y,std_yaw,updated,injected,"
-           "tempering,hit_fraction,rivals,state\n";
+           "tempering,hit_fraction,rivals,state,refined,refine_translation,refine_rotation,"
+           "refine_rms,refine_matched\n";
   }
   if (!opt.particles_out.empty()) {
     dump.open(opt.particles_out);
@@ -255,7 +256,9 @@ int main(int argc, char** argv) {
             << std::sqrt(est.covariance(0, 0)) << "," << std::sqrt(est.covariance(1, 1)) << ","
             << std::sqrt(est.covariance(2, 2)) << ",1," << r.report.injected << ","
             << r.report.tempering << "," << conf.hit_fraction << "," << conf.rivals << ","
-            << pf::toString(conf.state) << "\n";
+            << pf::toString(conf.state) << "," << r.report.refinement.accepted << ","
+            << r.report.refinement.translation << "," << r.report.refinement.rotation << ","
+            << r.report.refinement.rms_distance << "," << r.report.refinement.matched_beams << "\n";
       }
       if (dump && t - first_stamp <= kParticleDumpSeconds) {
         const pf::ParticleSet& p = localizer.filter().particles();

@@ -276,6 +276,20 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
   p.get("recovery_expansion_ratio", &f.recovery.expansion_ratio);
   p.get("recovery_expansion_std_xy", &f.recovery.expansion_std_xy);
   p.get("recovery_expansion_std_yaw", &f.recovery.expansion_std_yaw);
+  p.get("refine_estimate", &f.refine_estimate);
+  p.get("refine_max_beams", &f.refiner.max_beams);
+  p.get("refine_max_iterations", &f.refiner.max_iterations);
+  p.get("refine_outlier_distance", &f.refiner.outlier_distance);
+  p.get("refine_cauchy_scale", &f.refiner.cauchy_scale);
+  p.get("refine_wall_offset", &f.refiner.wall_offset);
+  p.get("refine_min_matched_fraction", &f.refiner.min_matched_fraction);
+  p.get("refine_min_matched_beams", &f.refiner.min_matched_beams);
+  p.get("refine_max_translation", &f.refiner.max_translation);
+  p.get("refine_max_rotation", &f.refiner.max_rotation);
+  p.get("refine_min_beam_std", &f.refiner.min_beam_std);
+  p.get("refine_degeneracy_ratio", &f.refiner.degeneracy_ratio);
+  p.get("refine_beam_std", &f.refiner.beam_std);
+  p.get("refine_convergence", &f.refiner.convergence);
 
   std::string odom_model = "diff";
   p.get("odom_model_type", &odom_model);

@@ -69,7 +69,8 @@ void logScan(const pf::LaserScan& s) {
 
 // Input layout, in order:
 //   params:  flags u8 (bit0 omni, bit1 max < min allowed, bit2 laser_max_range
-//            given, bit3 laser_min_range given, bit4 recovery on),
+//            given, bit3 laser_min_range given, bit4 recovery on, bit5
+//            refine_estimate on),
 //            min_particles u8, max_particles u8, kld_err, kld_confidence,
 //            kld_bin_xy, kld_bin_yaw, update_min_d, update_min_a,
 //            resample_ess_fraction, seed u8, alpha1..5, z_hit, z_rand,
@@ -114,6 +115,7 @@ pf::ParticleFilterParams readParams(Input& in) {
     p.recovery.alpha_slow = in.num(0.0, 0.1);
     p.recovery.alpha_fast = in.num(0.0, 1.0);
   }
+  p.refine_estimate = (flags & 32) != 0;
   return p;
 }
 
@@ -249,6 +251,15 @@ void checkFilter(const pf::ParticleFilter& filter, const pf::UpdateReport& repor
   if (report.updated) {
     PF_FUZZ_CHECK(!filter.estimate().clusters.empty(), "an update without a cluster");
     PF_FUZZ_CHECK(filter.mapToOdom().has_value(), "an update without map -> odom");
+  }
+  if (report.refinement.accepted) {
+    const pf::ScanRefinerParams& r = p.refiner;
+    PF_FUZZ_CHECK(report.refinement.pose.isFinite() && report.refinement.covariance.allFinite(),
+                  "a non-finite refinement");
+    PF_FUZZ_CHECK(report.refinement.translation <= r.max_translation &&
+                      std::fabs(report.refinement.rotation) <= r.max_rotation,
+                  "a refinement beyond its bounds: %g m, %g rad", report.refinement.translation,
+                  report.refinement.rotation);
   }
   (void)filter.mapToOdom();
 }

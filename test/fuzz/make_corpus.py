@@ -41,8 +41,8 @@ def pose(x, y, yaw, xy, a):
 
 
 def params(flags=0, min_p=50, max_p=150, max_beams=32, recovery=None, omni=False,
-           sigma_hit=0.2, z_rand=0.05, kld_bin_xy=None, cluster_xy=None, ess=0.5):
-    b = u8(flags | (1 if omni else 0) | (16 if recovery else 0))
+           sigma_hit=0.2, z_rand=0.05, kld_bin_xy=None, cluster_xy=None, ess=0.5, refine=False):
+    b = u8(flags | (1 if omni else 0) | (16 if recovery else 0) | (32 if refine else 0))
     b += u8(min_p - 1)                      # min_particles = raw % 100 + 1
     b += u8(max_p - min_p)                  # max_particles = min + raw % 101
     b += num(0.05, 0.001, 0.5)              # kld_err
@@ -109,21 +109,23 @@ def cov(vx=0.05, vy=0.05, va=0.05):
 
 def core_seeds():
     seeds = {}
-    # 1. Tracking in a walled room: Gaussian start, moves, a new scan, a no-motion update.
-    b = params() + room_map(1)
-    b += u8(0) + pose(1.5, 1.0, 0.0, 25.0, 4.0) + cov()
-    b += pose(0.0, 0.0, 0.0, 5.0, 4.0)                     # odometry
-    b += scan(ray_ranges(1.5, 1.0, 0.0, 72), bad={3, 40})
-    b += u8(7)                                              # 8 steps
-    b += u8(0) + pose(0.2, 0.0, 0.05, 0.5, 0.7)
-    b += u8(0) + pose(0.2, 0.0, 0.05, 0.5, 0.7)
-    b += u8(4) + scan(ray_ranges(1.9, 1.0, 0.1, 72))
-    b += u8(6)
-    b += u8(1) + pose(-0.3, 0.05, -0.4, 0.5, 0.7)
-    b += u8(5) + num(0.0, -1, 1) + u8(1)                   # angle_increment 0
-    b += u8(2) + pose(0.1, 0.0, 0.6, 0.5, 0.7)
-    b += u8(9) + pose(0.01, 0.0, 0.0, 0.05, 0.1)
-    seeds["tracking"] = b
+    # 1. Tracking in a walled room: Gaussian start, moves, a new scan, a no-motion update;
+    #    once as it is, once with the estimate refined against the map.
+    for name, refine in (("tracking", False), ("tracking_refined", True)):
+        b = params(refine=refine) + room_map(1)
+        b += u8(0) + pose(1.5, 1.0, 0.0, 25.0, 4.0) + cov()
+        b += pose(0.0, 0.0, 0.0, 5.0, 4.0)                     # odometry
+        b += scan(ray_ranges(1.5, 1.0, 0.0, 72), bad={3, 40})
+        b += u8(7)                                              # 8 steps
+        b += u8(0) + pose(0.2, 0.0, 0.05, 0.5, 0.7)
+        b += u8(0) + pose(0.2, 0.0, 0.05, 0.5, 0.7)
+        b += u8(4) + scan(ray_ranges(1.9, 1.0, 0.1, 72))
+        b += u8(6)
+        b += u8(1) + pose(-0.3, 0.05, -0.4, 0.5, 0.7)
+        b += u8(5) + num(0.0, -1, 1) + u8(1)                   # angle_increment 0
+        b += u8(2) + pose(0.1, 0.0, 0.6, 0.5, 0.7)
+        b += u8(9) + pose(0.01, 0.0, 0.0, 0.05, 0.1)
+        seeds[name] = b
     # 2. Global localization, omni drive, recovery on.
     b = params(omni=True, recovery=(0.001, 0.1), min_p=20, max_p=200) + room_map(1)
     b += u8(1) + pose(0.0, 0.0, 0.0, 5.0, 4.0)

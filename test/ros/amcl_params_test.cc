@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -141,6 +142,25 @@ TEST(AmclParams, UnknownNamesAreListedInOneWarning) {
   EXPECT_NE(notes.warnings[0].find("min_particle, odom_alpha_1"), std::string::npos)
       << notes.warnings[0];
   EXPECT_EQ(notes.warnings[0].find("max_particles"), std::string::npos) << notes.warnings[0];
+}
+
+TEST(AmclParams, RefinementParametersAreReadAndValidated) {
+  const LocalizerConfig c = readConfig(
+      *yaml("refine_estimate: false\nrefine_max_beams: 90\nrefine_max_translation: 0.25\n"
+            "refine_max_rotation: 0.1\nrefine_outlier_distance: 0.4\nrefine_beam_std: 0.05\n"));
+  EXPECT_FALSE(c.filter.refine_estimate);
+  EXPECT_EQ(90, c.filter.refiner.max_beams);
+  EXPECT_EQ(0.25, c.filter.refiner.max_translation);
+  EXPECT_EQ(0.1, c.filter.refiner.max_rotation);
+  EXPECT_EQ(0.4, c.filter.refiner.outlier_distance);
+  EXPECT_EQ(0.05, c.filter.refiner.beam_std);
+  try {
+    readConfig(*yaml("refine_max_rotation: 4\n"));
+    ADD_FAILURE() << "refine_max_rotation 4 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_EQ(std::string("invalid parameter refine_max_rotation = 4: must be in [0, pi]"),
+              e.what());
+  }
 }
 
 // config/pf.yaml, the defaults under every launch file: all of it known.

@@ -59,7 +59,9 @@ class LikelihoodFieldModel {
   const LikelihoodField& field() const { return field_; }
 
   /// The usable beams' end points in the robot frame.
-  PreparedScan prepare(const LaserScan& scan) const;
+  PreparedScan prepare(const LaserScan& scan) const { return prepare(scan, params_.max_beams); }
+  /// The same with another beam budget (<= 0: every usable beam).
+  PreparedScan prepare(const LaserScan& scan, int max_beams) const;
 
   /// likelihood_exponent * log p(scan | pose) for one pose.
   double logLikelihood(const PreparedScan& scan, const Pose2& pose) const;

@@ -1,0 +1,126 @@
+// Scan-to-map refinement: the pose at which the scan's end points lie best
+// on the map's obstacles, found by Gauss-Newton from the filter's estimate.
+//
+// The particle filter's estimate is the weighted mean of a cloud whose
+// particles are spread by the motion noise, so it wobbles by centimetres from
+// update to update. A scan of a few dozen beams pins the pose down far more
+// tightly than that, once the pose is known well enough to match it: this is
+// the Ceres scan matcher of Cartographer (Hess et al., "Real-Time Loop Closure
+// in 2D LIDAR SLAM", ICRA 2016), here on the distance field instead of a
+// probability grid. For end points p_i (robot frame) and the pose T, it
+// minimises
+//   sum_i rho(D(T p_i) - wall_offset) / beam_std^2 + prior(T)
+// where D is the bicubic interpolation of the distance to the nearest
+// obstacle (bicubic_distance_field.h) and rho the Cauchy loss with scale
+// cauchy_scale, solved by iteratively reweighted Gauss-Newton with a
+// backtracking line search. Beams whose end point lies outlier_distance or
+// further from any obstacle (a person, a door opened since the map was made,
+// nothing mapped) are truncated: they cost a constant and do not pull.
+//
+// prior(T) is optional: 1/2 (T - start)^T C^-1 (T - start) for the filter's
+// cloud covariance C (the maximum a posteriori pose is found then): what the
+// scan barely constrains,
+// such as the position along a corridor with a door frame or two, then stays
+// near the filter's estimate instead of following the scan's noise.
+// Directions that nothing constrains are left alone: the step is solved with
+// the pseudo-inverse of the Gauss-Newton Hessian. The fit's covariance says
+// nothing about the directions the scan does not constrain.
+//
+// The result is rejected, and the filter's estimate kept, when too few beams
+// match, when the fit constrains nothing, or when it moves further than
+// max_translation / max_rotation: a jump that large means the scan fits
+// another place better, and choosing between hypotheses is the filter's job.
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+#include <string>
+
+#include "pf_localization/core/bicubic_distance_field.h"
+#include "pf_localization/core/likelihood_field_model.h"
+#include "pf_localization/core/pose2.h"
+
+namespace pf {
+
+struct ScanRefinerParams {
+  // Beams fitted per scan, evenly spaced over the valid ones (<= 0: all).
+  // More than the particles are weighed with: the fit runs once per scan,
+  // not once per particle, and which few beams a dropout leaves would
+  // otherwise shift the fit from scan to scan.
+  int max_beams = 0;
+  int max_iterations = 20;        // Gauss-Newton iterations at most
+  double outlier_distance = 0.3;  // m: end points this far from any obstacle do not pull
+  double cauchy_scale = 0.05;     // m: residuals well beyond this are down-weighted (Cauchy)
+  // m: the distance from an occupied cell's centre at which a beam ends on
+  // the wall. The field measures distances to cell centres; a laser stops at
+  // the face of the first occupied cell, which a ray-cast simulation puts
+  // half a cell from its centre, and a mapped wall somewhere inside its cells.
+  double wall_offset = 0.0;
+  double min_matched_fraction = 0.3;  // of the beams, ending within outlier_distance: fewer rejects
+  int min_matched_beams = 8;          // and at least this many
+  double max_translation = 0.5;       // m: a longer move is rejected
+  double max_rotation = 0.3;          // rad: a larger turn is rejected
+  // m: floor of the per-beam residual std dev in the covariance. The map's
+  // cells quantise the walls (0.05 m cells: 0.014 m std), so no fit is
+  // better than that however small its residuals.
+  double min_beam_std = 0.015;
+  // m: the std dev of a beam's distance to the wall, which weighs the scan
+  // against the prior (the cloud's covariance) in the fit.
+  double beam_std = 0.03;
+  // A direction whose Hessian eigenvalue is below this fraction of the
+  // largest one (yaw scaled by 1 m) is unconstrained.
+  double degeneracy_ratio = 1e-3;
+  double convergence = 1e-6;  // m (and rad times 1 m): a smaller step ends the iterations
+};
+
+/// Throws std::invalid_argument naming the first parameter out of range (with
+/// its refine_ parameter name) and its valid range.
+void validate(const ScanRefinerParams& params);
+
+struct ScanRefinement {
+  bool accepted = false;
+  std::string rejection;  // why not, when !accepted
+  Pose2 pose;             // the refined pose when accepted, else the start
+  // The fit's covariance (x, y, yaw): the residual variance times the
+  // inverse Hessian, zero in the directions the scan does not constrain.
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+  int iterations = 0;
+  int matched_beams = 0;      // ending within outlier_distance, at the final pose
+  double rms_distance = 0.0;  // m, of the matched beams, at the final pose
+  double translation = 0.0;   // m moved from the start
+  double rotation = 0.0;      // rad turned from the start
+};
+
+class ScanRefiner {
+ public:
+  /// Keeps a reference to `field`, which must outlive the refiner.
+  /// Throws std::invalid_argument (see validate()).
+  ScanRefiner(const LikelihoodField& field, const ScanRefinerParams& params);
+
+  const ScanRefinerParams& params() const { return params_; }
+
+  /// The pose near `start` that best fits `scan` to the map, or `start`
+  /// with the reason the fit was rejected.
+  ScanRefinement refine(const PreparedScan& scan, const Pose2& start) const;
+  /// The same with a Gaussian prior at `start` (x, y, yaw covariance; empty:
+  /// none): the maximum a posteriori pose, so that what the scan barely
+  /// constrains stays near the start instead of following the noise.
+  ScanRefinement refine(const PreparedScan& scan, const Pose2& start,
+                        const std::optional<Eigen::Matrix3d>& prior_covariance) const;
+
+ private:
+  struct Evaluation;
+  Evaluation evaluate(const PreparedScan& scan, const Pose2& pose, bool with_derivatives) const;
+
+  BicubicDistanceField field_;
+  ScanRefinerParams params_;
+};
+
+/// A covariance at least as wide as both `a` and `b` in every direction (C -
+/// a and C - b positive semi-definite), and no wider than needed along their
+/// common principal axes: both are whitened by a + b, in which they share
+/// eigenvectors, and the larger variance is taken along each. For publishing
+/// a refined pose without claiming more certainty than the cloud has.
+Eigen::Matrix3d coveringCovariance(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b);
+
+}  // namespace pf

@@ -1,0 +1,258 @@
+#include "pf_localization/core/scan_refiner.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace pf {
+namespace {
+
+void require(bool ok, const std::string& name, const std::string& range, double value) {
+  if (!ok) {
+    std::ostringstream text;
+    text << "invalid parameter " << name << " = " << value << ": must be " << range;
+    throw std::invalid_argument(text.str());
+  }
+}
+
+bool finite(double v) { return std::isfinite(v); }
+
+// Yaw enters the eigen-analysis scaled by this length, so that a radian
+// weighs as much as the metre a beam's end point moves at 1 m range.
+constexpr double kYawScale = 1.0;  // m
+
+std::string text(double v) {
+  std::ostringstream s;
+  s.precision(3);
+  s << v;
+  return s.str();
+}
+
+}  // namespace
+
+void validate(const ScanRefinerParams& p) {
+  require(p.max_iterations >= 1, "refine_max_iterations", ">= 1", p.max_iterations);
+  require(p.outlier_distance > 0.0 && finite(p.outlier_distance), "refine_outlier_distance", "> 0",
+          p.outlier_distance);
+  require(p.cauchy_scale > 0.0 && finite(p.cauchy_scale), "refine_cauchy_scale", "> 0",
+          p.cauchy_scale);
+  require(p.wall_offset >= 0.0 && p.wall_offset < p.outlier_distance, "refine_wall_offset",
+          "in [0, refine_outlier_distance)", p.wall_offset);
+  require(p.min_matched_fraction >= 0.0 && p.min_matched_fraction <= 1.0,
+          "refine_min_matched_fraction", "in [0, 1]", p.min_matched_fraction);
+  require(p.min_matched_beams >= 3, "refine_min_matched_beams", ">= 3", p.min_matched_beams);
+  require(p.max_translation >= 0.0 && finite(p.max_translation), "refine_max_translation", ">= 0",
+          p.max_translation);
+  require(p.max_rotation >= 0.0 && p.max_rotation <= M_PI, "refine_max_rotation", "in [0, pi]",
+          p.max_rotation);
+  require(p.min_beam_std > 0.0 && finite(p.min_beam_std), "refine_min_beam_std", "> 0",
+          p.min_beam_std);
+  require(p.degeneracy_ratio > 0.0 && p.degeneracy_ratio < 1.0, "refine_degeneracy_ratio",
+          "in (0, 1)", p.degeneracy_ratio);
+  require(p.beam_std > 0.0 && finite(p.beam_std), "refine_beam_std", "> 0", p.beam_std);
+  require(p.convergence > 0.0 && finite(p.convergence), "refine_convergence", "> 0", p.convergence);
+}
+
+// The robust cost at one pose, and optionally the Gauss-Newton system.
+struct ScanRefiner::Evaluation {
+  double cost = 0.0;
+  int matched = 0;
+  double sum_weight = 0.0;
+  double sum_weighted_sq = 0.0;                        // sum of w r^2 over matched beams
+  double sum_sq = 0.0;                                 // sum of r^2 over matched beams
+  Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();   // J^T W J, yaw scaled by kYawScale
+  Eigen::Vector3d gradient = Eigen::Vector3d::Zero();  // J^T W r
+};
+
+ScanRefiner::ScanRefiner(const LikelihoodField& field, const ScanRefinerParams& params)
+    : field_(field), params_((validate(params), params)) {}
+
+ScanRefiner::Evaluation ScanRefiner::evaluate(const PreparedScan& scan, const Pose2& pose,
+                                              bool with_derivatives) const {
+  Evaluation e;
+  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
+  const double k2 = params_.cauchy_scale * params_.cauchy_scale;
+  const double truncated = params_.outlier_distance - params_.wall_offset;
+  const double outlier_cost = 0.5 * k2 * std::log1p(truncated * truncated / k2);
+  for (std::size_t b = 0; b < scan.size(); ++b) {
+    const double px = scan.x[b], py = scan.y[b];
+    const double mx = pose.x + c * px - s * py, my = pose.y + s * px + c * py;
+    const FieldSample f = field_.sample(mx, my);
+    if (!(f.distance < params_.outlier_distance)) {
+      // Constant beyond the truncation, so the cost stays continuous as
+      // beams come and go.
+      e.cost += outlier_cost;
+      continue;
+    }
+    const double r = f.distance - params_.wall_offset;
+    const double q = 1.0 + r * r / k2;
+    e.cost += 0.5 * k2 * std::log(q);
+    ++e.matched;
+    const double w = 1.0 / q;  // Cauchy: rho'(r^2 / 2)
+    e.sum_weight += w;
+    e.sum_weighted_sq += w * r * r;
+    e.sum_sq += r * r;
+    if (!with_derivatives) continue;
+    // d(end point)/d(yaw) = (-s px - c py, c px - s py).
+    const Eigen::Vector3d j(f.dx, f.dy,
+                            (f.dx * (-s * px - c * py) + f.dy * (c * px - s * py)) / kYawScale);
+    e.hessian.noalias() += w * j * j.transpose();
+    e.gradient.noalias() += w * r * j;
+  }
+  return e;
+}
+
+ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start) const {
+  return refine(scan, start, std::nullopt);
+}
+
+ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start,
+                                   const std::optional<Eigen::Matrix3d>& prior_covariance) const {
+  ScanRefinement out;
+  out.pose = start;
+  const int n = static_cast<int>(scan.size());
+  const int needed = std::max(params_.min_matched_beams,
+                              static_cast<int>(std::ceil(params_.min_matched_fraction * n)));
+  const auto too_few = [&](int matched) {
+    return "only " + std::to_string(matched) + " of " + std::to_string(n) + " beams end within " +
+           text(params_.outlier_distance) + " m of a mapped obstacle (" + std::to_string(needed) +
+           " needed): nothing to match";
+  };
+
+  // The prior in the scaled coordinates (x, y, kYawScale yaw): a tiny floor
+  // keeps a zero covariance from becoming an infinite information.
+  Eigen::Matrix3d prior_information = Eigen::Matrix3d::Zero();
+  if (prior_covariance) {
+    const Eigen::DiagonalMatrix<double, 3> scale(1.0, 1.0, kYawScale);
+    const Eigen::Matrix3d scaled = scale * (*prior_covariance) * scale;
+    prior_information = (scaled + 1e-6 * Eigen::Matrix3d::Identity()).inverse();
+    if (!prior_information.allFinite()) prior_information.setZero();
+  }
+  const double inv_beam_variance = 1.0 / (params_.beam_std * params_.beam_std);
+  // The total cost: the scan's over beam_std^2, plus the prior's.
+  const auto total = [&](const Evaluation& ev, const Pose2& at) {
+    const Eigen::Vector3d d(at.x - start.x, at.y - start.y,
+                            kYawScale * angleDiff(at.yaw, start.yaw));
+    return ev.cost * inv_beam_variance + 0.5 * d.dot(prior_information * d);
+  };
+
+  Pose2 pose = start;
+  Evaluation e = evaluate(scan, pose, true);
+  if (e.matched < needed) {
+    out.matched_beams = e.matched;
+    out.rejection = too_few(e.matched);
+    return out;
+  }
+  double cost = total(e, pose);
+  for (int it = 0; it < params_.max_iterations; ++it) {
+    const Eigen::Vector3d d(pose.x - start.x, pose.y - start.y,
+                            kYawScale * angleDiff(pose.yaw, start.yaw));
+    const Eigen::Matrix3d h = e.hessian * inv_beam_variance + prior_information;
+    const Eigen::Vector3d g = e.gradient * inv_beam_variance + prior_information * d;
+    // Gauss-Newton with the pseudo-inverse: a direction neither the scan nor
+    // the prior constrains (a corridor's length, without a prior) is not
+    // moved along, where noise alone would otherwise drag the fit.
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(h);
+    const Eigen::Vector3d lambda = eig.eigenvalues();  // increasing
+    if (!(lambda(2) > 0.0)) break;
+    Eigen::Vector3d step = Eigen::Vector3d::Zero();
+    for (int i = 0; i < 3; ++i) {
+      if (lambda(i) < params_.degeneracy_ratio * lambda(2)) continue;
+      const Eigen::Vector3d v = eig.eigenvectors().col(i);
+      step -= v * (v.dot(g) / lambda(i));
+    }
+    if (!step.allFinite()) break;
+    // Backtracking: a full Gauss-Newton step can overshoot where the field
+    // bends (corners, the truncation).
+    double scale = 1.0;
+    bool improved = false;
+    for (int k = 0; k < 10; ++k, scale *= 0.5) {
+      const Pose2 trial{pose.x + scale * step(0), pose.y + scale * step(1),
+                        normalizeAngle(pose.yaw + scale * step(2) / kYawScale)};
+      const Evaluation te = evaluate(scan, trial, true);
+      const double trial_cost = total(te, trial);
+      if (trial_cost < cost) {
+        pose = trial;
+        e = te;
+        cost = trial_cost;
+        improved = true;
+        break;
+      }
+    }
+    out.iterations = it + 1;
+    if (!improved || scale * step.norm() < params_.convergence) break;
+  }
+
+  out.matched_beams = e.matched;
+  out.translation = std::hypot(pose.x - start.x, pose.y - start.y);
+  out.rotation = angleDiff(pose.yaw, start.yaw);
+  // The scan's own information, without the prior: what the fit adds.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(e.hessian);
+  const Eigen::Vector3d lambda = eig.eigenvalues();
+  if (!(lambda(2) > 0.0)) {
+    out.rejection = "the scan constrains no direction of the pose";
+    return out;
+  }
+  if (e.matched < needed) {
+    out.rejection = too_few(e.matched);
+    return out;
+  }
+  if (out.translation > params_.max_translation || std::fabs(out.rotation) > params_.max_rotation) {
+    out.rejection = "the fit moved " + text(out.translation) + " m and " +
+                    text(std::fabs(out.rotation)) + " rad (bounds " +
+                    text(params_.max_translation) + " m, " + text(params_.max_rotation) +
+                    " rad): the scan fits another place better, which is for the filter to decide";
+    return out;
+  }
+  // The fit's covariance: the residual variance per unit weight (with the
+  // fitted degrees of freedom taken off, floored by the map's own
+  // precision) times the pseudo-inverse of the scan's Hessian, which says
+  // nothing about the directions the scan does not constrain.
+  int rank = 0;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < 3; ++i) {
+    if (lambda(i) < params_.degeneracy_ratio * lambda(2)) continue;
+    const Eigen::Vector3d v = eig.eigenvectors().col(i);
+    cov += v * v.transpose() / lambda(i);
+    ++rank;
+  }
+  const double dof = std::max(1.0, e.sum_weight - rank);
+  const double variance =
+      std::max(params_.min_beam_std * params_.min_beam_std, e.sum_weighted_sq / dof);
+  cov *= variance;
+  // Back from the scaled yaw.
+  cov.row(2) /= kYawScale;
+  cov.col(2) /= kYawScale;
+  out.covariance = 0.5 * (cov + cov.transpose());
+  out.rms_distance = std::sqrt(e.sum_sq / e.matched);
+  out.pose = pose;
+  out.accepted = true;
+  return out;
+}
+
+Eigen::Matrix3d coveringCovariance(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b) {
+  // Whitened by M = a + b, a' + b' = I, so a' and b' share eigenvectors and
+  // their eigenvalues pair up as (alpha, 1 - alpha). The tiny ridge makes M
+  // invertible when both are flat in some direction.
+  const Eigen::Matrix3d m = a + b + 1e-12 * Eigen::Matrix3d::Identity();
+  const Eigen::LLT<Eigen::Matrix3d> llt(m);
+  if (llt.info() != Eigen::Success) return a + b;  // not PSD: the sum covers both anyway
+  const Eigen::Matrix3d l = llt.matrixL();
+  const Eigen::Matrix3d l_inv = l.inverse();
+  const Eigen::Matrix3d aw = l_inv * a * l_inv.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (aw + aw.transpose()));
+  const Eigen::Matrix3d& v = eig.eigenvectors();
+  const Eigen::Matrix3d bw = l_inv * b * l_inv.transpose();
+  Eigen::Vector3d wider;
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d vi = v.col(i);
+    wider(i) = std::max(vi.dot(aw * vi), vi.dot(bw * vi));
+  }
+  const Eigen::Matrix3d c = l * v * wider.asDiagonal() * v.transpose() * l.transpose();
+  return 0.5 * (c + c.transpose());
+}
+
+}  // namespace pf

@@ -1,0 +1,183 @@
+// ParticleFilter with refine_estimate: the scan fit of scan_refiner.h feeds
+// the published estimate and map -> odom (scan_refiner_test.cc tests the fit
+// itself). In a file of its own, with its own small world, so that it stays
+// apart from the filter's other tests.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "expect_pose.h"
+#include "pf_localization/core/particle_filter.h"
+
+namespace pf {
+namespace {
+
+constexpr double kRes = 0.05;
+
+// A 4 m x 3 m room in 0.05 m cells: one-cell walls, a box near its lower
+// right and a smaller one near its upper left.
+OccupancyGrid asymmetricRoom() {
+  const int w = 80, h = 60;
+  std::vector<int8_t> data(static_cast<std::size_t>(w) * h, 0);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const double cx = (x + 0.5) * kRes, cy = (y + 0.5) * kRes;
+      const bool wall = x == 0 || y == 0 || x == w - 1 || y == h - 1;
+      const bool box = cx > 2.5 && cx < 3.0 && cy > 0.5 && cy < 1.2;
+      const bool small_box = cx > 0.6 && cx < 1.0 && cy > 2.0 && cy < 2.4;
+      data[static_cast<std::size_t>(y) * w + x] = wall || box || small_box ? 100 : 0;
+    }
+  }
+  return OccupancyGrid(w, h, kRes, {}, data);
+}
+
+// 180 beams over a full turn from the robot's centre, ray cast in 1 mm steps.
+LaserScan castScan(const OccupancyGrid& grid, const Pose2& robot) {
+  LaserScan scan;
+  scan.angle_min = -M_PI;
+  scan.angle_increment = 2.0 * M_PI / 180;
+  scan.range_min = 0.05;
+  scan.range_max = 8.0;
+  scan.ranges.assign(180, std::numeric_limits<float>::quiet_NaN());
+  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+    const double a = robot.yaw + scan.angle_min + i * scan.angle_increment;
+    for (double t = 0.0; t < scan.range_max; t += 0.001) {
+      const CellIndex c = grid.worldToCell(robot.x + t * std::cos(a), robot.y + t * std::sin(a));
+      if (!grid.contains(c)) break;
+      if (grid.state(c) == CellState::kOccupied) {
+        scan.ranges[i] = static_cast<float>(t);
+        break;
+      }
+    }
+  }
+  return scan;
+}
+
+ParticleFilterParams params() {
+  ParticleFilterParams p;
+  p.kld.min_particles = 300;
+  p.kld.max_particles = 2000;
+  p.seed = 3;
+  p.refine_estimate = true;
+  return p;
+}
+
+// The odometry frame: odom = kOdomInMap^-1 (+) truth.
+const Pose2 kOdomInMap{0.7, -0.4, 0.3};
+Pose2 odomOf(const Pose2& truth) { return compose(inverse(kOdomInMap), truth); }
+
+const Pose2 kTruth{1.6, 1.4, 0.2};
+const Eigen::Matrix3d kStartCov =
+    Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, 0.03 * 0.03).asDiagonal();
+
+double distance(const Pose2& a, const Pose2& b) { return std::hypot(a.x - b.x, a.y - b.y); }
+
+void expectPositiveSemiDefinite(const Eigen::Matrix3d& m) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(m);
+  EXPECT_GE(eig.eigenvalues()(0), -1e-12) << m;
+}
+
+TEST(ParticleFilterRefinement, TheFittedPoseIsPublishedThroughMapToOdom) {
+  const OccupancyGrid grid = asymmetricRoom();
+  ParticleFilter filter(params());
+  filter.setMap(grid);
+  filter.initializeGaussian({kTruth.x + 0.04, kTruth.y - 0.03, kTruth.yaw + 0.02}, kStartCov);
+  const Pose2 odom = odomOf(kTruth);
+  const UpdateReport r = filter.update(odom, castScan(grid, kTruth));
+  ASSERT_TRUE(r.updated) << r.skip_reason;
+  ASSERT_TRUE(r.refinement.accepted) << r.refinement.rejection;
+  EXPECT_EQ(180, r.refinement.matched_beams);
+  const PoseEstimate& e = filter.estimate();
+  expectPoseNear(r.refinement.pose, e.pose, 0.0);
+  // Beams end on the walls' faces, half a cell from the cells' centres that
+  // the field measures to: the fit is that good, not better.
+  EXPECT_LT(distance(kTruth, e.pose), 0.01);
+  EXPECT_LT(std::fabs(angleDiff(kTruth.yaw, e.pose.yaw)), 0.005);
+  // The cloud's mean stays with the clusters, further off.
+  EXPECT_GT(distance(kTruth, e.clusters[0].mean), distance(kTruth, e.pose));
+  // map -> odom is the fitted pose's.
+  expectPoseNear(compose(e.pose, inverse(odom)), *filter.mapToOdom(), 1e-12);
+  // The published covariances cover the cloud's and the fit's.
+  expectPositiveSemiDefinite(e.covariance - e.clusters[0].covariance);
+  expectPositiveSemiDefinite(e.covariance - r.refinement.covariance);
+  expectPositiveSemiDefinite(filter.confidence().covariance - e.clusters[0].covariance);
+}
+
+TEST(ParticleFilterRefinement, ScansBetweenUpdatesAreFittedAndStandingStillIsNot) {
+  const OccupancyGrid grid = asymmetricRoom();
+  ParticleFilter filter(params());
+  filter.setMap(grid);
+  filter.initializeGaussian(kTruth, kStartCov);
+  ASSERT_TRUE(filter.update(odomOf(kTruth), castScan(grid, kTruth)).updated);
+
+  // 5 cm on, below update_min_d: no filter update, but a fit. The odometry
+  // says 6 cm, so only the fit puts the robot where it is.
+  const Pose2 truth = compose(kTruth, {0.05, 0.0, 0.0});
+  const Pose2 odom = odomOf(compose(kTruth, {0.06, 0.0, 0.0}));
+  UpdateReport r = filter.update(odom, castScan(grid, truth));
+  EXPECT_FALSE(r.updated);
+  EXPECT_EQ("not moved enough since the last update", r.skip_reason);
+  ASSERT_TRUE(r.refinement.accepted) << r.refinement.rejection;
+  const Pose2 placed = compose(*filter.mapToOdom(), odom);
+  EXPECT_LT(distance(truth, placed), 0.01);
+  expectPoseNear(r.refinement.pose, placed, 1e-9);
+
+  // The same odometry again: standing still, the last fit stands.
+  const Pose2 map_to_odom = *filter.mapToOdom();
+  r = filter.update(odom, castScan(grid, compose(truth, {0.002, 0.0, 0.0})));
+  EXPECT_FALSE(r.refinement.accepted);
+  EXPECT_EQ("not moved since the last fit, which stands", r.refinement.rejection);
+  expectPoseNear(map_to_odom, *filter.mapToOdom(), 0.0);
+}
+
+TEST(ParticleFilterRefinement, AnOdometryFaultMakesTheFitStale) {
+  const OccupancyGrid grid = asymmetricRoom();
+  ParticleFilter filter(params());
+  filter.setMap(grid);
+  filter.initializeGaussian(kTruth, kStartCov);
+  ASSERT_TRUE(filter.update(odomOf(kTruth), castScan(grid, kTruth)).refinement.accepted);
+  // Odometry 10 m away: an odometry fault, skipped; tracking resumes from
+  // the new odometry with the estimate where it was, as without refinement.
+  const Pose2 jumped = compose(odomOf(kTruth), {10.0, 0.0, 0.0});
+  const UpdateReport r = filter.update(jumped, castScan(grid, kTruth));
+  EXPECT_NE(std::string::npos, r.skip_reason.find("odometry jumped")) << r.skip_reason;
+  expectPoseNear(compose(filter.estimate().pose, inverse(jumped)), *filter.mapToOdom(), 1e-12);
+}
+
+TEST(ParticleFilterRefinement, OffPublishesTheCloudsMean) {
+  const OccupancyGrid grid = asymmetricRoom();
+  ParticleFilterParams p = params();
+  p.refine_estimate = false;
+  ParticleFilter filter(p);
+  filter.setMap(grid);
+  filter.initializeGaussian(kTruth, kStartCov);
+  const UpdateReport r = filter.update(odomOf(kTruth), castScan(grid, kTruth));
+  ASSERT_TRUE(r.updated);
+  EXPECT_FALSE(r.refinement.accepted);
+  EXPECT_EQ("refine_estimate is off", r.refinement.rejection);
+  expectPoseNear(filter.estimate().clusters[0].mean, filter.estimate().pose, 0.0);
+  EXPECT_EQ(filter.estimate().clusters[0].covariance, filter.estimate().covariance);
+}
+
+TEST(ParticleFilterRefinement, ALostFilterIsNotRefined) {
+  const OccupancyGrid grid = asymmetricRoom();
+  ParticleFilter filter(params());
+  filter.setMap(grid);
+  filter.initializeGaussian(kTruth, kStartCov);
+  // Every beam ends 0.3 m from the robot, in the open: no wall anywhere near.
+  LaserScan scan = castScan(grid, kTruth);
+  for (float& range : scan.ranges) range = 0.3f;
+  const UpdateReport r = filter.update(odomOf(kTruth), scan);
+  ASSERT_TRUE(r.updated);
+  ASSERT_EQ(LocalizationState::kLost, filter.confidence().state);
+  EXPECT_FALSE(r.refinement.accepted);
+  EXPECT_EQ("the filter is lost", r.refinement.rejection);
+  expectPoseNear(filter.estimate().clusters[0].mean, filter.estimate().pose, 0.0);
+}
+
+}  // namespace
+}  // namespace pf

@@ -1,0 +1,231 @@
+#include "pf_localization/core/scan_refiner.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "expect_pose.h"
+
+namespace pf {
+namespace {
+
+// A grid drawn as text, top row first: '#' occupied, '.' free; 0.1 m cells,
+// origin at the lower-left corner.
+OccupancyGrid drawn(const std::vector<std::string>& rows) {
+  const int h = static_cast<int>(rows.size()), w = static_cast<int>(rows[0].size());
+  std::vector<int8_t> data(static_cast<std::size_t>(w) * h);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) data[y * w + x] = rows[h - 1 - y][x] == '#' ? 100 : 0;
+  }
+  return OccupancyGrid(w, h, 0.1, {}, data);
+}
+
+// 1.6 m x 1.2 m: walls, a square block and a stub, so that every direction
+// of the pose is pinned down.
+const std::vector<std::string> kRoom = {
+    "################",  //
+    "#..............#",  //
+    "#..............#",  //
+    "#....##........#",  //
+    "#....##........#",  //
+    "#..............#",  //
+    "#..............#",  //
+    "#.........#....#",  //
+    "#.........#....#",  //
+    "#..............#",  //
+    "#..............#",  //
+    "################",  //
+};
+
+// End points on the centres of the given grid's occupied cells, seen from
+// `pose`: at `pose` every one lies exactly on an obstacle.
+PreparedScan scanOfObstacles(const OccupancyGrid& grid, const Pose2& pose, int margin = 0) {
+  PreparedScan scan;
+  scan.range_max = 10.0;
+  for (int y = 0; y < grid.height(); ++y) {
+    for (int x = margin; x < grid.width() - margin; ++x) {
+      if (grid.state({x, y}) != CellState::kOccupied) continue;
+      double wx, wy;
+      grid.cellToWorld({x, y}, &wx, &wy);
+      const Pose2 local = between(pose, {wx, wy, 0.0});
+      scan.x.push_back(static_cast<float>(local.x));
+      scan.y.push_back(static_cast<float>(local.y));
+    }
+  }
+  return scan;
+}
+
+const Pose2 kTruth{0.83, 0.57, 0.2};
+
+TEST(ScanRefiner, RecoversAKnownOffsetToAMillimetre) {
+  const OccupancyGrid grid = drawn(kRoom);
+  const LikelihoodField field(grid, 2.0);
+  const ScanRefiner refiner(field, ScanRefinerParams());
+  const PreparedScan scan = scanOfObstacles(grid, kTruth);
+  ASSERT_EQ(58u, scan.size());
+  const Pose2 start{kTruth.x + 0.06, kTruth.y - 0.04, kTruth.yaw + 0.05};
+  const ScanRefinement r = refiner.refine(scan, start);
+  ASSERT_TRUE(r.accepted) << r.rejection;
+  EXPECT_EQ("", r.rejection);
+  expectPoseNear(kTruth, r.pose, 1e-3, 1e-3);
+  EXPECT_EQ(58, r.matched_beams);
+  EXPECT_LT(r.rms_distance, 1e-3);
+  EXPECT_NEAR(std::hypot(0.06, 0.04), r.translation, 1e-3);
+  EXPECT_NEAR(-0.05, r.rotation, 1e-3);
+  EXPECT_GE(r.iterations, 1);
+  // Residuals near zero: the covariance is the floor, min_beam_std^2 H^-1,
+  // positive definite, and tighter than a 0.1 m cell.
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(r.covariance);
+  EXPECT_GT(eig.eigenvalues()(0), 0.0);
+  EXPECT_LT(std::sqrt(r.covariance(0, 0)), 0.01);
+  EXPECT_LT(std::sqrt(r.covariance(1, 1)), 0.01);
+  EXPECT_LT(std::sqrt(r.covariance(2, 2)), 0.02);  // rad: 1.5 cm over ~1 m lever arms
+}
+
+TEST(ScanRefiner, StartingAtTheTruthStaysThere) {
+  const OccupancyGrid grid = drawn(kRoom);
+  const LikelihoodField field(grid, 2.0);
+  const ScanRefiner refiner(field, ScanRefinerParams());
+  const ScanRefinement r = refiner.refine(scanOfObstacles(grid, kTruth), kTruth);
+  ASSERT_TRUE(r.accepted) << r.rejection;
+  expectPoseNear(kTruth, r.pose, 1e-6, 1e-6);
+}
+
+TEST(ScanRefiner, AScanWithNothingToMatchIsRejected) {
+  // A 2 m x 2 m room with nothing in it but its walls.
+  std::vector<int8_t> data(400, 0);
+  for (int i = 0; i < 20; ++i) data[i] = data[380 + i] = data[20 * i] = data[20 * i + 19] = 100;
+  const LikelihoodField field(OccupancyGrid(20, 20, 0.1, {}, data), 2.0);
+  const ScanRefiner refiner(field, ScanRefinerParams());
+  // Twelve end points 0.1 m around the robot in the middle of the room,
+  // 0.75 m or more from the walls.
+  PreparedScan scan;
+  for (int i = 0; i < 12; ++i) {
+    scan.x.push_back(static_cast<float>(0.1 * std::cos(i * M_PI / 6)));
+    scan.y.push_back(static_cast<float>(0.1 * std::sin(i * M_PI / 6)));
+  }
+  const Pose2 start{1.0, 1.0, 0.3};
+  const ScanRefinement r = refiner.refine(scan, start);
+  EXPECT_FALSE(r.accepted);
+  EXPECT_EQ("only 0 of 12 beams end within 0.3 m of a mapped obstacle (8 needed): nothing to match",
+            r.rejection);
+  expectPoseNear(start, r.pose, 0.0);
+  EXPECT_EQ(Eigen::Matrix3d::Zero(), r.covariance);
+}
+
+TEST(ScanRefiner, AnEmptyScanIsRejected) {
+  const OccupancyGrid grid = drawn(kRoom);
+  const LikelihoodField field(grid, 2.0);
+  const ScanRefinement r = ScanRefiner(field, ScanRefinerParams()).refine(PreparedScan(), kTruth);
+  EXPECT_FALSE(r.accepted);
+  EXPECT_NE(std::string::npos, r.rejection.find("nothing to match")) << r.rejection;
+}
+
+TEST(ScanRefiner, AFitThatMovesTooFarIsRejected) {
+  const OccupancyGrid grid = drawn(kRoom);
+  const LikelihoodField field(grid, 2.0);
+  const PreparedScan scan = scanOfObstacles(grid, kTruth);
+  const Pose2 start{kTruth.x + 0.06, kTruth.y - 0.04, kTruth.yaw};
+  ScanRefinerParams params;
+  params.max_translation = 0.05;  // the fit moves 0.072 m
+  ScanRefinement r = ScanRefiner(field, params).refine(scan, start);
+  EXPECT_FALSE(r.accepted);
+  EXPECT_NE(std::string::npos, r.rejection.find("the fit moved 0.0721 m")) << r.rejection;
+  EXPECT_NE(std::string::npos, r.rejection.find("bounds 0.05 m, 0.3 rad")) << r.rejection;
+  expectPoseNear(start, r.pose, 0.0);
+  EXPECT_NEAR(0.0721, r.translation, 1e-3);
+
+  params = ScanRefinerParams();
+  params.max_rotation = 0.02;  // the fit turns 0.05 rad
+  r = ScanRefiner(field, params).refine(scan, {kTruth.x, kTruth.y, kTruth.yaw + 0.05});
+  EXPECT_FALSE(r.accepted);
+  EXPECT_NE(std::string::npos, r.rejection.find("0.05 rad (bounds 0.5 m, 0.02 rad)"))
+      << r.rejection;
+}
+
+TEST(ScanRefiner, AlongAFeaturelessCorridorTheStartIsKept) {
+  // Two walls 0.8 m apart, open at both ends: the scan says nothing about x.
+  const OccupancyGrid grid = drawn({
+      "##############################",  //
+      "..............................",  //
+      "..............................",  //
+      "..............................",  //
+      "..............................",  //
+      "..............................",  //
+      "..............................",  //
+      "..............................",  //
+      "##############################",  //
+  });
+  const LikelihoodField field(grid, 2.0);
+  const Pose2 truth{1.5, 0.42, 0.0};
+  // Only cells well inside the map, so that no stencil sees past its ends.
+  const PreparedScan scan = scanOfObstacles(grid, truth, 6);
+  const Pose2 start{truth.x + 0.07, truth.y + 0.03, 0.04};
+  const ScanRefinement r = ScanRefiner(field, ScanRefinerParams()).refine(scan, start);
+  ASSERT_TRUE(r.accepted) << r.rejection;
+  EXPECT_NEAR(start.x, r.pose.x, 1e-9);  // unconstrained: kept
+  EXPECT_NEAR(truth.y, r.pose.y, 1e-3);
+  EXPECT_NEAR(truth.yaw, r.pose.yaw, 1e-3);
+  // ... and the fit's covariance claims nothing about it.
+  EXPECT_NEAR(0.0, r.covariance(0, 0), 1e-12);
+  EXPECT_GT(r.covariance(1, 1), 0.0);
+}
+
+TEST(ScanRefiner, InvalidParametersAreNamed) {
+  const auto what = [](void (*change)(ScanRefinerParams&)) {
+    ScanRefinerParams p;
+    change(p);
+    try {
+      validate(p);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ("invalid parameter refine_max_translation = -1: must be >= 0",
+            what([](ScanRefinerParams& p) { p.max_translation = -1.0; }));
+  EXPECT_EQ("invalid parameter refine_min_matched_beams = 2: must be >= 3",
+            what([](ScanRefinerParams& p) { p.min_matched_beams = 2; }));
+  EXPECT_EQ("invalid parameter refine_wall_offset = 0.3: must be in [0, refine_outlier_distance)",
+            what([](ScanRefinerParams& p) { p.wall_offset = 0.3; }));
+  EXPECT_EQ("", what([](ScanRefinerParams&) {}));
+}
+
+TEST(CoveringCovariance, TakesTheWiderAlongEachAxis) {
+  const Eigen::Matrix3d a = Eigen::Vector3d(1.0, 4.0, 0.01).asDiagonal();
+  const Eigen::Matrix3d b = Eigen::Vector3d(4.0, 1.0, 0.04).asDiagonal();
+  const Eigen::Matrix3d c = coveringCovariance(a, b);
+  EXPECT_TRUE(c.isApprox(Eigen::Vector3d(4.0, 4.0, 0.04).asDiagonal().toDenseMatrix(), 1e-9)) << c;
+}
+
+TEST(CoveringCovariance, TheWiderOfTwoNestedIsKept) {
+  Eigen::Matrix3d wide;
+  wide << 0.04, 0.01, 0.0,  //
+      0.01, 0.03, 0.002,    //
+      0.0, 0.002, 0.01;
+  const Eigen::Matrix3d narrow = 0.01 * wide;
+  EXPECT_TRUE(coveringCovariance(narrow, wide).isApprox(wide, 1e-9));
+  EXPECT_TRUE(coveringCovariance(wide, narrow).isApprox(wide, 1e-9));
+  // A zero covariance (the fit says nothing) leaves the other.
+  EXPECT_TRUE(coveringCovariance(Eigen::Matrix3d::Zero(), wide).isApprox(wide, 1e-9));
+}
+
+TEST(CoveringCovariance, CoversBothWhenTheyCross) {
+  Eigen::Matrix3d a;
+  a << 2.0, 1.0, 0.0,  //
+      1.0, 2.0, 0.0,   //
+      0.0, 0.0, 0.1;
+  const Eigen::Matrix3d b = Eigen::Vector3d(3.0, 0.5, 0.2).asDiagonal();
+  const Eigen::Matrix3d c = coveringCovariance(a, b);
+  for (const Eigen::Matrix3d& d : {Eigen::Matrix3d(c - a), Eigen::Matrix3d(c - b)}) {
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(d);
+    EXPECT_GE(eig.eigenvalues()(0), -1e-9) << d;
+  }
+}
+
+}  // namespace
+}  // namespace pf
