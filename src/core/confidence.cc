@@ -6,18 +6,9 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pf_localization/core/parameter_check.h"
+
 namespace pf {
-namespace {
-
-void require(bool ok, const std::string& name, const std::string& range, double value) {
-  if (!ok) {
-    std::ostringstream text;
-    text << "invalid parameter " << name << " = " << value << ": must be " << range;
-    throw std::invalid_argument(text.str());
-  }
-}
-
-}  // namespace
 
 const char* toString(LocalizationState state) {
   switch (state) {
@@ -31,21 +22,25 @@ const char* toString(LocalizationState state) {
 }
 
 void validate(const ConfidenceParams& p) {
-  require(p.hit_distance > 0.0 && std::isfinite(p.hit_distance), "confidence_hit_distance", "> 0",
-          p.hit_distance);
-  require(p.lost_hit_fraction >= 0.0 && p.lost_hit_fraction <= 1.0, "confidence_lost_hit_fraction",
-          "in [0, 1]", p.lost_hit_fraction);
-  require(p.localized_hit_fraction >= p.lost_hit_fraction && p.localized_hit_fraction <= 1.0,
-          "confidence_localized_hit_fraction", "in [confidence_lost_hit_fraction, 1]",
-          p.localized_hit_fraction);
-  require(p.localized_std_xy > 0.0, "confidence_localized_std_xy", "> 0", p.localized_std_xy);
-  require(p.localized_std_yaw > 0.0, "confidence_localized_std_yaw", "> 0", p.localized_std_yaw);
-  require(p.rival_weight_ratio > 0.0 && p.rival_weight_ratio <= 1.0,
-          "confidence_rival_weight_ratio", "in (0, 1]", p.rival_weight_ratio);
-  require(p.jump_distance > 0.0 && std::isfinite(p.jump_distance), "confidence_jump_distance",
-          "> 0", p.jump_distance);
-  require(p.jump_yaw > 0.0 && std::isfinite(p.jump_yaw), "confidence_jump_yaw", "> 0", p.jump_yaw);
-  require(p.settle_updates >= 0, "confidence_settle_updates", ">= 0", p.settle_updates);
+  requireParameter(p.hit_distance > 0.0 && std::isfinite(p.hit_distance), "confidence_hit_distance",
+                   "> 0", p.hit_distance);
+  requireParameter(p.lost_hit_fraction >= 0.0 && p.lost_hit_fraction <= 1.0,
+                   "confidence_lost_hit_fraction", "in [0, 1]", p.lost_hit_fraction);
+  requireParameter(
+      p.localized_hit_fraction >= p.lost_hit_fraction && p.localized_hit_fraction <= 1.0,
+      "confidence_localized_hit_fraction", "in [confidence_lost_hit_fraction, 1]",
+      p.localized_hit_fraction);
+  requireParameter(p.localized_std_xy > 0.0, "confidence_localized_std_xy", "> 0",
+                   p.localized_std_xy);
+  requireParameter(p.localized_std_yaw > 0.0, "confidence_localized_std_yaw", "> 0",
+                   p.localized_std_yaw);
+  requireParameter(p.rival_weight_ratio > 0.0 && p.rival_weight_ratio <= 1.0,
+                   "confidence_rival_weight_ratio", "in (0, 1]", p.rival_weight_ratio);
+  requireParameter(p.jump_distance > 0.0 && std::isfinite(p.jump_distance),
+                   "confidence_jump_distance", "> 0", p.jump_distance);
+  requireParameter(p.jump_yaw > 0.0 && std::isfinite(p.jump_yaw), "confidence_jump_yaw", "> 0",
+                   p.jump_yaw);
+  requireParameter(p.settle_updates >= 0, "confidence_settle_updates", ">= 0", p.settle_updates);
 }
 
 Confidence assessConfidence(const ParticleSet& particles, const PoseEstimate& estimate,

@@ -7,16 +7,10 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pf_localization/core/parameter_check.h"
+
 namespace pf {
 namespace {
-
-void require(bool ok, const std::string& name, const std::string& range, double value) {
-  if (!ok) {
-    std::ostringstream text;
-    text << "invalid parameter " << name << " = " << value << ": must be " << range;
-    throw std::invalid_argument(text.str());
-  }
-}
 
 bool finite(double v) { return std::isfinite(v); }
 
@@ -34,26 +28,28 @@ std::string text(double v) {
 }  // namespace
 
 void validate(const ScanRefinerParams& p) {
-  require(p.max_iterations >= 1, "refine_max_iterations", ">= 1", p.max_iterations);
-  require(p.outlier_distance > 0.0 && finite(p.outlier_distance), "refine_outlier_distance", "> 0",
-          p.outlier_distance);
-  require(p.cauchy_scale > 0.0 && finite(p.cauchy_scale), "refine_cauchy_scale", "> 0",
-          p.cauchy_scale);
-  require(p.wall_offset >= 0.0 && p.wall_offset < p.outlier_distance, "refine_wall_offset",
-          "in [0, refine_outlier_distance)", p.wall_offset);
-  require(p.min_matched_fraction >= 0.0 && p.min_matched_fraction <= 1.0,
-          "refine_min_matched_fraction", "in [0, 1]", p.min_matched_fraction);
-  require(p.min_matched_beams >= 3, "refine_min_matched_beams", ">= 3", p.min_matched_beams);
-  require(p.max_translation >= 0.0 && finite(p.max_translation), "refine_max_translation", ">= 0",
-          p.max_translation);
-  require(p.max_rotation >= 0.0 && p.max_rotation <= M_PI, "refine_max_rotation", "in [0, pi]",
-          p.max_rotation);
-  require(p.min_beam_std > 0.0 && finite(p.min_beam_std), "refine_min_beam_std", "> 0",
-          p.min_beam_std);
-  require(p.degeneracy_ratio > 0.0 && p.degeneracy_ratio < 1.0, "refine_degeneracy_ratio",
-          "in (0, 1)", p.degeneracy_ratio);
-  require(p.beam_std > 0.0 && finite(p.beam_std), "refine_beam_std", "> 0", p.beam_std);
-  require(p.convergence > 0.0 && finite(p.convergence), "refine_convergence", "> 0", p.convergence);
+  requireParameter(p.max_iterations >= 1, "refine_max_iterations", ">= 1", p.max_iterations);
+  requireParameter(p.outlier_distance > 0.0 && finite(p.outlier_distance),
+                   "refine_outlier_distance", "> 0", p.outlier_distance);
+  requireParameter(p.cauchy_scale > 0.0 && finite(p.cauchy_scale), "refine_cauchy_scale", "> 0",
+                   p.cauchy_scale);
+  requireParameter(p.wall_offset >= 0.0 && p.wall_offset < p.outlier_distance, "refine_wall_offset",
+                   "in [0, refine_outlier_distance)", p.wall_offset);
+  requireParameter(p.min_matched_fraction >= 0.0 && p.min_matched_fraction <= 1.0,
+                   "refine_min_matched_fraction", "in [0, 1]", p.min_matched_fraction);
+  requireParameter(p.min_matched_beams >= 3, "refine_min_matched_beams", ">= 3",
+                   p.min_matched_beams);
+  requireParameter(p.max_translation >= 0.0 && finite(p.max_translation), "refine_max_translation",
+                   ">= 0", p.max_translation);
+  requireParameter(p.max_rotation >= 0.0 && p.max_rotation <= M_PI, "refine_max_rotation",
+                   "in [0, pi]", p.max_rotation);
+  requireParameter(p.min_beam_std > 0.0 && finite(p.min_beam_std), "refine_min_beam_std", "> 0",
+                   p.min_beam_std);
+  requireParameter(p.degeneracy_ratio > 0.0 && p.degeneracy_ratio < 1.0, "refine_degeneracy_ratio",
+                   "in (0, 1)", p.degeneracy_ratio);
+  requireParameter(p.beam_std > 0.0 && finite(p.beam_std), "refine_beam_std", "> 0", p.beam_std);
+  requireParameter(p.convergence > 0.0 && finite(p.convergence), "refine_convergence", "> 0",
+                   p.convergence);
 }
 
 // The robust cost at one pose, and optionally the Gauss-Newton system.
