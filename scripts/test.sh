@@ -7,7 +7,9 @@
 # or when no test ran at all.
 set -uo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
-ws=${PF_WS:-$repo/.ws}
+# shellcheck source=scripts/workspace.bash
+source "$repo/scripts/workspace.bash"
+ws=$(pf_default_ws "$repo")
 export PATH=/usr/bin:$PATH
 cd "$repo"
 
@@ -26,8 +28,6 @@ check() {  # check NAME COMMAND...: a source check counted as one test
 
 # --- GoogleTest and rostest, through catkin ---------------------------------
 bash scripts/build.sh run_tests -j1 2>&1 | tee "$ws/run_tests.log" | grep -E "^\[ *(OK|FAILED|PASSED) *\]|^\[ROSTEST\]|^\[Testcase|FAILURE|Error" || true
-# shellcheck source=scripts/workspace.bash
-source scripts/workspace.bash
 pf_source_workspace "$ws" test || failed=$((failed + 1))
 catkin_test_results "$ws/build/test_results" 2>&1 | grep -vE "^Skipping" | tail -n 20
 read -r ok bad < <(/usr/bin/python3 scripts/count_test_results.py "$ws/build/test_results")
