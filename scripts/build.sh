@@ -7,11 +7,17 @@
 # (e.g. PF_WS=~/catkin_ws for ~/catkin_ws/src/pf_localization); it is then
 # built as it is, other packages included.
 # Extra arguments go to catkin_make (e.g. a target, run_tests, or install).
+#   bash scripts/build.sh --where      prints the workspace and builds nothing, e.g.
+#   source "$(bash scripts/build.sh --where)/devel/setup.bash"
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 # shellcheck source=scripts/workspace.bash
 source "$repo/scripts/workspace.bash"
 ws=$(pf_default_ws "$repo")
+if [ "${1:-}" = --where ]; then
+  printf '%s\n' "$ws"
+  exit 0
+fi
 
 # Workspaces inside the package were the old layout (.ws, .ws_asan, ...): their
 # src/ links back to the package, so rosrun and catkin loop through them.
