@@ -28,15 +28,15 @@ for old in .ws .ws_asan .ws_fuzz .ws_bench; do
   fi
 done
 
-mkdir -p "$ws/src"
-ws=$(cd "$ws" && pwd)
 repo_real=$(cd "$repo" && pwd -P)
-case "$(cd "$ws" && pwd -P)/" in
+case "$(realpath -m "$ws")/" in
   "$repo_real"/*)
     echo "build: the workspace $ws is inside the package: rosrun and catkin would loop" \
       "through its src/ link; pick a folder outside $repo (PF_WS)" >&2
     exit 2 ;;
 esac
+mkdir -p "$ws/src"
+ws=$(cd "$ws" && pwd)
 if [ -d "$ws/.catkin_tools" ]; then
   echo "build: $ws is a \`catkin build\` workspace; these scripts use catkin_make." \
     "Build it with \`catkin build pf_localization\` yourself, or leave PF_WS unset" >&2
