@@ -42,7 +42,7 @@ pf_check_rosrun() {
 }
 
 # bag_demo.launch from the install space alone (a private roscore on a random
-# port, the bundled bag at 4x): pf_node must publish pf_pose within 60 s.
+# port, the bundled bag at 2x, 66 s long): pf_node must publish pf_pose within 60 s.
 # SIGTERM stops roslaunch: a background job of a script ignores SIGINT.
 pf_check_install_demo() {
   local ws=$1 tmp port launch_pid rc out
@@ -60,7 +60,7 @@ pf_check_install_demo() {
     # A simple command run with & is exec'ed: $! is timeout's pid, and timeout
     # passes the signal on to roslaunch.
     pf_space_cmd "$ws/install/setup.bash" timeout -s TERM 150 \
-      roslaunch -p "$port" pf_localization bag_demo.launch rate:=4
+      roslaunch -p "$port" pf_localization bag_demo.launch rate:=2
     "${PF_SPACE_CMD[@]}" >"$tmp/launch.log" 2>&1 &
     launch_pid=$!
     for _ in $(seq 30); do  # roslaunch starts its roscore first

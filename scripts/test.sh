@@ -46,8 +46,9 @@ catkin_lint_clean() {
   echo "$out" | head -n 30
   return 1
 }
-install_space() {  # a fresh install space, made by catkin_make install
-  rm -rf "$ws/install"
+install_space() {  # catkin_make install; from scratch in the scripts' own workspace
+  # (not in a PF_WS of the user's, whose install space may hold other packages)
+  case $ws in "$(pf_cache_dir "$repo")"/*) rm -rf "$ws/install" ;; esac
   bash scripts/build.sh install >"$ws/install.log" 2>&1 && return 0
   tail -n 30 "$ws/install.log"
   return 1
