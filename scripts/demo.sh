@@ -10,7 +10,9 @@
 # bag's known start pose. Reports go to reports/<bag name>/ (override: --report DIR).
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
-ws=${PF_WS:-$repo/.ws}
+# shellcheck source=scripts/workspace.bash
+source "$repo/scripts/workspace.bash"
+ws=$(pf_default_ws "$repo")
 export PATH=/usr/bin:$PATH
 
 bag="" map="" report="" runner_args=()

@@ -4,12 +4,13 @@
 #   bash scripts/fuzz.sh [SECONDS]     # default 600, split evenly between the targets
 #
 # Builds test/fuzz/fuzz_core and fuzz_map_loader with clang-14 in their own
-# catkin workspace (default .ws_fuzz, or $PF_FUZZ_WS; only the fuzz targets and
+# catkin workspace (default ws_fuzz beside the usual one, see
+# scripts/workspace.bash, or $PF_FUZZ_WS; only the fuzz targets and
 # their instrumented copy of the core are compiled), then runs each target for
 # its share of SECONDS, starting from the committed seeds in
 # test/fuzz/corpus/<target>/. What a run discovers is kept in
-# $PF_FUZZ_WS/fuzz/<target>/corpus, so the next run carries on from there.
-# A crash writes crash-*/leak-*/timeout-* into $PF_FUZZ_WS/fuzz/<target>/;
+# <fuzz workspace>/fuzz/<target>/corpus, so the next run carries on from there.
+# A crash writes crash-*/leak-*/timeout-* into <fuzz workspace>/fuzz/<target>/;
 # fuzzing then resumes (at most 5 restarts per target) so one bug does not
 # use up the time budget. Prints executions, time, exec/s and crashes per
 # target and exits non-zero when anything crashed.
@@ -18,7 +19,10 @@
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 total=${1:-600}
-ws=${PF_FUZZ_WS:-$repo/.ws_fuzz}
+# shellcheck source=scripts/workspace.bash
+source "$repo/scripts/workspace.bash"
+ws=$(pf_default_ws "$repo" fuzz)
+mkdir -p "$ws"
 targets=(fuzz_core fuzz_map_loader)
 
 if ! command -v clang++-14 >/dev/null; then

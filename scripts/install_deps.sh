@@ -9,6 +9,8 @@ set -euo pipefail
 packages=(
   # build tools
   build-essential cmake catkin catkin-lint python3-catkin-pkg clang-format
+  # `catkin build` (catkin_tools; Debian calls it catkin-tools, not python3-catkin-tools)
+  catkin-tools
   # ROS 1 core, messages and tools
   ros-base-dev libroscpp-dev rosbash python3-roslaunch python3-rostopic python3-rosnode
   python3-rosservice python3-rosparam python3-rosmsg

@@ -9,10 +9,13 @@
 #                                  sha256 sums with the committed files; exits 1
 #                                  on any mismatch
 #
-# The tools are (re)built first with scripts/build.sh (workspace $PF_WS, or .ws).
+# The tools are (re)built first with scripts/build.sh (its workspace: $PF_WS, or
+# the default of scripts/workspace.bash).
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
-ws=${PF_WS:-$repo/.ws}
+# shellcheck source=scripts/workspace.bash
+source "$repo/scripts/workspace.bash"
+ws=$(pf_default_ws "$repo")
 bin=$ws/devel/lib/pf_localization
 
 #     bag       map       seed  simulator options

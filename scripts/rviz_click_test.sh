@@ -33,7 +33,9 @@
 # removed at the end unless --keep (or a failure) says otherwise.
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
-ws=${PF_WS:-$repo/.ws}
+# shellcheck source=scripts/workspace.bash
+source "$repo/scripts/workspace.bash"
+ws=$(pf_default_ws "$repo")
 out=$repo/docs
 keep=0
 while [ $# -gt 0 ]; do
@@ -53,8 +55,6 @@ for tool in rviz Xvfb xdotool xwininfo import; do
     exit 2
   fi
 done
-# shellcheck source=scripts/workspace.bash
-source "$repo/scripts/workspace.bash"
 pf_source_workspace "$ws" rviz_click_test || exit 2
 mkdir -p "$out"
 out=$(cd "$out" && pwd)

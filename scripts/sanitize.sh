@@ -2,13 +2,17 @@
 # Builds the GoogleTest unit tests with AddressSanitizer + UndefinedBehaviorSanitizer
 # (CMake option PF_SANITIZE) in their own catkin workspace and runs them.
 #
-#   bash scripts/sanitize.sh            # workspace .ws_asan, or $PF_ASAN_WS
+#   bash scripts/sanitize.sh            # workspace ws_asan beside the usual one
+#                                       # (scripts/workspace.bash), or $PF_ASAN_WS
 #
 # Prints each binary's gtest summary and exits non-zero when a test fails or a
 # sanitizer reports anything (memory error, leak, undefined behaviour).
 set -uo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
-ws=${PF_ASAN_WS:-$repo/.ws_asan}
+# shellcheck source=scripts/workspace.bash
+source "$repo/scripts/workspace.bash"
+ws=$(pf_default_ws "$repo" asan)
+mkdir -p "$ws"
 tests=(pf_core_test pf_sim_test pf_ros_test pf_fuzz_replay_test)
 start=$(date +%s)
 

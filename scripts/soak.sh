@@ -16,7 +16,7 @@
 # within 5 % of the RSS at 300 s of simulated time. Prints pf_node's
 # warnings, grouped, at the end.
 #
-# Environment: PF_WS (workspace with pf_node built; default .ws),
+# Environment: PF_WS (workspace with pf_node built; default: scripts/build.sh's),
 # PF_SOAK_BAG, PF_SOAK_MAP, PF_SOAK_POSE ("x y yaw"; default: bags/<bag>.start
 # if present, else the bundled tracking bag's start pose from bags/README.md),
 # PF_SOAK_RATE (default 20), PF_SOAK_ARGS (extra roslaunch arguments),
@@ -24,7 +24,9 @@
 set -uo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 sim_seconds=${1:-3600}
-ws=${PF_WS:-$repo/.ws}
+# shellcheck source=scripts/workspace.bash
+source "$repo/scripts/workspace.bash"
+ws=$(pf_default_ws "$repo")
 bag=${PF_SOAK_BAG:-$repo/bags/tracking.bag}
 map=${PF_SOAK_MAP:-$repo/maps/building.yaml}
 rate=${PF_SOAK_RATE:-20}
@@ -39,8 +41,6 @@ read -r px py pa <<<"$pose"
 mark=300  # s of simulated time at which the reference RSS is taken
 
 export PATH=/usr/bin:$PATH
-# shellcheck source=scripts/workspace.bash
-source "$repo/scripts/workspace.bash"
 pf_source_workspace "$ws" soak || exit 2
 
 tmp=$(mktemp -d /tmp/pf_soak.XXXXXX)

@@ -1,13 +1,17 @@
 #!/usr/bin/env bash
 # Installs the dependencies, builds the package and runs every test: the
 # GoogleTest unit tests, the rostest integration tests on the bundled bags,
-# the Python unit tests, the source checks (clang-format, a ROS-free core) and
+# the catkin checks (catkin_lint, rosrun and bag_demo.launch from the devel
+# and the install space: scripts/space_checks.bash), the Python unit tests,
+# the source checks (clang-format, a ROS-free core) and
 # the unit tests once more under AddressSanitizer + UndefinedBehaviorSanitizer.
 # Ends with one line "N passed, N failed"; exits non-zero when anything failed
 # or when no test ran at all.
 set -uo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
-ws=${PF_WS:-$repo/.ws}
+# shellcheck source=scripts/workspace.bash
+source "$repo/scripts/workspace.bash"
+ws=$(pf_default_ws "$repo")
 export PATH=/usr/bin:$PATH
 cd "$repo"
 
@@ -26,14 +30,34 @@ check() {  # check NAME COMMAND...: a source check counted as one test
 
 # --- GoogleTest and rostest, through catkin ---------------------------------
 bash scripts/build.sh run_tests -j1 2>&1 | tee "$ws/run_tests.log" | grep -E "^\[ *(OK|FAILED|PASSED) *\]|^\[ROSTEST\]|^\[Testcase|FAILURE|Error" || true
-# shellcheck source=scripts/workspace.bash
-source scripts/workspace.bash
 pf_source_workspace "$ws" test || failed=$((failed + 1))
 catkin_test_results "$ws/build/test_results" 2>&1 | grep -vE "^Skipping" | tail -n 20
 read -r ok bad < <(/usr/bin/python3 scripts/count_test_results.py "$ws/build/test_results")
 passed=$((passed + ${ok:-0}))
 failed=$((failed + ${bad:-1}))
 [ "${ok:-0}" -eq 0 ] && { echo "no gtest or rostest result found"; failed=$((failed + 1)); }
+
+# --- A standard catkin package: lint, rosrun, the install space ----------------
+# shellcheck source=scripts/space_checks.bash
+source scripts/space_checks.bash
+catkin_lint_clean() {
+  local out
+  out=$(catkin_lint -W1 --strict --offline . 2>&1) && return 0
+  echo "$out" | head -n 30
+  return 1
+}
+install_space() {  # catkin_make install; from scratch in the scripts' own workspace
+  # (not in a PF_WS of the user's, whose install space may hold other packages)
+  case $ws in "$(pf_cache_dir "$repo")"/*) rm -rf "$ws/install" ;; esac
+  bash scripts/build.sh install >"$ws/install.log" 2>&1 && return 0
+  tail -n 30 "$ws/install.log"
+  return 1
+}
+check "catkin_lint -W1 clean" catkin_lint_clean
+check "rosrun pf_evaluate from the devel space: no prompt, no loop" pf_check_rosrun "$ws/devel/setup.bash"
+check "catkin_make install" install_space
+check "rosrun pf_evaluate from the install space: no prompt, no loop" pf_check_rosrun "$ws/install/setup.bash"
+check "bag_demo.launch from the install space alone: pf_node publishes pf_pose" pf_check_install_demo "$ws"
 
 # --- Python unit tests (pf_evaluate's metrics) ------------------------------
 if [ -d test/python ]; then
