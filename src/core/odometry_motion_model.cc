@@ -20,14 +20,16 @@ double rotationMagnitude(double rot) {
 // The translation one particle takes: the odometry's with Gaussian noise,
 // or, for the share fault_fraction of the particles, half the time the
 // reversed one (with the same noise) and half the time none (uniform within
-// +-fault_margin). See the header.
-double sampleTranslation(double trans, double sigma, const OdometryMotionParams& params,
-                         Random* random) {
-  if (params.fault_fraction > 0.0) {
+// +-margin). *fault says which. See the header.
+double sampleTranslation(double trans, double sigma, double fault_fraction, double margin,
+                         Random* random, uint8_t* fault) {
+  if (fault_fraction > 0.0) {
     const double u = random->uniform();
-    if (u < 0.5 * params.fault_fraction) return -trans + random->gaussian(sigma);
-    if (u < params.fault_fraction)
-      return random->uniform(-params.fault_margin, params.fault_margin);
+    *fault = u < fault_fraction ? 1 : 0;
+    if (u < 0.5 * fault_fraction) return -trans + random->gaussian(sigma);
+    if (u < fault_fraction) return random->uniform(-margin, margin);
+  } else {
+    *fault = 0;
   }
   return trans - random->gaussian(sigma);
 }
@@ -66,15 +68,25 @@ OdometryStep OdometryMotionModel::decompose(const Pose2& from, const Pose2& to) 
 
 void OdometryMotionModel::apply(const Pose2& from, const Pose2& to, ParticleSet* particles,
                                 Random* random) const {
+  apply(from, to, params_.fault_fraction, particles, random, nullptr);
+}
+
+void OdometryMotionModel::apply(const Pose2& from, const Pose2& to, double fault_fraction,
+                                ParticleSet* particles, Random* random,
+                                std::vector<uint8_t>* faulty) const {
+  thread_local std::vector<uint8_t> unused;
+  std::vector<uint8_t>* flags = faulty != nullptr ? faulty : &unused;
+  flags->resize(particles->size());
   if (params_.kind == OdometryMotionParams::Kind::kOmni) {
-    applyOmni(from, to, particles, random);
+    applyOmni(from, to, fault_fraction, particles, random, flags->data());
   } else {
-    applyDifferential(from, to, particles, random);
+    applyDifferential(from, to, fault_fraction, particles, random, flags->data());
   }
 }
 
 void OdometryMotionModel::applyDifferential(const Pose2& from, const Pose2& to,
-                                            ParticleSet* particles, Random* random) const {
+                                            double fault_fraction, ParticleSet* particles,
+                                            Random* random, uint8_t* faulty) const {
   const OdometryStep step = decompose(from, to);
   const double rot1 = rotationMagnitude(step.rot1);
   const double rot2 = rotationMagnitude(step.rot2);
@@ -87,7 +99,8 @@ void OdometryMotionModel::applyDifferential(const Pose2& from, const Pose2& to,
   ParticleSet& p = *particles;
   for (std::size_t i = 0; i < p.size(); ++i) {
     const double r1 = step.rot1 - random->gaussian(sigma_rot1);
-    const double t = sampleTranslation(step.trans, sigma_trans, params_, random);
+    const double t = sampleTranslation(step.trans, sigma_trans, fault_fraction,
+                                       params_.fault_margin, random, &faulty[i]);
     const double r2 = step.rot2 - random->gaussian(sigma_rot2);
     const double heading = p.yaw[i] + r1;
     p.x[i] += t * std::cos(heading);
@@ -96,8 +109,8 @@ void OdometryMotionModel::applyDifferential(const Pose2& from, const Pose2& to,
   }
 }
 
-void OdometryMotionModel::applyOmni(const Pose2& from, const Pose2& to, ParticleSet* particles,
-                                    Random* random) const {
+void OdometryMotionModel::applyOmni(const Pose2& from, const Pose2& to, double fault_fraction,
+                                    ParticleSet* particles, Random* random, uint8_t* faulty) const {
   const double dx = to.x - from.x;
   const double dy = to.y - from.y;
   const double trans = std::hypot(dx, dy);
@@ -112,7 +125,8 @@ void OdometryMotionModel::applyOmni(const Pose2& from, const Pose2& to, Particle
 
   ParticleSet& p = *particles;
   for (std::size_t i = 0; i < p.size(); ++i) {
-    const double t = sampleTranslation(trans, sigma_trans, params_, random);
+    const double t = sampleTranslation(trans, sigma_trans, fault_fraction, params_.fault_margin,
+                                       random, &faulty[i]);
     const double s = random->gaussian(sigma_strafe);
     const double heading = p.yaw[i] + bearing;
     p.x[i] += t * std::cos(heading) - s * std::sin(heading);

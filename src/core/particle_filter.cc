@@ -107,6 +107,8 @@ void validate(const ParticleFilterParams& p) {
   }
   requireParameter(m.fault_fraction >= 0.0 && m.fault_fraction < 1.0, "odom_fault_fraction",
                    "in [0, 1)", m.fault_fraction);
+  requireParameter(m.fault_fraction_max >= m.fault_fraction && m.fault_fraction_max < 1.0,
+                   "odom_fault_fraction_max", "in [odom_fault_fraction, 1)", m.fault_fraction_max);
   requireParameter(m.fault_margin >= 0.0 && finite(m.fault_margin), "odom_fault_margin", ">= 0",
                    m.fault_margin);
 }
@@ -129,6 +131,8 @@ ParticleFilter::ParticleFilter(const ParticleFilterParams& params)
     for (std::vector<double>* v : {&set->x, &set->y, &set->yaw, &set->weight}) prefault(v);
   }
   for (std::vector<double>* v : {&scratch_, &log_prior_, &log_likelihood_}) prefault(v);
+  faulty_.assign(max, 0);
+  faulty_.clear();
 }
 
 bool ParticleFilter::setMap(const OccupancyGrid& grid) {
@@ -193,6 +197,7 @@ void ParticleFilter::restartAfterInitialization() {
   w_slow_ = w_fast_ = 0.0;
   low_fit_updates_ = 0;
   settle_left_ = 0;
+  fault_fraction_ = params_.motion.fault_fraction;
 }
 
 Pose2 ParticleFilter::randomFreePose() {
@@ -262,12 +267,16 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
 
   // Where the last estimate would be now had the odometry been right.
   const std::optional<Pose2> before = mapToOdom();
-  if (!first) motion_model_.apply(*odom_at_update_, odom, &particles_, &random_);
+  if (!first) {
+    motion_model_.apply(*odom_at_update_, odom, fault_fraction_, &particles_, &random_, &faulty_);
+  }
   odom_at_update_ = odom;
   restart_ = false;
   force_update_ = false;
 
   weigh(prepared, &report);
+  if (!first) adaptFaultFraction();
+  report.fault_fraction = fault_fraction_;
   report.ess = effectiveSampleSize(particles_.weight);
   // The estimate comes from the weighted cloud, before resampling: resampling
   // only adds noise, and the random particles recovery injects must not count.
@@ -367,6 +376,22 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
       w_fast_ += params_.recovery.alpha_fast * (mean_beam - w_fast_);
     }
   }
+}
+
+void ParticleFilter::adaptFaultFraction() {
+  // Odometry faults come in runs (a robot reverses for a while, wheels spin
+  // on a threshold for a while), so the share of the posterior weight that
+  // the faulty particles won on this scan is the best guess of how many the
+  // next step needs: it rises while a fault lasts and falls back to the
+  // floor as soon as the odometry is right again. In a corridor, where the
+  // scans cannot tell the faulty particles from the others, their share
+  // stays where it was put: at the floor.
+  const OdometryMotionParams& m = params_.motion;
+  double share = 0.0;
+  for (std::size_t i = 0; i < particles_.size(); ++i) {
+    share += faulty_[i] ? particles_.weight[i] : 0.0;
+  }
+  fault_fraction_ = std::clamp(share, m.fault_fraction, m.fault_fraction_max);
 }
 
 void ParticleFilter::resample(UpdateReport* report) {

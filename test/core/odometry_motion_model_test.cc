@@ -350,6 +350,25 @@ TEST(ApplyFaults, ReversedParticlesKeepTheTranslationNoise) {
   EXPECT_NEAR(0.2, b.stddev, 0.01);
 }
 
+TEST(ApplyFaults, AnExplicitShareOverridesTheParameterAndFlagsTheFaultyParticles) {
+  OdometryMotionParams params;
+  params.alpha1 = params.alpha2 = params.alpha3 = params.alpha4 = 0.0;
+  params.fault_fraction = 0.0;  // the call's 0.4 applies
+  const OdometryMotionModel model(params);
+  ParticleSet p = manyAt({0, 0, 0}, kSamples);
+  Random random(23);
+  std::vector<uint8_t> faulty;
+  model.apply({0, 0, 0}, {1, 0, 0}, 0.4, &p, &random, &faulty);
+  ASSERT_EQ(kSamples, faulty.size());
+  std::size_t flagged = 0;
+  for (std::size_t i = 0; i < kSamples; ++i) {
+    // A flagged particle reversed or stalled; the others moved exactly 1 m.
+    EXPECT_EQ(faulty[i] != 0, p.x[i] != 1.0) << i;
+    flagged += faulty[i];
+  }
+  EXPECT_NEAR(16000.0, static_cast<double>(flagged), 400.0);  // 40 %, binomial std 98
+}
+
 TEST(ApplyFaults, RefusesAFractionOfOne) {
   OdometryMotionParams params;
   params.fault_fraction = 1.0;

@@ -538,6 +538,40 @@ TEST(ParticleFilterUpdate, RecoveryGuessesDoNotTemperTheNextScanAway) {
   EXPECT_NEAR(0.99 * prior_ess, next.ess, 0.01 * prior_ess);  // the bisection's target
 }
 
+// The share of particles the filter gives to odometry faults after each of
+// `steps` updates in which the odometry reports 0.3 m forwards along x and the
+// scans are taken at `truth_step` metres per update from `start`.
+std::vector<double> faultShares(double truth_step, int steps) {
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilterParams params = exactParams();
+  params.kld.min_particles = params.kld.max_particles = 1000;
+  params.motion.fault_fraction = 0.02;
+  params.motion.fault_fraction_max = 0.5;
+  params.motion.fault_margin = 0.05;
+  ParticleFilter filter(params);
+  filter.setMap(grid);
+  const Pose2 start{1.5, 1.5, 0.0};
+  filter.initializeGaussian(start, Eigen::Matrix3d::Zero());
+  filter.update({0.0, 0.0, 0.0}, simulateScan(grid, start));
+  std::vector<double> shares;
+  for (int k = 1; k <= steps; ++k) {
+    const UpdateReport r = filter.update(
+        {0.3 * k, 0.0, 0.0}, simulateScan(grid, {start.x + truth_step * k, start.y, 0.0}));
+    EXPECT_TRUE(r.updated) << r.skip_reason;
+    shares.push_back(r.fault_fraction);
+  }
+  return shares;
+}
+
+TEST(ParticleFilterUpdate, TheFaultShareRisesWhileTheOdometryIsReversedAndFallsBack) {
+  // Right odometry: the faulty particles win nothing, the share stays at the floor.
+  for (double share : faultShares(0.3, 3)) EXPECT_DOUBLE_EQ(0.02, share);
+  // Odometry that reports forwards while the robot reverses: the reversed
+  // particles win the weight, and the next step gives faults the maximum.
+  const std::vector<double> reversed = faultShares(-0.3, 3);
+  for (double share : reversed) EXPECT_DOUBLE_EQ(0.5, share);
+}
+
 // The number of updates with bad scans before recovery injects, for a filter
 // whose thresholds keep it "localized" whatever the fit.
 int updatesBeforeInjection(int patience) {

@@ -31,11 +31,18 @@
 // the particles take, half of them, the reversed translation (with the same
 // noise) and the other half no translation (uniform within +-fault_margin).
 // The scans decide which particles were right; when the odometry was, the
-// faulty ones die at the next resampling. A uniform spread over every
-// translation in between was tried: in long corridors, where the scans say
-// little about the position along them, it smeared the estimate along the
-// corridor (Intel lab) more than the two discrete faults do.
+// faulty ones die at the next resampling. Faults come in runs (a robot
+// reverses for a while), so the filter sets the next step's share to the
+// weight the faulty particles won on this scan, between fault_fraction and
+// fault_fraction_max (ParticleFilter::adaptFaultFraction): a small share
+// while the odometry is right, and many particles in the fault while it lasts. A uniform spread
+// over every translation in between was tried: in long corridors, where the scans say little about
+// the position along them, it smeared the estimate along the corridor (Intel lab) more than the two
+// discrete faults do.
 #pragma once
+
+#include <cstdint>
+#include <vector>
 
 #include "pf_localization/core/particle_set.h"
 #include "pf_localization/core/pose2.h"
@@ -53,7 +60,11 @@ struct OdometryMotionParams {
   double alpha5 = 0.2;  // strafe noise from translation, omni only (m^2/m^2)
   // Share of the particles that assume the odometry's translation was wrong
   // this step (see above). 0 is the textbook model. [0, 1)
-  double fault_fraction = 0.05;
+  double fault_fraction = 0.01;
+  // The filter raises the share up to this while the faulty particles win
+  // the weight (a fault that lasts), see ParticleFilter::adaptFaultFraction.
+  // Equal to fault_fraction: a fixed share. [fault_fraction, 1)
+  double fault_fraction_max = 0.5;
   // How far a robot whose odometry stalled may still have moved (m). >= 0
   double fault_margin = 0.1;
 };
@@ -77,11 +88,17 @@ class OdometryMotionModel {
 
   /// Moves every particle by the noisy odometry motion from `from` to `to`.
   void apply(const Pose2& from, const Pose2& to, ParticleSet* particles, Random* random) const;
+  /// The same with `fault_fraction` in place of the parameter's (the filter
+  /// adapts it), writing into `faulty` (when not null) which particles took
+  /// a fault (1) and which the odometry's step (0).
+  void apply(const Pose2& from, const Pose2& to, double fault_fraction, ParticleSet* particles,
+             Random* random, std::vector<uint8_t>* faulty) const;
 
  private:
-  void applyDifferential(const Pose2& from, const Pose2& to, ParticleSet* particles,
-                         Random* random) const;
-  void applyOmni(const Pose2& from, const Pose2& to, ParticleSet* particles, Random* random) const;
+  void applyDifferential(const Pose2& from, const Pose2& to, double fault_fraction,
+                         ParticleSet* particles, Random* random, uint8_t* faulty) const;
+  void applyOmni(const Pose2& from, const Pose2& to, double fault_fraction, ParticleSet* particles,
+                 Random* random, uint8_t* faulty) const;
 
   OdometryMotionParams params_;
 };

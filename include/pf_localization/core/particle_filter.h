@@ -123,6 +123,7 @@ struct UpdateReport {
   std::size_t injected = 0;           // random particles added by recovery
   double tempering = 1.0;             // exponent applied to this scan's likelihood (1: none)
   bool expanded = false;              // the survivors were spread by expansion resetting
+  double fault_fraction = 0.0;        // share of particles to assume an odometry fault next step
   // The scan fit of the estimate (when refine_estimate is on): accepted, or
   // the reason it was not, as in refinement.rejection.
   ScanRefinement refinement;
@@ -174,6 +175,7 @@ class ParticleFilter {
  private:
   void weigh(const PreparedScan& scan, UpdateReport* report);
   void resample(UpdateReport* report);
+  void adaptFaultFraction();
   void refineEstimate(const LaserScan& scan, UpdateReport* report);
   void refineBetweenUpdates(const Pose2& odom, const LaserScan& scan, UpdateReport* report);
   bool refinedIsCurrent() const;
@@ -205,8 +207,10 @@ class ParticleFilter {
   double w_fast_ = 0.0;
   int low_fit_updates_ = 0;  // consecutive updates with w_fast below the trigger
   LocalizationState fit_state_ = LocalizationState::kLost;  // the verdict before holdAfterJump
-  int settle_left_ = 0;  // updates until a jumped estimate may be localized (holdAfterJump)
-  bool expand_ = false;  // this scan's fit collapsed: spread the survivors
+  double fault_fraction_ = 0.0;  // of the next motion update (adaptFaultFraction)
+  std::vector<uint8_t> faulty_;  // which particles took an odometry fault in this update
+  int settle_left_ = 0;          // updates until a jumped estimate may be localized (holdAfterJump)
+  bool expand_ = false;          // this scan's fit collapsed: spread the survivors
   std::vector<double> scratch_;
   std::vector<double> log_prior_;
   std::vector<double> log_likelihood_;
