@@ -421,6 +421,27 @@ ParticleFilterParams recoveryParams() {
   return p;
 }
 
+// The recovery tests' robot: tracked at kTracked for five scans, then moved
+// to kMoved (1.3 m away and turned) without the odometry seeing it.
+const Pose2 kTracked{1.0, 1.5, 0.2};
+const Pose2 kMoved{2.0, 2.2, 1.5};
+
+void trackFiveScans(const OccupancyGrid& grid, ParticleFilter* filter) {
+  filter->setMap(grid);
+  filter->initializeGaussian(kTracked, Eigen::Matrix3d::Zero());
+  const LaserScan good = simulateScan(grid, kTracked);
+  for (int k = 0; k < 5; ++k) EXPECT_TRUE(filter->update({0.0, 0.0, 0.0}, good).updated);
+}
+
+// Feeds scans taken at kMoved until recovery injects (five at most).
+UpdateReport updateUntilInjection(const OccupancyGrid& grid, ParticleFilter* filter) {
+  UpdateReport r;
+  for (int k = 0; k < 5 && r.injected == 0; ++k) {
+    r = filter->update({0.0, 0.0, 0.0}, simulateScan(grid, kMoved));
+  }
+  return r;
+}
+
 TEST(ParticleFilterUpdate, ACollapsedFitSpreadsTheSurvivors) {
   // Expansion resetting: tracking well at `start`, then the robot is pushed
   // 0.5 m sideways without odometry seeing it. That scan fits far worse than
@@ -453,13 +474,13 @@ TEST(ParticleFilterUpdate, ACollapsedFitSpreadsTheSurvivors) {
 // Tracks at `start` on `grid`, then feeds scans taken 1 m away that fit far
 // worse than the usual ones; returns the random particles recovery injected.
 std::size_t injectedAfterScansStopFitting(const OccupancyGrid& grid) {
+  // The scans are simulated on the mapped room, whatever `grid` is.
   ParticleFilter filter(recoveryParams());
   filter.setMap(grid);
-  const Pose2 start{1.0, 1.5, 0.2};
-  filter.initializeGaussian(start, Eigen::Matrix3d::Zero());
-  const LaserScan good = simulateScan(trackingRoom(), start);
+  filter.initializeGaussian(kTracked, Eigen::Matrix3d::Zero());
+  const LaserScan good = simulateScan(trackingRoom(), kTracked);
   for (int k = 0; k < 5; ++k) EXPECT_TRUE(filter.update({0.0, 0.0, 0.0}, good).updated);
-  const LaserScan moved = simulateScan(trackingRoom(), {2.0, 2.2, 1.5});
+  const LaserScan moved = simulateScan(trackingRoom(), kMoved);
   std::size_t injected = 0;
   for (int k = 0; k < 5; ++k) {
     const UpdateReport r = filter.update({0.0, 0.0, 0.0}, moved);
@@ -492,14 +513,8 @@ TEST(ParticleFilterUpdate, InjectedParticlesWeighTheKidnapPriorTogether) {
   ParticleFilterParams params = recoveryParams();
   params.recovery.kidnap_prior = 0.01;
   ParticleFilter filter(params);
-  filter.setMap(grid);
-  const Pose2 start{1.0, 1.5, 0.2};
-  filter.initializeGaussian(start, Eigen::Matrix3d::Zero());
-  for (int k = 0; k < 5; ++k) filter.update({0.0, 0.0, 0.0}, simulateScan(grid, start));
-  UpdateReport r;
-  for (int k = 0; k < 5 && r.injected == 0; ++k) {
-    r = filter.update({0.0, 0.0, 0.0}, simulateScan(grid, {2.0, 2.2, 1.5}));
-  }
+  trackFiveScans(grid, &filter);
+  const UpdateReport r = updateUntilInjection(grid, &filter);
   ASSERT_GT(r.injected, 0u);
   const ParticleSet& p = filter.particles();
   const std::size_t kept = p.size() - r.injected;
@@ -519,19 +534,11 @@ TEST(ParticleFilterUpdate, RecoveryGuessesDoNotTemperTheNextScanAway) {
   ParticleFilterParams params = recoveryParams();
   params.tempering_ess_fraction = params.tempering_ess_fraction_uncertain = 0.99;
   ParticleFilter filter(params);
-  filter.setMap(grid);
-  const Pose2 start{1.0, 1.5, 0.2};
-  filter.initializeGaussian(start, Eigen::Matrix3d::Zero());
-  for (int k = 0; k < 5; ++k) filter.update({0.0, 0.0, 0.0}, simulateScan(grid, start));
-  const Pose2 moved{2.0, 2.2, 1.5};
-  UpdateReport r;
-  for (int k = 0; k < 5 && r.injected == 0; ++k) {
-    r = filter.update({0.0, 0.0, 0.0}, simulateScan(grid, moved));
-  }
-  ASSERT_GT(r.injected, 0u);
+  trackFiveScans(grid, &filter);
+  ASSERT_GT(updateUntilInjection(grid, &filter).injected, 0u);
   const double prior_ess = effectiveSampleSize(filter.particles().weight);
   ASSERT_LT(prior_ess, 0.99 * static_cast<double>(filter.particles().size()));
-  const UpdateReport next = filter.update({0.0, 0.0, 0.0}, simulateScan(grid, moved));
+  const UpdateReport next = filter.update({0.0, 0.0, 0.0}, simulateScan(grid, kMoved));
   ASSERT_TRUE(next.updated);
   EXPECT_GT(next.tempering, 0.0);
   EXPECT_LT(next.tempering, 1.0);
@@ -581,12 +588,9 @@ int updatesBeforeInjection(int patience) {
   params.confidence.lost_hit_fraction = params.confidence.localized_hit_fraction = 0.0;
   params.confidence.localized_std_xy = params.confidence.localized_std_yaw = 100.0;
   ParticleFilter filter(params);
-  filter.setMap(grid);
-  const Pose2 start{1.0, 1.5, 0.2};
-  filter.initializeGaussian(start, Eigen::Matrix3d::Zero());
-  for (int k = 0; k < 5; ++k) filter.update({0.0, 0.0, 0.0}, simulateScan(grid, start));
+  trackFiveScans(grid, &filter);
   for (int k = 1; k <= 30; ++k) {
-    const UpdateReport r = filter.update({0.0, 0.0, 0.0}, simulateScan(grid, {2.0, 2.2, 1.5}));
+    const UpdateReport r = filter.update({0.0, 0.0, 0.0}, simulateScan(grid, kMoved));
     EXPECT_EQ(LocalizationState::kLocalized, filter.confidence().state);
     if (r.injected > 0) return k;
   }
