@@ -109,6 +109,8 @@ void validate(const ParticleFilterParams& p) {
                    "in [0, 1)", m.fault_fraction);
   requireParameter(m.fault_fraction_max >= m.fault_fraction && m.fault_fraction_max < 1.0,
                    "odom_fault_fraction_max", "in [odom_fault_fraction, 1)", m.fault_fraction_max);
+  requireParameter(m.fault_suspect_fraction > 0.0, "odom_fault_suspect_fraction", "> 0",
+                   m.fault_suspect_fraction);
   requireParameter(m.fault_margin >= 0.0 && finite(m.fault_margin), "odom_fault_margin", ">= 0",
                    m.fault_margin);
 }
@@ -246,7 +248,12 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
                            " m): treated as an odometry fault, particles not moved";
       return report;
     }
-    if (!force_update_ && step < params_.update_min_d &&
+    // While the faulty particles win (a reversal, a stall), the odometry
+    // between updates is what is wrong: every scan updates the filter then,
+    // instead of the published pose following the wrong odometry until the
+    // robot has "moved" update_min_d.
+    const bool odometry_suspect = fault_fraction_ >= params_.motion.fault_suspect_fraction;
+    if (!force_update_ && !odometry_suspect && step < params_.update_min_d &&
         std::fabs(delta.yaw) < params_.update_min_a) {
       report.skip_reason = "not moved enough since the last update";
       refineBetweenUpdates(odom, scan, &report);

@@ -308,6 +308,7 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
   p.get("odom_alpha5", &f.motion.alpha5);
   p.get("odom_fault_fraction", &f.motion.fault_fraction);
   p.get("odom_fault_fraction_max", &f.motion.fault_fraction_max);
+  p.get("odom_fault_suspect_fraction", &f.motion.fault_suspect_fraction);
   p.get("odom_fault_margin", &f.motion.fault_margin);
 
   p.get("laser_max_beams", &f.sensor.max_beams);

@@ -579,6 +579,39 @@ TEST(ParticleFilterUpdate, TheFaultShareRisesWhileTheOdometryIsReversedAndFallsB
   for (double share : reversed) EXPECT_DOUBLE_EQ(0.5, share);
 }
 
+// Whether the filter updates on a 0.3 m step below update_min_d (1 m),
+// after one forced update on which the robot moved `truth_step` while the
+// odometry said 0.3 m forwards.
+bool updatesOnAShortStepAfter(double truth_step) {
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilterParams params = exactParams();
+  params.kld.min_particles = params.kld.max_particles = 1000;
+  params.update_min_d = 1.0;
+  params.update_min_a = 1.0;
+  params.motion.fault_fraction = 0.02;
+  params.motion.fault_fraction_max = 0.5;
+  params.motion.fault_suspect_fraction = 0.1;
+  ParticleFilter filter(params);
+  filter.setMap(grid);
+  const Pose2 start{1.5, 1.5, 0.0};
+  filter.initializeGaussian(start, Eigen::Matrix3d::Zero());
+  filter.update({0.0, 0.0, 0.0}, simulateScan(grid, start));
+  filter.requestNoMotionUpdate();
+  const Pose2 truth{start.x + truth_step, start.y, 0.0};
+  EXPECT_TRUE(filter.update({0.3, 0.0, 0.0}, simulateScan(grid, truth)).updated);
+  const UpdateReport next =
+      filter.update({0.6, 0.0, 0.0}, simulateScan(grid, {truth.x + truth_step, truth.y, 0.0}));
+  return next.updated;
+}
+
+TEST(ParticleFilterUpdate, SuspectOdometryUpdatesOnEveryScan) {
+  // Right odometry: the next 0.3 m waits for update_min_d as usual.
+  EXPECT_FALSE(updatesOnAShortStepAfter(0.3));
+  // Reversed: the faulty particles won (share 0.5 >= 0.1), so the odometry
+  // between updates is not trusted and the next scan updates at once.
+  EXPECT_TRUE(updatesOnAShortStepAfter(-0.3));
+}
+
 // The number of updates with bad scans before recovery injects, for a filter
 // whose thresholds keep it "localized" whatever the fit.
 int updatesBeforeInjection(int patience) {

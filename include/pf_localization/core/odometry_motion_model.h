@@ -65,6 +65,10 @@ struct OdometryMotionParams {
   // the weight (a fault that lasts), see ParticleFilter::adaptFaultFraction.
   // Equal to fault_fraction: a fixed share. [fault_fraction, 1)
   double fault_fraction_max = 0.5;
+  // While the filter's share is at or above this, it updates on every scan
+  // (update_min_d and update_min_a wait for odometry that is wrong). > 0;
+  // above fault_fraction_max: never.
+  double fault_suspect_fraction = 0.1;
   // How far a robot whose odometry stalled may still have moved (m). >= 0
   double fault_margin = 0.1;
 };
