@@ -216,7 +216,7 @@ int main(int argc, char** argv) {
     if (!log) fail(opt.log + ": cannot write");
     log << "t,particles,ess,cpu_ms,mean_beam_likelihood,std_x,std_y,std_yaw,updated,injected,"
            "tempering,hit_fraction,rivals,state,refined,refine_translation,refine_rotation,"
-           "refine_rms,refine_matched\n";
+           "refine_rms,refine_matched,fault_fraction\n";
   }
   if (!opt.particles_out.empty()) {
     dump.open(opt.particles_out);
@@ -258,7 +258,8 @@ int main(int argc, char** argv) {
             << r.report.tempering << "," << conf.hit_fraction << "," << conf.rivals << ","
             << pf::toString(conf.state) << "," << r.report.refinement.accepted << ","
             << r.report.refinement.translation << "," << r.report.refinement.rotation << ","
-            << r.report.refinement.rms_distance << "," << r.report.refinement.matched_beams << "\n";
+            << r.report.refinement.rms_distance << "," << r.report.refinement.matched_beams << ","
+            << r.report.fault_fraction << "\n";
       }
       if (dump && t - first_stamp <= kParticleDumpSeconds) {
         const pf::ParticleSet& p = localizer.filter().particles();
