@@ -103,6 +103,17 @@ std::string show(const T& value) {
   return s.str();
 }
 
+// Whether our `name` set to `ours` and its amcl alias set to `amcls` mean the same.
+template <typename T>
+bool agree(const std::string&, const T& ours, const T& amcls) {
+  return ours == amcls;
+}
+
+bool agree(const std::string& name, const double& ours, const double& amcls) {
+  if (name == "kld_confidence") return std::fabs(kldConfidenceFromZ(amcls) - ours) < 1e-9;
+  return ours == amcls;
+}
+
 // Looks each setting up under our name and amcl's, in the user's source
 // before the defaults, and remembers every name asked for: whatever else the
 // source holds is reported as unknown (a misspelt name would otherwise be
@@ -127,8 +138,12 @@ class ParamReader {
           *value = amcl_value;
           return *alias;
         }
-        notes_->warnings.push_back("both " + name + " (" + show(*value) + ") and amcl's " + *alias +
-                                   " (" + show(amcl_value) + ") are set: using " + name);
+        // pf_node's dynamic_reconfigure server writes both names, in
+        // agreement, to the parameter server, where a respawned node finds them.
+        if (!agree(name, *value, amcl_value)) {
+          notes_->warnings.push_back("both " + name + " (" + show(*value) + ") and amcl's " +
+                                     *alias + " (" + show(amcl_value) + ") are set: using " + name);
+        }
       }
       if (ours) return name;
     }
