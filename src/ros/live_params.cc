@@ -246,37 +246,22 @@ void copyLiveParams(const LocalizerConfig& from, LocalizerConfig* to) {
 LiveChange applyLiveParams(const LocalizerConfig& current,
                            const dynamic_reconfigure::Config& request) {
   LiveChange out{current, {}, ""};
-  LocalizerConfig before = current;
   LocalizerConfig& next = out.config;
   for (const LiveParam& p : liveParams()) {
-    double was = 0.0, now = 0.0;
     if (const auto* f = std::get_if<Field<double>>(&p.field)) {
-      const auto* v = find(request.doubles, p.name);
-      if (v == nullptr) continue;
-      was = (*f)(before);
-      now = v->value;
-      (*f)(next) = now;
+      if (const auto* v = find(request.doubles, p.name)) (*f)(next) = v->value;
     } else if (const auto* i = std::get_if<Field<int>>(&p.field)) {
-      const auto* v = find(request.ints, p.name);
-      if (v == nullptr) continue;
-      was = (*i)(before);
-      now = v->value;
-      (*i)(next) = v->value;
-    } else {
-      const auto* v = find(request.bools, p.name);
-      if (v == nullptr) continue;
-      was = std::get<Field<bool>>(p.field)(before);
-      now = v->value;
+      if (const auto* v = find(request.ints, p.name)) (*i)(next) = v->value;
+    } else if (const auto* v = find(request.bools, p.name)) {
       std::get<Field<bool>>(p.field)(next) = v->value;
     }
-    if (now != was)
-      out.changed.push_back(std::string(p.name) + " " + show(was) + " -> " + show(now));
   }
   // amcl's kld_z: taken when it moved and kld_confidence did not (a client
   // that only knows amcl's name), as readConfig takes it when ours is absent.
   const auto* z = find(request.doubles, "kld_z");
-  const double z_was = kldZOf(before.filter.kld.confidence);
-  if (z != nullptr && next.filter.kld.confidence == before.filter.kld.confidence &&
+  const double z_was = kldZOf(current.filter.kld.confidence);
+  std::string from_kld_z;
+  if (z != nullptr && next.filter.kld.confidence == current.filter.kld.confidence &&
       std::fabs(z->value - z_was) > 1e-9 * std::max(1.0, std::fabs(z_was))) {
     const double p = kldConfidenceFromZ(z->value);
     if (!(std::isfinite(z->value) && p > 0.0 && p < 1.0)) {
@@ -285,12 +270,24 @@ LiveChange applyLiveParams(const LocalizerConfig& current,
       return out;
     }
     next.filter.kld.confidence = p;
-    out.changed.push_back("kld_z " + show(z_was) + " -> " + show(z->value) + " (kld_confidence " +
-                          show(p) + ")");
+    from_kld_z = " (amcl's kld_z " + show(z_was) + " -> " + show(z->value) + ")";
   }
   // amcl spells "use the scan's own limit" as -1, as at start-up.
   next.filter.sensor.range_min = std::max(next.filter.sensor.range_min, 0.0);
   next.filter.sensor.range_max = std::max(next.filter.sensor.range_max, 0.0);
+
+  // What changed, as it will be in effect.
+  LocalizerConfig before = current, after = next;
+  for (const LiveParam& p : liveParams()) {
+    std::visit(
+        [&](auto f) {
+          if (f(after) == f(before)) return;
+          out.changed.push_back(std::string(p.name) + " " + show(f(before)) + " -> " +
+                                show(f(after)) +
+                                (std::string(p.name) == "kld_confidence" ? from_kld_z : ""));
+        },
+        p.field);
+  }
   try {
     validate(next);
   } catch (const std::invalid_argument& e) {

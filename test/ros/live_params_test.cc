@@ -116,6 +116,9 @@ TEST(LiveParams, AmclsKldZSetsKldConfidence) {
   const LiveChange change = applyLiveParams(current, request("kld_z", 3.0));
   EXPECT_EQ(change.error, "");
   EXPECT_NEAR(change.config.filter.kld.confidence, 0.99865, 1e-5);
+  EXPECT_EQ(
+      change.changed,
+      (std::vector<std::string>{"kld_confidence 0.99 -> 0.99865 (amcl's kld_z 2.32635 -> 3)"}));
   // kld_confidence itself wins over a kld_z that moved with it.
   dynamic_reconfigure::Config both = request("kld_confidence", 0.95);
   both.doubles.push_back(request("kld_z", 3.0).doubles.front());
@@ -126,6 +129,7 @@ TEST(LiveParams, NegativeRangesMeanTheScansOwnAsAtStartUp) {
   const LiveChange change = applyLiveParams(LocalizerConfig(), request("laser_max_range", -1.0));
   EXPECT_EQ(change.error, "");
   EXPECT_EQ(change.config.filter.sensor.range_max, 0.0);
+  EXPECT_TRUE(change.changed.empty());  // 0 already: nothing changes
 }
 
 TEST(LiveParams, TheFilterKeepsItsParticlesThroughAChange) {
