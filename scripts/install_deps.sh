@@ -17,6 +17,9 @@ packages=(
   libtf2-dev libtf2-ros-dev libtf2-geometry-msgs-dev libtf2-msgs-dev
   libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev libstd-srvs-dev libdiagnostic-msgs-dev
   librosbag-dev librosbag-storage-dev python3-rosbag
+  # dynamic_reconfigure: the C++ server and its headers; the .cfg generator,
+  # the Python client (test/ros/reconfigure_checker) and dynparam
+  libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   # libraries of the core
   libeigen3-dev libyaml-cpp-dev
   # tests and benchmarks

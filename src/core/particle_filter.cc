@@ -124,17 +124,55 @@ ParticleFilter::ParticleFilter(const ParticleFilterParams& params)
   // reserving alone let the resident memory creep up by megabytes, hours into
   // a run, the first time a re-initialisation or recovery made the cloud
   // larger than ever before (scripts/soak.sh showed it).
-  const auto max = static_cast<std::size_t>(params_.kld.max_particles);
-  const auto prefault = [max](std::vector<double>* v) {
-    v->assign(max, 0.0);
-    v->clear();  // keeps the capacity, and the pages
+  reserveStorage(static_cast<std::size_t>(params_.kld.max_particles));
+}
+
+void ParticleFilter::reserveStorage(std::size_t max) {
+  // Growing to `max` and back writes the new pages and keeps what is there
+  // (setParams reserves more under live particles).
+  const auto prefault = [max](auto* v) {
+    const std::size_t n = v->size();
+    v->resize(std::max(max, n));
+    v->resize(n);  // keeps the capacity, and the pages
   };
   for (ParticleSet* set : {&particles_, &spare_}) {
     for (std::vector<double>* v : {&set->x, &set->y, &set->yaw, &set->weight}) prefault(v);
   }
   for (std::vector<double>* v : {&scratch_, &log_prior_, &log_likelihood_}) prefault(v);
-  faulty_.assign(max, 0);
-  faulty_.clear();
+  prefault(&faulty_);
+}
+
+namespace {
+
+bool sameSensor(const LikelihoodFieldModelParams& a, const LikelihoodFieldModelParams& b) {
+  return a.z_hit == b.z_hit && a.z_rand == b.z_rand && a.sigma_hit == b.sigma_hit &&
+         a.max_distance == b.max_distance && a.max_beams == b.max_beams &&
+         a.range_min == b.range_min && a.range_max == b.range_max &&
+         a.likelihood_exponent == b.likelihood_exponent && a.threads == b.threads;
+}
+
+}  // namespace
+
+void ParticleFilter::setParams(const ParticleFilterParams& params) {
+  validate(params);
+  // Everything that can throw comes before the first change.
+  OdometryMotionModel motion(params.motion);
+  std::unique_ptr<LikelihoodFieldModel> model;
+  if (model_ && !sameSensor(params.sensor, params_.sensor)) {
+    // The model holds its parameters and its table of beam likelihoods; the
+    // distance field under them depends on laser_likelihood_max_dist too.
+    model = std::make_unique<LikelihoodFieldModel>(model_->field().grid(), params.sensor);
+  }
+  if (params.kld.max_particles > params_.kld.max_particles) {
+    reserveStorage(static_cast<std::size_t>(params.kld.max_particles));
+  }
+  const uint64_t seed = params_.seed;
+  params_ = params;
+  params_.seed = seed;
+  motion_model_ = motion;
+  if (model) model_ = std::move(model);
+  fault_fraction_ =
+      std::clamp(fault_fraction_, params_.motion.fault_fraction, params_.motion.fault_fraction_max);
 }
 
 bool ParticleFilter::setMap(const OccupancyGrid& grid) {

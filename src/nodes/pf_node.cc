@@ -6,7 +6,8 @@
 // pf_ros::ScanLocalizer and the core; this file only moves messages, waits
 // for tf and tells the user what is wrong. It speaks amcl's interface too
 // (topics, services, parameter names, the pose saved to the parameter
-// server), so that it can replace amcl in an existing bringup.
+// server, dynamic_reconfigure through pf_ros::ReconfigureServer), so that it
+// can replace amcl in an existing bringup.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
@@ -33,7 +34,9 @@
 
 #include "pf_localization/ros/conversions.h"
 #include "pf_localization/ros/diagnostics.h"
+#include "pf_localization/ros/live_params.h"
 #include "pf_localization/ros/localizer_config.h"
+#include "pf_localization/ros/reconfigure_server.h"
 #include "pf_localization/ros/scan_localizer.h"
 
 namespace pf_ros {
@@ -141,6 +144,8 @@ class PfNode {
       save_timer_ = nh_.createTimer(ros::Duration(1.0 / config.save_pose_rate),
                                     [this](const ros::TimerEvent&) { savePose(); });
     }
+    reconfigure_ = std::make_unique<ReconfigureServer>(
+        pnh_, config, [this](const LocalizerConfig& c) { return reconfigure(c); }, "pf_node");
     // Wall time: a paused bag clock must not keep Ctrl-C waiting.
     sigint_timer_ = nh_.createWallTimer(ros::WallDuration(0.1), &PfNode::onSigintCheck, this);
     if (config.initial_pose) {
@@ -162,6 +167,18 @@ class PfNode {
       return;
     }
     installMap(*msg);
+  }
+
+  // The live parameters from ReconfigureServer: the filter's at its next
+  // update, this node's own (tf and particlecloud rates, transform_tolerance) now.
+  std::string reconfigure(const LocalizerConfig& next) {
+    const std::string error = localizer_.reconfigure(next);
+    if (!error.empty()) return error;
+    if (next.tf_publish_rate != config_.tf_publish_rate) {
+      tf_timer_.setPeriod(ros::Duration(1.0 / next.tf_publish_rate));
+    }
+    copyLiveParams(next, &config_);
+    return "";
   }
 
   bool installMap(const nav_msgs::OccupancyGrid& map) {
@@ -411,7 +428,8 @@ class PfNode {
     const std::string name = ros::this_node::getName() + ": localization";
     diagnostic_msgs::DiagnosticArray array;
     array.header.stamp = stamp;
-    array.status.push_back(toDiagnosticStatus(localizer_.filter(), report, name));
+    array.status.push_back(
+        toDiagnosticStatus(localizer_.filter(), report, name, reconfigure_->generation()));
     diagnostics_pub_.publish(array);
     status_pub_.publish(array.status.front());
     // A change of state is news; the same state on every scan is not.
@@ -508,6 +526,7 @@ class PfNode {
   ros::WallTimer sigint_timer_;
   ros::Time last_scan_stamp_, last_tf_stamp_, last_cloud_stamp_;
   LimitedLog log_{kLogPeriod};
+  std::unique_ptr<ReconfigureServer> reconfigure_;
 };
 
 }  // namespace

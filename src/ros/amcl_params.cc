@@ -67,7 +67,9 @@ const std::vector<AmclOnlyParam>& amclOnlyParams() {
       {"std_warn_level_y", kStdWarnWhy},
       {"std_warn_level_yaw", kStdWarnWhy},
       {"bag_scan_period", "for amcl --run-from-bag; pf_bag_runner replays a bag instead"},
-      {"restore_defaults", "a dynamic_reconfigure action; pf_node reads its parameters at start"},
+      {"restore_defaults",
+       "a dynamic_reconfigure action, not a setting (pf_node's server offers it: back to the "
+       "values the node started with)"},
   };
   return params;
 }

@@ -15,11 +15,20 @@ void add(diagnostic_msgs::DiagnosticStatus* status, const std::string& key, doub
   status->values.push_back(kv);
 }
 
+// Counts in full (a double would show a million as 1e+06).
+void add(diagnostic_msgs::DiagnosticStatus* status, const std::string& key, int value) {
+  diagnostic_msgs::KeyValue kv;
+  kv.key = key;
+  kv.value = std::to_string(value);
+  status->values.push_back(kv);
+}
+
 }  // namespace
 
 diagnostic_msgs::DiagnosticStatus toDiagnosticStatus(const pf::ParticleFilter& filter,
                                                      const pf::UpdateReport& report,
-                                                     const std::string& name) {
+                                                     const std::string& name,
+                                                     int config_generation) {
   const pf::Confidence& c = filter.confidence();
   diagnostic_msgs::DiagnosticStatus status;
   status.name = name;
@@ -51,6 +60,11 @@ diagnostic_msgs::DiagnosticStatus toDiagnosticStatus(const pf::ParticleFilter& f
   add(&status, "injected_particles", static_cast<double>(report.injected));
   add(&status, "tempering", report.tempering);
   add(&status, "beams_used", report.beams_used);
+  const pf::ParticleFilterParams& p = filter.params();
+  add(&status, "config_generation", config_generation);
+  add(&status, "max_particles", p.kld.max_particles);
+  add(&status, "odom_alpha1", p.motion.alpha1);
+  add(&status, "laser_sigma_hit", p.sensor.sigma_hit);
   return status;
 }
 

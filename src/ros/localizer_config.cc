@@ -9,6 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pf_localization/core/parameter_check.h"
 #include "pf_localization/ros/amcl_params.h"
 
 namespace pf_ros {
@@ -102,6 +103,17 @@ std::string show(const T& value) {
   return s.str();
 }
 
+// Whether our `name` set to `ours` and its amcl alias set to `amcls` mean the same.
+template <typename T>
+bool agree(const std::string&, const T& ours, const T& amcls) {
+  return ours == amcls;
+}
+
+bool agree(const std::string& name, const double& ours, const double& amcls) {
+  if (name == "kld_confidence") return std::fabs(kldConfidenceFromZ(amcls) - ours) < 1e-9;
+  return ours == amcls;
+}
+
 // Looks each setting up under our name and amcl's, in the user's source
 // before the defaults, and remembers every name asked for: whatever else the
 // source holds is reported as unknown (a misspelt name would otherwise be
@@ -126,8 +138,12 @@ class ParamReader {
           *value = amcl_value;
           return *alias;
         }
-        notes_->warnings.push_back("both " + name + " (" + show(*value) + ") and amcl's " + *alias +
-                                   " (" + show(amcl_value) + ") are set: using " + name);
+        // pf_node's dynamic_reconfigure server writes both names, in
+        // agreement, to the parameter server, where a respawned node finds them.
+        if (!agree(name, *value, amcl_value)) {
+          notes_->warnings.push_back("both " + name + " (" + show(*value) + ") and amcl's " +
+                                     *alias + " (" + show(amcl_value) + ") are set: using " + name);
+        }
       }
       if (ours) return name;
     }
@@ -342,19 +358,25 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
         "map topic, which map_server and map_publisher latch, instead of the static_map service)");
   }
   p.reportLeftovers();
+  validate(c);
+  if (notes == nullptr) logNotes(own_notes);
+  return c;
+}
 
+void validate(const LocalizerConfig& c) {
   require(!c.global_frame.empty(), "global_frame", "a frame name");
   require(!c.odom_frame.empty(), "odom_frame", "a frame name");
   require(!c.base_frame.empty(), "base_frame", "a frame name");
-  require(c.transform_tolerance >= 0.0 && std::isfinite(c.transform_tolerance),
-          "transform_tolerance", ">= 0 (s)");
-  require(c.tf_publish_rate > 0.0 && std::isfinite(c.tf_publish_rate), "tf_publish_rate",
-          "> 0 (Hz)");
-  require(std::isfinite(c.gui_publish_rate), "gui_publish_rate", "finite (Hz; <= 0: no limit)");
-  require(std::isfinite(c.save_pose_rate), "save_pose_rate", "finite (Hz; <= 0: never)");
-  pf::validate(f);
-  if (notes == nullptr) logNotes(own_notes);
-  return c;
+  // Numbers as the core words them, value included.
+  pf::requireParameter(c.transform_tolerance >= 0.0 && std::isfinite(c.transform_tolerance),
+                       "transform_tolerance", ">= 0 (s)", c.transform_tolerance);
+  pf::requireParameter(c.tf_publish_rate > 0.0 && std::isfinite(c.tf_publish_rate),
+                       "tf_publish_rate", "> 0 (Hz)", c.tf_publish_rate);
+  pf::requireParameter(std::isfinite(c.gui_publish_rate), "gui_publish_rate",
+                       "finite (Hz; <= 0: no limit)", c.gui_publish_rate);
+  pf::requireParameter(std::isfinite(c.save_pose_rate), "save_pose_rate",
+                       "finite (Hz; <= 0: never)", c.save_pose_rate);
+  pf::validate(c.filter);
 }
 
 }  // namespace pf_ros

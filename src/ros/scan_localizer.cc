@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "pf_localization/ros/conversions.h"
+#include "pf_localization/ros/live_params.h"
 
 namespace pf_ros {
 namespace {
@@ -51,6 +52,16 @@ std::string ScanLocalizer::setMap(const nav_msgs::OccupancyGrid& map) {
     return "";
   }
   return startGlobalLocalization();
+}
+
+std::string ScanLocalizer::reconfigure(const LocalizerConfig& config) {
+  try {
+    filter_.setParams(config.filter);
+  } catch (const std::invalid_argument& e) {
+    return e.what();
+  }
+  copyLiveParams(config, &config_);
+  return "";
 }
 
 std::string ScanLocalizer::setInitialPose(const geometry_msgs::PoseWithCovarianceStamped& msg) {

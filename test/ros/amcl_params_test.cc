@@ -58,6 +58,17 @@ TEST(AmclParams, LeadingSlashOfTfEraFramesIsDropped) {
   EXPECT_EQ(c.base_frame, "base_link");
 }
 
+TEST(AmclParams, BothNamesMeaningTheSameAreNoConflict) {
+  // As pf_node's dynamic_reconfigure server leaves them for a respawned node.
+  ConfigNotes notes;
+  const LocalizerConfig c =
+      readConfig(*yaml("kld_confidence: 0.99\nkld_z: 2.3263478740408408\nodom_frame: odom\n"
+                       "odom_frame_id: odom\n"),
+                 nullptr, &notes);
+  EXPECT_EQ(c.filter.kld.confidence, 0.99);
+  EXPECT_TRUE(notes.warnings.empty()) << notes.warnings[0];
+}
+
 TEST(AmclParams, OurNameWinsOverAmclsInTheSameSourceWithAWarning) {
   ConfigNotes notes;
   const LocalizerConfig c =

@@ -37,6 +37,19 @@ TEST(Diagnostics, FreshlyInitialisedFilterIsUncertainWithItsReason) {
   EXPECT_EQ(v.count("rival_clusters"), 1u);
 }
 
+TEST(Diagnostics, ShowsTheParametersInEffectAndTheirGeneration) {
+  pf::ParticleFilterParams params = smallFilter();
+  params.kld.max_particles = 1000000;
+  params.motion.alpha1 = 0.35;
+  params.sensor.sigma_hit = 0.15;
+  pf::ParticleFilter filter(params);
+  const auto v = values(toDiagnosticStatus(filter, pf::UpdateReport(), "x", 3));
+  EXPECT_EQ(v.at("config_generation"), "3");
+  EXPECT_EQ(v.at("max_particles"), "1000000");  // in full, not 1e+06
+  EXPECT_EQ(v.at("odom_alpha1"), "0.35");
+  EXPECT_EQ(v.at("laser_sigma_hit"), "0.15");
+}
+
 TEST(Diagnostics, UninitialisedFilterIsLost) {
   pf::ParticleFilter filter(smallFilter());
   const auto status = toDiagnosticStatus(filter, pf::UpdateReport(), "x");

@@ -136,6 +136,15 @@ class ParticleFilter {
 
   const ParticleFilterParams& params() const { return params_; }
 
+  /// Replaces the parameters while running (dynamic_reconfigure): the
+  /// particles, the estimate and the recovery averages are kept; the motion
+  /// model and, when a sensor parameter changed, the likelihood field are
+  /// built anew from `params`, and a larger max_particles reserves (and
+  /// prefaults) the storage as the constructor does. The seed is not
+  /// changed: the random stream goes on. Throws std::invalid_argument (see
+  /// validate()) and then leaves everything as it was.
+  void setParams(const ParticleFilterParams& params);
+
   /// Installs a map (rebuilding the likelihood field). If particles exist and
   /// the current estimate lies in free space of the new map they are kept;
   /// otherwise the filter becomes uninitialised. Returns whether they were kept.
@@ -181,6 +190,7 @@ class ParticleFilter {
   bool refinedIsCurrent() const;
   Pose2 randomFreePose();
   void restartAfterInitialization();
+  void reserveStorage(std::size_t max_particles);
 
   ParticleFilterParams params_;
   Random random_;

@@ -11,9 +11,13 @@
 namespace pf_ros {
 
 /// OK when localized, WARN when uncertain, ERROR when lost; the message is the
-/// state and its reason, the values every figure behind it.
+/// state and its reason, the values every figure behind it, and a few of the
+/// parameters in effect (max_particles, odom_alpha1, laser_sigma_hit) with
+/// `config_generation`, the number of live changes accepted (ReconfigureServer),
+/// so that a change can be seen to have reached the filter.
 diagnostic_msgs::DiagnosticStatus toDiagnosticStatus(const pf::ParticleFilter& filter,
                                                      const pf::UpdateReport& report,
-                                                     const std::string& name);
+                                                     const std::string& name,
+                                                     int config_generation = 0);
 
 }  // namespace pf_ros

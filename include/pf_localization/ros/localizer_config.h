@@ -77,4 +77,9 @@ std::unique_ptr<ParamSource> rosParamSource(const ros::NodeHandle& nh);
 LocalizerConfig readConfig(const ParamSource& source, const ParamSource* defaults = nullptr,
                            ConfigNotes* notes = nullptr);
 
+/// The checks readConfig ends with, for a configuration changed while running
+/// (dynamic_reconfigure): throws std::invalid_argument with the same message
+/// ("invalid parameter NAME = V: must be RANGE") that refuses it at start-up.
+void validate(const LocalizerConfig& config);
+
 }  // namespace pf_ros

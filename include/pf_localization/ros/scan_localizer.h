@@ -58,6 +58,11 @@ class ScanLocalizer {
   /// jumping back, as when a bag is replayed with --loop.
   std::string restart();
 
+  /// Puts the live parameters of `config` (live_params.h) in effect from the
+  /// next update on, keeping the particles and the estimate. Returns an error
+  /// message (empty on success); on error nothing changed.
+  std::string reconfigure(const LocalizerConfig& config);
+
   /// Uses one scan: odometry and laser pose from tf at the scan's stamp, then
   /// the filter update.
   ScanResult processScan(const sensor_msgs::LaserScan& scan);
