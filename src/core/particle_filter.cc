@@ -99,6 +99,22 @@ void validate(const ParticleFilterParams& p) {
                    s.range_min);
   requireParameter(s.range_max >= 0.0 && finite(s.range_max), "laser_max_range", ">= 0",
                    s.range_max);
+  if (p.laser_model_type == LaserModelType::kBeam) {
+    requireParameter(p.beam.z_short >= 0.0 && finite(p.beam.z_short), "laser_z_short", ">= 0",
+                     p.beam.z_short);
+    requireParameter(p.beam.z_max >= 0.0 && finite(p.beam.z_max), "laser_z_max", ">= 0",
+                     p.beam.z_max);
+    requireParameter(p.beam.lambda_short > 0.0 && finite(p.beam.lambda_short), "laser_lambda_short",
+                     "> 0", p.beam.lambda_short);
+  }
+  if (s.beam_skip) {
+    requireParameter(s.beam_skip_distance > 0.0 && finite(s.beam_skip_distance),
+                     "beam_skip_distance", "> 0", s.beam_skip_distance);
+    requireParameter(s.beam_skip_threshold >= 0.0 && s.beam_skip_threshold <= 1.0,
+                     "beam_skip_threshold", "in [0, 1]", s.beam_skip_threshold);
+    requireParameter(s.beam_skip_error_threshold >= 0.0 && s.beam_skip_error_threshold <= 1.0,
+                     "beam_skip_error_threshold", "in [0, 1]", s.beam_skip_error_threshold);
+  }
   const auto& m = p.motion;
   const double alphas[] = {m.alpha1, m.alpha2, m.alpha3, m.alpha4, m.alpha5};
   for (int i = 0; i < 5; ++i) {
@@ -111,6 +127,22 @@ void validate(const ParticleFilterParams& p) {
                    "odom_fault_fraction_max", "in [odom_fault_fraction, 1)", m.fault_fraction_max);
   requireParameter(m.fault_margin >= 0.0 && finite(m.fault_margin), "odom_fault_margin", ">= 0",
                    m.fault_margin);
+}
+
+std::unique_ptr<SensorModel> makeSensorModel(const OccupancyGrid& grid,
+                                             const ParticleFilterParams& params) {
+  switch (params.laser_model_type) {
+    case LaserModelType::kBeam:
+      return std::make_unique<BeamModel>(grid, params.sensor, params.beam);
+    case LaserModelType::kLikelihoodFieldProb:
+      return std::make_unique<LikelihoodFieldModel>(grid, params.sensor);
+    case LaserModelType::kLikelihoodField:
+      break;
+  }
+  // amcl's likelihood_field never skips beams.
+  LikelihoodFieldModelParams sensor = params.sensor;
+  sensor.beam_skip = false;
+  return std::make_unique<LikelihoodFieldModel>(grid, sensor);
 }
 
 ParticleFilter::ParticleFilter(const ParticleFilterParams& params)
@@ -137,7 +169,7 @@ ParticleFilter::ParticleFilter(const ParticleFilterParams& params)
 
 bool ParticleFilter::setMap(const OccupancyGrid& grid) {
   if (grid.empty()) throw std::invalid_argument("the map is empty");
-  model_ = std::make_unique<LikelihoodFieldModel>(grid, params_.sensor);
+  model_ = makeSensorModel(grid, params_);
   refined_.reset();  // fitted to the old map
   if (isInitialized() && grid.isFreeAt(estimate_.pose.x, estimate_.pose.y)) return true;
   particles_.resize(0);  // keeps the reserved storage
@@ -301,7 +333,7 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
 }
 
 void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
-  model_->logLikelihoods(scan, particles_, &log_likelihood_);
+  const std::size_t beams_counted = model_->logLikelihoods(scan, particles_, &log_likelihood_);
   // After a resampling every weight is the same, and a constant prior does
   // not change the normalised result: zeros spare N logarithms.
   const std::vector<double>& w = particles_.weight;
@@ -335,6 +367,7 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
     beta = lo;
   }
   report->tempering = beta;
+  report->beams_skipped = static_cast<int>(scan.size() - beams_counted);
   scratch_.resize(particles_.size());
   double max_log = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < particles_.size(); ++i) {
@@ -359,7 +392,9 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
   // robots), averaged with the posterior weights. The posterior, not the
   // prior, so that a few particles that found the robot count for what they
   // are worth, and a cloud salted with random particles is not judged by them.
-  const double beams = static_cast<double>(scan.size()) * params_.sensor.likelihood_exponent;
+  // Over the beams the model counted: beam skipping may leave some out.
+  const double beams = static_cast<double>(std::max<std::size_t>(beams_counted, 1)) *
+                       params_.sensor.likelihood_exponent;
   double mean_beam = 0.0;
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     mean_beam += particles_.weight[i] * std::exp(ll[i] / beams);
