@@ -62,7 +62,9 @@ class BeamModel : public SensorModel {
   double beamProbability(double range, double expected, double range_max) const;
 
  private:
-  double scorePose(const PreparedScan& scan, double x, double y, double yaw) const;
+  // beam_cos, beam_sin: the beams' directions in the robot frame.
+  double scorePose(const PreparedScan& scan, const double* beam_cos, const double* beam_sin,
+                   double x, double y, double yaw) const;
 
   LikelihoodFieldModelParams shared_;
   BeamModelParams params_;
