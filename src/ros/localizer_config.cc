@@ -340,6 +340,11 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
   p.get("beam_skip_distance", &f.sensor.beam_skip_distance);
   p.get("beam_skip_threshold", &f.sensor.beam_skip_threshold);
   p.get("beam_skip_error_threshold", &f.sensor.beam_skip_error_threshold);
+  if (f.sensor.beam_skip && f.laser_model_type != pf::LaserModelType::kLikelihoodFieldProb) {
+    out->infos.push_back("do_beamskip is true but laser_model_type is " + laser_model +
+                         ": beam skipping is part of likelihood_field_prob (as in amcl), so no "
+                         "beam is skipped");
+  }
 
   p.get("gui_publish_rate", &c.gui_publish_rate);
   p.get("save_pose_rate", &c.save_pose_rate);

@@ -132,6 +132,11 @@ TEST(AmclParams, BeamModelAndBeamSkipParametersAreRead) {
   EXPECT_EQ(c.filter.sensor.beam_skip_threshold, 0.2);
   // amcl's misspelling is read as the right name.
   EXPECT_EQ(c.filter.sensor.beam_skip_error_threshold, 0.8);
+  // Under another model, as in amcl, do_beamskip does nothing, and says so.
+  ConfigNotes plain_notes;
+  readConfig(*yaml("do_beamskip: true\n"), nullptr, &plain_notes);
+  EXPECT_TRUE(anyContains(plain_notes.infos, "beam skipping is part of likelihood_field_prob"));
+  EXPECT_FALSE(anyContains(notes.infos, "beam skipping is part of likelihood_field_prob"));
   EXPECT_THROW(readConfig(*yaml("do_beamskip: true\nbeam_skip_threshold: 1.5\n"), nullptr, &notes),
                std::invalid_argument);
   EXPECT_THROW(
