@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "pf_localization/core/parameter_check.h"
+
 namespace pf {
 namespace {
 
@@ -33,14 +35,13 @@ LikelihoodFieldModel::LikelihoodFieldModel(const OccupancyGrid& grid,
   require(params.range_min >= 0.0 && params.range_max >= 0.0,
           "laser_min_range and laser_max_range must be >= 0");
   if (!params.beam_skip) return;
-  require(params.beam_skip_distance > 0.0 && std::isfinite(params.beam_skip_distance),
-          "beam_skip_distance must be > 0, got " + std::to_string(params.beam_skip_distance));
-  require(
-      params.beam_skip_threshold >= 0.0 && params.beam_skip_threshold <= 1.0,
-      "beam_skip_threshold must be in [0, 1], got " + std::to_string(params.beam_skip_threshold));
-  require(params.beam_skip_error_threshold >= 0.0 && params.beam_skip_error_threshold <= 1.0,
-          "beam_skip_error_threshold must be in [0, 1], got " +
-              std::to_string(params.beam_skip_error_threshold));
+  requireParameter(params.beam_skip_distance > 0.0 && std::isfinite(params.beam_skip_distance),
+                   "beam_skip_distance", "> 0", params.beam_skip_distance);
+  requireParameter(params.beam_skip_threshold >= 0.0 && params.beam_skip_threshold <= 1.0,
+                   "beam_skip_threshold", "in [0, 1]", params.beam_skip_threshold);
+  requireParameter(
+      params.beam_skip_error_threshold >= 0.0 && params.beam_skip_error_threshold <= 1.0,
+      "beam_skip_error_threshold", "in [0, 1]", params.beam_skip_error_threshold);
   const int stride = grid.width() + 2;
   near_.assign(static_cast<std::size_t>(stride) * (grid.height() + 2), 0);
   const std::vector<float>& dist = field_.distances();

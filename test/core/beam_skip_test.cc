@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <vector>
 
 #include "pf_localization/core/distance_field_ray_caster.h"
@@ -119,6 +120,23 @@ TEST(BeamSkip, OnePoseIsScoredOnEveryBeam) {
   const PreparedScan scan = skipping.prepare(scanWithUnmappedObstacle());
   EXPECT_EQ(plain.logLikelihood(scan, {2.0, 2.0, 0.0}),
             skipping.logLikelihood(scan, {2.0, 2.0, 0.0}));
+}
+
+TEST(BeamSkip, TheModelRefusesBadSkipParameters) {
+  LikelihoodFieldModelParams p = params(true);
+  p.beam_skip_threshold = 1.5;
+  try {
+    LikelihoodFieldModel model(room(), p);
+    FAIL() << "accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ("invalid parameter beam_skip_threshold = 1.5: must be in [0, 1]", e.what());
+  }
+  p = params(true);
+  p.beam_skip_distance = 0.0;
+  EXPECT_THROW(LikelihoodFieldModel(room(), p), std::invalid_argument);
+  // Unchecked, as unused, while skipping is off.
+  p.beam_skip = false;
+  EXPECT_NO_THROW(LikelihoodFieldModel(room(), p));
 }
 
 }  // namespace
