@@ -13,17 +13,16 @@
 // stands for "outside the map". The per-beam work is then: transform the end
 // point, clamp the cell index into the table, add.
 //
-// Beam skipping (amcl's likelihood_field_prob, after Thrun, Burgard & Fox
-// ch. 6.3.2's remark that beams hitting unmapped obstacles should be left
-// out): a beam that few particles place near an obstacle probably hit
-// something the map does not have (a person, a moved box), and would only
-// punish the particles at the true pose. For each beam, count the particles
-// whose end point lies within beam_skip_distance of an obstacle; a beam is
-// counted only when more than beam_skip_threshold of the particles agree
-// with it, unless so many beams would be left out (at least
-// beam_skip_error_threshold of them) that the filter is more likely wrong
-// than the map, and then every beam counts. The particles are counted
-// unweighted, as amcl does.
+// Beam skipping (ROS amcl's likelihood_field_prob, in its
+// AMCLLaser::LikelihoodFieldModelProb; not in Probabilistic Robotics): a beam
+// that few particles place near an obstacle probably hit something the map
+// does not have (a person, a moved box), and would only punish the particles
+// at the true pose. For each beam, count the particles whose end point lies
+// within beam_skip_distance of an obstacle; a beam is counted only when more
+// than beam_skip_threshold of the particles agree with it, unless so many
+// beams would be left out (at least beam_skip_error_threshold of them) that
+// the filter is more likely wrong than the map, and then every beam counts.
+// The particles are counted unweighted, as amcl does.
 #pragma once
 
 #include <cstdint>
