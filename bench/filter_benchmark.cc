@@ -7,7 +7,9 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <memory>
 
+#include "pf_localization/core/beam_model.h"
 #include "pf_localization/core/likelihood_field_model.h"
 #include "pf_localization/core/particle_filter.h"
 #include "pf_localization/core/resampler.h"
@@ -139,6 +141,50 @@ void BM_ScanRefinement(benchmark::State& state) {
   state.counters["gauss_newton_iterations"] = iterations;
 }
 BENCHMARK(BM_ScanRefinement)->Arg(60)->Arg(360)->Unit(benchmark::kMicrosecond);
+
+// The sensor models side by side (0: likelihood field, 1: the same with
+// beam skipping, 2: beam model) on a scan ray cast from the cloud's centre,
+// so that the beam model's expected ranges are the measured ones there.
+void BM_SensorModel(benchmark::State& state) {
+  const int beams = static_cast<int>(state.range(2));
+  const pf::OccupancyGrid grid = pillarMap(400);
+  pf::ParticleFilterParams params;
+  params.sensor.max_beams = beams;
+  params.laser_model_type =
+      state.range(0) == 2 ? pf::LaserModelType::kBeam : pf::LaserModelType::kLikelihoodFieldProb;
+  params.sensor.beam_skip = state.range(0) == 1;
+  const std::unique_ptr<pf::SensorModel> model = pf::makeSensorModel(grid, params);
+  pf::Random random(1);
+  const pf::ParticleSet particles = scatter(state.range(1), &random);
+  const pf::PreparedScan scan = model->prepare(castScan(grid, {10.0, 10.0, 0.0}, beams));
+  std::vector<double> out;
+  for (auto _ : state) {
+    model->logLikelihoods(scan, particles, &out);
+    benchmark::DoNotOptimize(out.data());
+  }
+  const double pairs = static_cast<double>(state.range(1)) * static_cast<double>(scan.size());
+  state.counters["ns_per_particle_beam"] = benchmark::Counter(
+      pairs * state.iterations(), benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_SensorModel)
+    ->ArgNames({"model", "particles", "beams"})
+    ->Args({0, 10000, 60})
+    ->Args({1, 10000, 60})
+    ->Args({2, 10000, 60})
+    ->Args({2, 1000, 360})
+    ->UseRealTime()
+    ->Unit(benchmark::kMillisecond);
+
+// Building the beam model's ray-casting table (the exact distance transform,
+// uncapped) for a side x side map, once per map.
+void BM_RayCasterTable(benchmark::State& state) {
+  const pf::OccupancyGrid grid = pillarMap(static_cast<int>(state.range(0)));
+  for (auto _ : state) {
+    const pf::DistanceFieldRayCaster caster(grid);
+    benchmark::DoNotOptimize(&caster);
+  }
+}
+BENCHMARK(BM_RayCasterTable)->Arg(1000)->Arg(2000)->Unit(benchmark::kMillisecond);
 
 void BM_SystematicResample(benchmark::State& state) {
   pf::Random random(2);

@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "pf_localization/core/parameter_check.h"
+
 namespace pf {
 namespace {
 
@@ -32,6 +34,24 @@ LikelihoodFieldModel::LikelihoodFieldModel(const OccupancyGrid& grid,
           "laser_max_beams must be >= 1, got " + std::to_string(params.max_beams));
   require(params.range_min >= 0.0 && params.range_max >= 0.0,
           "laser_min_range and laser_max_range must be >= 0");
+  if (!params.beam_skip) return;
+  requireParameter(params.beam_skip_distance > 0.0 && std::isfinite(params.beam_skip_distance),
+                   "beam_skip_distance", "> 0", params.beam_skip_distance);
+  requireParameter(params.beam_skip_threshold >= 0.0 && params.beam_skip_threshold <= 1.0,
+                   "beam_skip_threshold", "in [0, 1]", params.beam_skip_threshold);
+  requireParameter(
+      params.beam_skip_error_threshold >= 0.0 && params.beam_skip_error_threshold <= 1.0,
+      "beam_skip_error_threshold", "in [0, 1]", params.beam_skip_error_threshold);
+  const int stride = grid.width() + 2;
+  near_.assign(static_cast<std::size_t>(stride) * (grid.height() + 2), 0);
+  const std::vector<float>& dist = field_.distances();
+  for (int y = 0; y < grid.height(); ++y) {
+    for (int x = 0; x < grid.width(); ++x) {
+      // amcl's test: occ_dist < beam_skip_distance.
+      near_[static_cast<std::size_t>(y + 1) * stride + x + 1] =
+          dist[static_cast<std::size_t>(y) * grid.width() + x] < params.beam_skip_distance ? 1 : 0;
+    }
+  }
 }
 
 double LikelihoodFieldModel::beamLogLikelihood(double distance, double range_max) const {
@@ -41,30 +61,8 @@ double LikelihoodFieldModel::beamLogLikelihood(double distance, double range_max
 }
 
 PreparedScan LikelihoodFieldModel::prepare(const LaserScan& scan, int max_beams) const {
-  std::size_t valid = 0;
-  const std::vector<Beam> beams =
-      selectBeams(scan, max_beams, params_.range_min, params_.range_max, &valid);
-  PreparedScan out;
-  out.range_max =
-      params_.range_max > 0.0 ? std::min(params_.range_max, scan.range_max) : scan.range_max;
-  out.dropped = static_cast<int>(scan.ranges.size() - valid);
-  out.x.reserve(beams.size());
-  out.y.reserve(beams.size());
-  for (const Beam& b : beams) {
-    const Pose2 end = compose(scan.sensor_pose,
-                              {b.range * std::cos(b.bearing), b.range * std::sin(b.bearing), 0.0});
-    // Ranges of 1e38 m pass the scan's own limits when range_max is absurd;
-    // in float cells they overflow, so they are dropped like any bad beam.
-    const double res = field_.grid().resolution();
-    if (!std::isfinite(static_cast<float>(end.x / res)) ||
-        !std::isfinite(static_cast<float>(end.y / res))) {
-      ++out.dropped;
-      continue;
-    }
-    out.x.push_back(static_cast<float>(end.x));
-    out.y.push_back(static_cast<float>(end.y));
-  }
-  return out;
+  return prepareScan(scan, max_beams, params_.range_min, params_.range_max,
+                     field_.grid().resolution());
 }
 
 void LikelihoodFieldModel::buildTable(double range_max) const {
@@ -84,23 +82,19 @@ void LikelihoodFieldModel::buildTable(double range_max) const {
   table_range_max_ = range_max;
 }
 
-double LikelihoodFieldModel::hitFraction(const PreparedScan& scan, const Pose2& pose,
-                                         double distance) const {
-  if (scan.size() == 0) return 0.0;
-  std::size_t hits = 0;
-  for (std::size_t b = 0; b < scan.size(); ++b) {
-    const Pose2 end = compose(pose, {scan.x[b], scan.y[b], 0.0});
-    hits += field_.distanceAt(end.x, end.y) <= distance ? 1 : 0;
-  }
-  return static_cast<double>(hits) / static_cast<double>(scan.size());
-}
-
 double LikelihoodFieldModel::logLikelihood(const PreparedScan& scan, const Pose2& pose) const {
   ParticleSet one;
   one.resize(1);
   one.setPose(0, pose);
+  buildTable(scan.range_max);
+  const float inv_res = static_cast<float>(1.0 / field_.grid().resolution());
+  std::vector<float> bx(scan.size()), by(scan.size());
+  for (std::size_t b = 0; b < scan.size(); ++b) {
+    bx[b] = scan.x[b] * inv_res;
+    by[b] = scan.y[b] * inv_res;
+  }
   std::vector<double> out;
-  logLikelihoods(scan, one, &out);
+  score(bx.data(), by.data(), scan.size(), one, &out);
   return out[0];
 }
 
@@ -160,31 +154,54 @@ __attribute__((target_clones("avx2", "default"))) void scoreParticles(const Scor
   }
 }
 
+// The particle in the grid's frame, in cells, shifted by the one-cell
+// border: what every per-beam loop over one particle starts from.
+struct CellPose {
+  float x, y, c, s;
+};
+
+CellPose cellPose(const ScoringFrame& f, const ParticleSet& particles, std::size_t i) {
+  const double dx = particles.x[i] - f.origin.x, dy = particles.y[i] - f.origin.y;
+  const float yaw = static_cast<float>(particles.yaw[i] - f.origin.yaw);
+  return {static_cast<float>((f.origin_cos * dx + f.origin_sin * dy) * f.inv_res) + 1.0f,
+          static_cast<float>((-f.origin_sin * dx + f.origin_cos * dy) * f.inv_res) + 1.0f,
+          std::cos(yaw), std::sin(yaw)};
+}
+
+// For beam skipping: per beam, the number of particles whose end point lands
+// in a cell of `near` (the same border and clamping as scoreParticles).
+void countAgreeingParticles(const ScoringFrame& f, const uint8_t* near,
+                            const ParticleSet& particles, std::vector<std::size_t>* counts) {
+  counts->assign(f.beams, 0);
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    const CellPose p = cellPose(f, particles, i);
+    for (std::size_t b = 0; b < f.beams; ++b) {
+      const float ex = p.x + p.c * f.bx[b] - p.s * f.by[b];
+      const float ey = p.y + p.s * f.bx[b] + p.c * f.by[b];
+      const float gx = ex > 0.0f ? std::min(ex, f.max_x) : 0.0f;
+      const float gy = ey > 0.0f ? std::min(ey, f.max_y) : 0.0f;
+      (*counts)[b] += near[static_cast<int>(gy) * f.stride + static_cast<int>(gx)];
+    }
+  }
+}
+
 }  // namespace
 
-void LikelihoodFieldModel::logLikelihoods(const PreparedScan& scan, const ParticleSet& particles,
-                                          std::vector<double>* log_likelihood) const {
-  buildTable(scan.range_max);
+void LikelihoodFieldModel::score(const float* bx, const float* by, std::size_t beams,
+                                 const ParticleSet& particles,
+                                 std::vector<double>* log_likelihood) const {
   const OccupancyGrid& grid = field_.grid();
-  const float inv_res = static_cast<float>(1.0 / grid.resolution());
-  // End points in cell units, so the inner loop needs no division.
-  const std::size_t n = scan.size();
-  std::vector<float> bx(n), by(n);
-  for (std::size_t b = 0; b < n; ++b) {
-    bx[b] = scan.x[b] * inv_res;
-    by[b] = scan.y[b] * inv_res;
-  }
   const ScoringFrame frame{table_.data(),
                            grid.width() + 2,
                            static_cast<float>(grid.width() + 1),
                            static_cast<float>(grid.height() + 1),
-                           inv_res,
+                           static_cast<float>(1.0 / grid.resolution()),
                            grid.origin(),
                            std::cos(grid.origin().yaw),
                            std::sin(grid.origin().yaw),
-                           bx.data(),
-                           by.data(),
-                           n};
+                           bx,
+                           by,
+                           beams};
   log_likelihood->resize(particles.size());
   const int threads = params_.threads;
   if (threads <= 1) {
@@ -201,6 +218,72 @@ void LikelihoodFieldModel::logLikelihoods(const PreparedScan& scan, const Partic
     scoreParticles(frame, particles, size * t / threads, size * (t + 1) / threads,
                    log_likelihood->data());
   }
+}
+
+std::vector<uint8_t> LikelihoodFieldModel::keptBeams(const float* bx, const float* by,
+                                                     std::size_t beams,
+                                                     const ParticleSet& particles) const {
+  const OccupancyGrid& grid = field_.grid();
+  const ScoringFrame frame{nullptr,
+                           grid.width() + 2,
+                           static_cast<float>(grid.width() + 1),
+                           static_cast<float>(grid.height() + 1),
+                           static_cast<float>(1.0 / grid.resolution()),
+                           grid.origin(),
+                           std::cos(grid.origin().yaw),
+                           std::sin(grid.origin().yaw),
+                           bx,
+                           by,
+                           beams};
+  std::vector<std::size_t> agree;
+  countAgreeingParticles(frame, near_.data(), particles, &agree);
+  std::vector<uint8_t> kept(beams, 1);
+  const double n = static_cast<double>(particles.size());
+  std::size_t skipped = 0;
+  for (std::size_t b = 0; b < beams; ++b) {
+    // amcl keeps a beam when more than the threshold agree.
+    if (!(static_cast<double>(agree[b]) / n > params_.beam_skip_threshold)) {
+      kept[b] = 0;
+      ++skipped;
+    }
+  }
+  // Most beams disagreeing with the cloud means the cloud is wrong, not the
+  // map: then every beam must count, or the filter could never notice.
+  if (static_cast<double>(skipped) >=
+      static_cast<double>(beams) * params_.beam_skip_error_threshold) {
+    std::fill(kept.begin(), kept.end(), 1);
+  }
+  return kept;
+}
+
+std::size_t LikelihoodFieldModel::logLikelihoods(const PreparedScan& scan,
+                                                 const ParticleSet& particles,
+                                                 std::vector<double>* log_likelihood) const {
+  buildTable(scan.range_max);
+  const float inv_res = static_cast<float>(1.0 / field_.grid().resolution());
+  // End points in cell units, so the inner loop needs no division.
+  const std::size_t n = scan.size();
+  std::vector<float> bx(n), by(n);
+  for (std::size_t b = 0; b < n; ++b) {
+    bx[b] = scan.x[b] * inv_res;
+    by[b] = scan.y[b] * inv_res;
+  }
+  if (params_.beam_skip && particles.size() > 0 && n > 0) {
+    // The skipped beams are left out of the list scored, so the per-beam
+    // loop stays the same as without skipping.
+    const std::vector<uint8_t> kept = keptBeams(bx.data(), by.data(), n, particles);
+    std::size_t used = 0;
+    for (std::size_t b = 0; b < n; ++b) {
+      if (!kept[b]) continue;
+      bx[used] = bx[b];
+      by[used] = by[b];
+      ++used;
+    }
+    score(bx.data(), by.data(), used, particles, log_likelihood);
+    return used;
+  }
+  score(bx.data(), by.data(), n, particles, log_likelihood);
+  return n;
 }
 
 }  // namespace pf

@@ -99,6 +99,22 @@ void validate(const ParticleFilterParams& p) {
                    s.range_min);
   requireParameter(s.range_max >= 0.0 && finite(s.range_max), "laser_max_range", ">= 0",
                    s.range_max);
+  if (p.laser_model_type == LaserModelType::kBeam) {
+    requireParameter(p.beam.z_short >= 0.0 && finite(p.beam.z_short), "laser_z_short", ">= 0",
+                     p.beam.z_short);
+    requireParameter(p.beam.z_max >= 0.0 && finite(p.beam.z_max), "laser_z_max", ">= 0",
+                     p.beam.z_max);
+    requireParameter(p.beam.lambda_short > 0.0 && finite(p.beam.lambda_short), "laser_lambda_short",
+                     "> 0", p.beam.lambda_short);
+  }
+  if (s.beam_skip) {
+    requireParameter(s.beam_skip_distance > 0.0 && finite(s.beam_skip_distance),
+                     "beam_skip_distance", "> 0", s.beam_skip_distance);
+    requireParameter(s.beam_skip_threshold >= 0.0 && s.beam_skip_threshold <= 1.0,
+                     "beam_skip_threshold", "in [0, 1]", s.beam_skip_threshold);
+    requireParameter(s.beam_skip_error_threshold >= 0.0 && s.beam_skip_error_threshold <= 1.0,
+                     "beam_skip_error_threshold", "in [0, 1]", s.beam_skip_error_threshold);
+  }
   const auto& m = p.motion;
   const double alphas[] = {m.alpha1, m.alpha2, m.alpha3, m.alpha4, m.alpha5};
   for (int i = 0; i < 5; ++i) {
@@ -113,6 +129,22 @@ void validate(const ParticleFilterParams& p) {
                    m.fault_suspect_fraction);
   requireParameter(m.fault_margin >= 0.0 && finite(m.fault_margin), "odom_fault_margin", ">= 0",
                    m.fault_margin);
+}
+
+std::unique_ptr<SensorModel> makeSensorModel(const OccupancyGrid& grid,
+                                             const ParticleFilterParams& params) {
+  switch (params.laser_model_type) {
+    case LaserModelType::kBeam:
+      return std::make_unique<BeamModel>(grid, params.sensor, params.beam);
+    case LaserModelType::kLikelihoodFieldProb:
+      return std::make_unique<LikelihoodFieldModel>(grid, params.sensor);
+    case LaserModelType::kLikelihoodField:
+      break;
+  }
+  // amcl's likelihood_field never skips beams.
+  LikelihoodFieldModelParams sensor = params.sensor;
+  sensor.beam_skip = false;
+  return std::make_unique<LikelihoodFieldModel>(grid, sensor);
 }
 
 ParticleFilter::ParticleFilter(const ParticleFilterParams& params)
@@ -144,11 +176,18 @@ void ParticleFilter::reserveStorage(std::size_t max) {
 
 namespace {
 
-bool sameSensor(const LikelihoodFieldModelParams& a, const LikelihoodFieldModelParams& b) {
-  return a.z_hit == b.z_hit && a.z_rand == b.z_rand && a.sigma_hit == b.sigma_hit &&
-         a.max_distance == b.max_distance && a.max_beams == b.max_beams &&
-         a.range_min == b.range_min && a.range_max == b.range_max &&
-         a.likelihood_exponent == b.likelihood_exponent && a.threads == b.threads;
+// Whether the sensor model built from `a` would be the one built from `b`.
+bool sameSensor(const ParticleFilterParams& a, const ParticleFilterParams& b) {
+  const LikelihoodFieldModelParams &s = a.sensor, &t = b.sensor;
+  return a.laser_model_type == b.laser_model_type && s.z_hit == t.z_hit && s.z_rand == t.z_rand &&
+         s.sigma_hit == t.sigma_hit && s.max_distance == t.max_distance &&
+         s.max_beams == t.max_beams && s.range_min == t.range_min && s.range_max == t.range_max &&
+         s.likelihood_exponent == t.likelihood_exponent && s.threads == t.threads &&
+         s.beam_skip == t.beam_skip && s.beam_skip_distance == t.beam_skip_distance &&
+         s.beam_skip_threshold == t.beam_skip_threshold &&
+         s.beam_skip_error_threshold == t.beam_skip_error_threshold &&
+         a.beam.z_short == b.beam.z_short && a.beam.z_max == b.beam.z_max &&
+         a.beam.lambda_short == b.beam.lambda_short;
 }
 
 }  // namespace
@@ -157,11 +196,11 @@ void ParticleFilter::setParams(const ParticleFilterParams& params) {
   validate(params);
   // Everything that can throw comes before the first change.
   OdometryMotionModel motion(params.motion);
-  std::unique_ptr<LikelihoodFieldModel> model;
-  if (model_ && !sameSensor(params.sensor, params_.sensor)) {
+  std::unique_ptr<SensorModel> model;
+  if (model_ && !sameSensor(params, params_)) {
     // The model holds its parameters and its table of beam likelihoods; the
     // distance field under them depends on laser_likelihood_max_dist too.
-    model = std::make_unique<LikelihoodFieldModel>(model_->field().grid(), params.sensor);
+    model = makeSensorModel(model_->field().grid(), params);
   }
   if (params.kld.max_particles > params_.kld.max_particles) {
     reserveStorage(static_cast<std::size_t>(params.kld.max_particles));
@@ -177,7 +216,7 @@ void ParticleFilter::setParams(const ParticleFilterParams& params) {
 
 bool ParticleFilter::setMap(const OccupancyGrid& grid) {
   if (grid.empty()) throw std::invalid_argument("the map is empty");
-  model_ = std::make_unique<LikelihoodFieldModel>(grid, params_.sensor);
+  model_ = makeSensorModel(grid, params_);
   refined_.reset();  // fitted to the old map
   if (isInitialized() && grid.isFreeAt(estimate_.pose.x, estimate_.pose.y)) return true;
   particles_.resize(0);  // keeps the reserved storage
@@ -346,7 +385,7 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
 }
 
 void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
-  model_->logLikelihoods(scan, particles_, &log_likelihood_);
+  const std::size_t beams_counted = model_->logLikelihoods(scan, particles_, &log_likelihood_);
   // After a resampling every weight is the same, and a constant prior does
   // not change the normalised result: zeros spare N logarithms.
   const std::vector<double>& w = particles_.weight;
@@ -380,6 +419,7 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
     beta = lo;
   }
   report->tempering = beta;
+  report->beams_skipped = static_cast<int>(scan.size() - beams_counted);
   scratch_.resize(particles_.size());
   double max_log = -std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < particles_.size(); ++i) {
@@ -404,7 +444,9 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
   // robots), averaged with the posterior weights. The posterior, not the
   // prior, so that a few particles that found the robot count for what they
   // are worth, and a cloud salted with random particles is not judged by them.
-  const double beams = static_cast<double>(scan.size()) * params_.sensor.likelihood_exponent;
+  // Over the beams the model counted: beam skipping may leave some out.
+  const double beams = static_cast<double>(std::max<std::size_t>(beams_counted, 1)) *
+                       params_.sensor.likelihood_exponent;
   double mean_beam = 0.0;
   for (std::size_t i = 0; i < particles_.size(); ++i) {
     mean_beam += particles_.weight[i] * std::exp(ll[i] / beams);

@@ -11,6 +11,8 @@ const std::vector<std::pair<std::string, std::string>>& amclAliases() {
       {"odom_frame", "odom_frame_id"},
       {"base_frame", "base_frame_id"},
       {"kld_confidence", "kld_z"},
+      // amcl reads only this misspelling; configurations written for it exist.
+      {"beam_skip_error_threshold", "beam_skip_error_threshold_"},
   };
   return aliases;
 }
@@ -29,14 +31,9 @@ double kldConfidenceFromZ(double kld_z) {
 }
 
 std::string laserModelTypeError(const std::string& type) {
-  if (type == "likelihood_field" || type == "likelihood_field_prob") return "";
-  if (type == "beam") {
-    return "laser_model_type 'beam' is not available: only the likelihood field model is "
-           "implemented (set likelihood_field; laser_z_hit, laser_z_rand and laser_sigma_hit "
-           "mean the same there, laser_z_short, laser_z_max and laser_lambda_short have no "
-           "counterpart)";
-  }
-  return "laser_model_type must be likelihood_field (or likelihood_field_prob), got '" + type + "'";
+  if (type == "likelihood_field" || type == "likelihood_field_prob" || type == "beam") return "";
+  return "laser_model_type must be likelihood_field, likelihood_field_prob or beam, got '" + type +
+         "'";
 }
 
 const std::vector<AmclOnlyParam>& amclOnlyParams() {
@@ -51,18 +48,6 @@ const std::vector<AmclOnlyParam>& amclOnlyParams() {
       {"selective_resampling",
        "resampling here is always selective (effective sample size below "
        "resample_ess_fraction x N; amcl's selective_resampling is the same test at 0.5)"},
-      {"laser_z_short", "a beam-model weight (only the likelihood field model is implemented)"},
-      {"laser_z_max", "a beam-model weight (only the likelihood field model is implemented)"},
-      {"laser_lambda_short",
-       "a beam-model parameter (only the likelihood field model is implemented)"},
-      {"do_beamskip", "beam skipping (amcl's likelihood_field_prob) is not implemented"},
-      {"beam_skip_distance", "beam skipping (amcl's likelihood_field_prob) is not implemented"},
-      {"beam_skip_threshold", "beam skipping (amcl's likelihood_field_prob) is not implemented"},
-      {"beam_skip_error_threshold",
-       "beam skipping (amcl's likelihood_field_prob) is not implemented"},
-      // amcl reads this misspelling first; configurations written for it exist.
-      {"beam_skip_error_threshold_",
-       "beam skipping (amcl's likelihood_field_prob) is not implemented"},
       {"std_warn_level_x", kStdWarnWhy},
       {"std_warn_level_y", kStdWarnWhy},
       {"std_warn_level_yaw", kStdWarnWhy},

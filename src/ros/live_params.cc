@@ -63,6 +63,23 @@ const std::vector<LiveParam>& liveParams() {
       {"laser_likelihood_exponent", field<double>([](LocalizerConfig& c) -> double& {
          return c.filter.sensor.likelihood_exponent;
        })},
+      {"laser_z_short",
+       field<double>([](LocalizerConfig& c) -> double& { return c.filter.beam.z_short; })},
+      {"laser_z_max",
+       field<double>([](LocalizerConfig& c) -> double& { return c.filter.beam.z_max; })},
+      {"laser_lambda_short",
+       field<double>([](LocalizerConfig& c) -> double& { return c.filter.beam.lambda_short; })},
+      {"do_beamskip",
+       field<bool>([](LocalizerConfig& c) -> bool& { return c.filter.sensor.beam_skip; })},
+      {"beam_skip_distance", field<double>([](LocalizerConfig& c) -> double& {
+         return c.filter.sensor.beam_skip_distance;
+       })},
+      {"beam_skip_threshold", field<double>([](LocalizerConfig& c) -> double& {
+         return c.filter.sensor.beam_skip_threshold;
+       })},
+      {"beam_skip_error_threshold", field<double>([](LocalizerConfig& c) -> double& {
+         return c.filter.sensor.beam_skip_error_threshold;
+       })},
       {"laser_max_beams",
        field<int>([](LocalizerConfig& c) -> int& { return c.filter.sensor.max_beams; })},
       {"laser_min_range",

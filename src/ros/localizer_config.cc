@@ -343,6 +343,25 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
   p.get("laser_model_type", &laser_model);
   const std::string laser_model_error = laserModelTypeError(laser_model);
   if (!laser_model_error.empty()) throw std::invalid_argument(laser_model_error);
+  f.laser_model_type = laser_model == "beam" ? pf::LaserModelType::kBeam
+                       : laser_model == "likelihood_field_prob"
+                           ? pf::LaserModelType::kLikelihoodFieldProb
+                           : pf::LaserModelType::kLikelihoodField;
+  p.get("laser_z_short", &f.beam.z_short);
+  p.get("laser_z_max", &f.beam.z_max);
+  p.get("laser_lambda_short", &f.beam.lambda_short);
+  // Beam skipping is part of likelihood_field_prob only, as in amcl; the
+  // filter ignores it under the other models. amcl reads its misspelt
+  // beam_skip_error_threshold_ (an alias here).
+  p.get("do_beamskip", &f.sensor.beam_skip);
+  p.get("beam_skip_distance", &f.sensor.beam_skip_distance);
+  p.get("beam_skip_threshold", &f.sensor.beam_skip_threshold);
+  p.get("beam_skip_error_threshold", &f.sensor.beam_skip_error_threshold);
+  if (f.sensor.beam_skip && f.laser_model_type != pf::LaserModelType::kLikelihoodFieldProb) {
+    out->infos.push_back("do_beamskip is true but laser_model_type is " + laser_model +
+                         ": beam skipping is part of likelihood_field_prob (as in amcl), so no "
+                         "beam is skipped");
+  }
 
   p.get("gui_publish_rate", &c.gui_publish_rate);
   p.get("save_pose_rate", &c.save_pose_rate);

@@ -753,6 +753,74 @@ TEST(ParticleFilter, TracksFromAnOffInitialGuess) {
   EXPECT_LT(filter.estimate().covariance(1, 1), 0.05 * 0.05);
 }
 
+// The filter composes whichever sensor model laser_model_type names; each
+// one must track on the same drive.
+TEST(ParticleFilter, EveryLaserModelTracksFromAnOffInitialGuess) {
+  const OccupancyGrid grid = trackingRoom();
+  for (const LaserModelType type : {LaserModelType::kLikelihoodField,
+                                    LaserModelType::kLikelihoodFieldProb, LaserModelType::kBeam}) {
+    ParticleFilterParams params = baseParams();
+    params.laser_model_type = type;
+    params.sensor.beam_skip = true;  // used by kLikelihoodFieldProb only
+    ParticleFilter filter(params);
+    filter.setMap(grid);
+    const std::vector<Pose2> path = trackingPath(10);
+    filter.initializeGaussian({1.18, 1.26, 0.1}, diag(0.3, 0.3, 0.15));
+    for (std::size_t k = 0; k < path.size(); ++k) {
+      const UpdateReport r = filter.update(odomOf(path[k]), simulateScan(grid, path[k]));
+      ASSERT_TRUE(r.updated) << "model " << static_cast<int>(type) << ", step " << k;
+      // Only the skipping model may leave beams out.
+      if (type != LaserModelType::kLikelihoodFieldProb) {
+        EXPECT_EQ(0, r.beams_skipped);
+      }
+    }
+    const Pose2 truth = path.back();
+    const Pose2 estimate = filter.estimate().pose;
+    EXPECT_LT(distance(truth, estimate), 0.1) << "model " << static_cast<int>(type);
+    EXPECT_LT(std::fabs(angleDiff(truth.yaw, estimate.yaw)), 0.05)
+        << "model " << static_cast<int>(type);
+  }
+}
+
+TEST(ParticleFilterParams, SensorModelParametersAreNamed) {
+  expectInvalid(
+      [](ParticleFilterParams& p) {
+        p.laser_model_type = LaserModelType::kBeam;
+        p.beam.lambda_short = 0.0;
+      },
+      "laser_lambda_short");
+  expectInvalid(
+      [](ParticleFilterParams& p) {
+        p.laser_model_type = LaserModelType::kBeam;
+        p.beam.z_short = -0.1;
+      },
+      "laser_z_short");
+  expectInvalid(
+      [](ParticleFilterParams& p) {
+        p.laser_model_type = LaserModelType::kBeam;
+        p.beam.z_max = NAN;
+      },
+      "laser_z_max");
+  expectInvalid(
+      [](ParticleFilterParams& p) {
+        p.sensor.beam_skip = true;
+        p.sensor.beam_skip_distance = 0.0;
+      },
+      "beam_skip_distance");
+  expectInvalid(
+      [](ParticleFilterParams& p) {
+        p.sensor.beam_skip = true;
+        p.sensor.beam_skip_threshold = 1.5;
+      },
+      "beam_skip_threshold");
+  expectInvalid(
+      [](ParticleFilterParams& p) {
+        p.sensor.beam_skip = true;
+        p.sensor.beam_skip_error_threshold = -0.1;
+      },
+      "beam_skip_error_threshold");
+}
+
 TEST(ParticleFilter, GlobalLocalizationInAnAsymmetricRoom) {
   // An L-shaped room: 3 m x 2 m less a 1.2 m x 0.9 m block in its upper
   // right corner, plus a pillar in the upper arm. No half turn or mirror

@@ -106,19 +106,53 @@ TEST(AmclParams, KldZIsTheNormalQuantileOfOurConfidence) {
   EXPECT_THROW(readConfig(*yaml("kld_z: .nan\n"), nullptr, &notes), std::invalid_argument);
 }
 
-TEST(AmclParams, OnlyTheLikelihoodFieldModelIsAccepted) {
+TEST(AmclParams, EveryAmclLaserModelIsAccepted) {
   ConfigNotes notes;
-  EXPECT_NO_THROW(readConfig(*yaml("laser_model_type: likelihood_field\n"), nullptr, &notes));
-  EXPECT_NO_THROW(readConfig(*yaml("laser_model_type: likelihood_field_prob\n"), nullptr, &notes));
+  EXPECT_EQ(readConfig(*yaml("laser_model_type: likelihood_field\n"), nullptr, &notes)
+                .filter.laser_model_type,
+            pf::LaserModelType::kLikelihoodField);
+  EXPECT_EQ(readConfig(*yaml("laser_model_type: likelihood_field_prob\n"), nullptr, &notes)
+                .filter.laser_model_type,
+            pf::LaserModelType::kLikelihoodFieldProb);
+  EXPECT_EQ(readConfig(*yaml("laser_model_type: beam\n"), nullptr, &notes).filter.laser_model_type,
+            pf::LaserModelType::kBeam);
   try {
-    readConfig(*yaml("laser_model_type: beam\n"), nullptr, &notes);
-    FAIL() << "the beam model was accepted";
+    readConfig(*yaml("laser_model_type: lidar\n"), nullptr, &notes);
+    FAIL() << "an unknown model was accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("only the likelihood field model"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("likelihood_field, likelihood_field_prob or beam"),
+              std::string::npos)
         << e.what();
   }
-  EXPECT_THROW(readConfig(*yaml("laser_model_type: lidar\n"), nullptr, &notes),
+}
+
+TEST(AmclParams, BeamModelAndBeamSkipParametersAreRead) {
+  ConfigNotes notes;
+  const LocalizerConfig c = readConfig(*yaml("laser_model_type: likelihood_field_prob\n"
+                                             "laser_z_short: 0.2\nlaser_z_max: 0.01\n"
+                                             "laser_lambda_short: 0.3\ndo_beamskip: true\n"
+                                             "beam_skip_distance: 0.4\nbeam_skip_threshold: 0.2\n"
+                                             "beam_skip_error_threshold_: 0.8\n"),
+                                       nullptr, &notes);
+  EXPECT_TRUE(notes.warnings.empty());
+  EXPECT_EQ(c.filter.beam.z_short, 0.2);
+  EXPECT_EQ(c.filter.beam.z_max, 0.01);
+  EXPECT_EQ(c.filter.beam.lambda_short, 0.3);
+  EXPECT_TRUE(c.filter.sensor.beam_skip);
+  EXPECT_EQ(c.filter.sensor.beam_skip_distance, 0.4);
+  EXPECT_EQ(c.filter.sensor.beam_skip_threshold, 0.2);
+  // amcl's misspelling is read as the right name.
+  EXPECT_EQ(c.filter.sensor.beam_skip_error_threshold, 0.8);
+  // Under another model, as in amcl, do_beamskip does nothing, and says so.
+  ConfigNotes plain_notes;
+  readConfig(*yaml("do_beamskip: true\n"), nullptr, &plain_notes);
+  EXPECT_TRUE(anyContains(plain_notes.infos, "beam skipping is part of likelihood_field_prob"));
+  EXPECT_FALSE(anyContains(notes.infos, "beam skipping is part of likelihood_field_prob"));
+  EXPECT_THROW(readConfig(*yaml("do_beamskip: true\nbeam_skip_threshold: 1.5\n"), nullptr, &notes),
                std::invalid_argument);
+  EXPECT_THROW(
+      readConfig(*yaml("laser_model_type: beam\nlaser_lambda_short: 0\n"), nullptr, &notes),
+      std::invalid_argument);
 }
 
 TEST(AmclParams, ResampleIntervalIsAcceptedAndExplained) {

@@ -12,13 +12,26 @@
 // once per map (and per range_max) into a table with a one-cell border that
 // stands for "outside the map". The per-beam work is then: transform the end
 // point, clamp the cell index into the table, add.
+//
+// Beam skipping (ROS amcl's likelihood_field_prob, in its
+// AMCLLaser::LikelihoodFieldModelProb; not in Probabilistic Robotics): a beam
+// that few particles place near an obstacle probably hit something the map
+// does not have (a person, a moved box), and would only punish the particles
+// at the true pose. For each beam, count the particles whose end point lies
+// within beam_skip_distance of an obstacle; a beam is counted only when more
+// than beam_skip_threshold of the particles agree with it, unless so many
+// beams would be left out (at least beam_skip_error_threshold of them) that
+// the filter is more likely wrong than the map, and then every beam counts.
+// The particles are counted unweighted, as amcl does.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include "pf_localization/core/laser_scan.h"
 #include "pf_localization/core/likelihood_field.h"
 #include "pf_localization/core/particle_set.h"
+#include "pf_localization/core/sensor_model.h"
 
 namespace pf {
 
@@ -39,46 +52,48 @@ struct LikelihoodFieldModelParams {
   // Threads scoring the particles (OpenMP builds). Each particle is scored on
   // its own, so the result does not depend on this number.
   int threads = 1;
+  // Beam skipping (see above; amcl's do_beamskip and beam_skip_*). Only
+  // laser_model_type likelihood_field_prob turns it on, as in amcl.
+  bool beam_skip = false;
+  double beam_skip_distance = 0.5;         // m; an end point this close to an obstacle agrees (> 0)
+  double beam_skip_threshold = 0.3;        // share of particles that must agree, in [0, 1]
+  double beam_skip_error_threshold = 0.9;  // skip nothing when this share would be skipped, [0, 1]
 };
 
-/// End points of the usable beams in the robot's base frame, computed once per scan.
-struct PreparedScan {
-  std::vector<float> x;    // m
-  std::vector<float> y;    // m
-  double range_max = 0.0;  // the range_max that scales z_rand
-  int dropped = 0;         // invalid beams dropped before subsampling
-  std::size_t size() const { return x.size(); }
-};
-
-class LikelihoodFieldModel {
+class LikelihoodFieldModel : public SensorModel {
  public:
   /// Throws std::invalid_argument naming the parameter when one is out of range.
   LikelihoodFieldModel(const OccupancyGrid& grid, const LikelihoodFieldModelParams& params);
 
   const LikelihoodFieldModelParams& params() const { return params_; }
-  const LikelihoodField& field() const { return field_; }
+  const LikelihoodField& field() const override { return field_; }
 
   /// The usable beams' end points in the robot frame.
-  PreparedScan prepare(const LaserScan& scan) const { return prepare(scan, params_.max_beams); }
+  PreparedScan prepare(const LaserScan& scan) const override {
+    return prepare(scan, params_.max_beams);
+  }
   /// The same with another beam budget (<= 0: every usable beam).
-  PreparedScan prepare(const LaserScan& scan, int max_beams) const;
+  PreparedScan prepare(const LaserScan& scan, int max_beams) const override;
 
-  /// likelihood_exponent * log p(scan | pose) for one pose.
-  double logLikelihood(const PreparedScan& scan, const Pose2& pose) const;
+  /// likelihood_exponent * log p(scan | pose) for one pose (no beam skipping:
+  /// that is a decision of the whole cloud).
+  double logLikelihood(const PreparedScan& scan, const Pose2& pose) const override;
 
-  /// likelihood_exponent * log p(scan | particle) for every particle, into `log_likelihood`.
-  void logLikelihoods(const PreparedScan& scan, const ParticleSet& particles,
-                      std::vector<double>* log_likelihood) const;
-
-  /// The fraction of the scan's beams whose end point, placed from `pose`,
-  /// lies within `distance` metres of an obstacle (0 for an empty scan).
-  double hitFraction(const PreparedScan& scan, const Pose2& pose, double distance) const;
+  /// likelihood_exponent * log p(scan | particle) for every particle, into
+  /// `log_likelihood`, over the beams that beam skipping keeps (all when it
+  /// is off). Returns how many beams were counted.
+  std::size_t logLikelihoods(const PreparedScan& scan, const ParticleSet& particles,
+                             std::vector<double>* log_likelihood) const override;
 
   /// log p of one beam whose end point is `distance` metres from an obstacle.
   double beamLogLikelihood(double distance, double range_max) const;
 
  private:
   void buildTable(double range_max) const;
+  void score(const float* bx, const float* by, std::size_t beams, const ParticleSet& particles,
+             std::vector<double>* log_likelihood) const;
+  std::vector<uint8_t> keptBeams(const float* bx, const float* by, std::size_t beams,
+                                 const ParticleSet& particles) const;
 
   LikelihoodFieldModelParams params_;
   LikelihoodField field_;
@@ -86,6 +101,9 @@ class LikelihoodFieldModel {
   // "outside the map" cells, rebuilt only when range_max changes.
   mutable std::vector<float> table_;
   mutable double table_range_max_ = -1.0;
+  // For beam skipping: 1 where a cell lies within beam_skip_distance of an
+  // obstacle, with the same border (0: outside the map agrees with nothing).
+  std::vector<uint8_t> near_;
 };
 
 }  // namespace pf

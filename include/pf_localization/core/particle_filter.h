@@ -1,5 +1,6 @@
 // Monte Carlo localization: the particle filter that composes the motion
-// model, the likelihood-field sensor model, the resampler and the pose
+// model, a sensor model (sensor_model.h: the likelihood field, with or
+// without beam skipping, or the beam model), the resampler and the pose
 // estimator.
 //
 // Thrun, Burgard & Fox, "Probabilistic Robotics" (2005), table 8.2 (MCL) with
@@ -23,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "pf_localization/core/beam_model.h"
 #include "pf_localization/core/confidence.h"
 #include "pf_localization/core/laser_scan.h"
 #include "pf_localization/core/likelihood_field_model.h"
@@ -33,6 +35,7 @@
 #include "pf_localization/core/random.h"
 #include "pf_localization/core/resampler.h"
 #include "pf_localization/core/scan_refiner.h"
+#include "pf_localization/core/sensor_model.h"
 
 namespace pf {
 
@@ -76,6 +79,13 @@ struct RecoveryParams {
   double expansion_std_yaw = 0.3;  // rad
 };
 
+// amcl's laser_model_type.
+enum class LaserModelType {
+  kLikelihoodField,      // likelihood_field_model.h
+  kLikelihoodFieldProb,  // the same, with beam skipping when sensor.beam_skip is set
+  kBeam,                 // beam_model.h
+};
+
 struct ParticleFilterParams {
   KldParams kld;                       // particle count bounds and KLD-sampling
   double update_min_d = 0.2;           // m of travel between updates
@@ -92,7 +102,11 @@ struct ParticleFilterParams {
   double tempering_ess_fraction_uncertain = 0.1;
   uint64_t seed = 0;
   OdometryMotionParams motion;
-  LikelihoodFieldModelParams sensor;
+  // Which sensor model weighs the particles. Beam skipping (sensor.beam_skip)
+  // takes effect with kLikelihoodFieldProb only, as in amcl.
+  LaserModelType laser_model_type = LaserModelType::kLikelihoodField;
+  LikelihoodFieldModelParams sensor;  // also the terms the beam model shares
+  BeamModelParams beam;               // the beam model's own terms
   ClusterParams clusters;
   RecoveryParams recovery;
   ConfidenceParams confidence;
@@ -110,12 +124,18 @@ struct ParticleFilterParams {
 /// Throws std::invalid_argument naming the first parameter out of range and its valid range.
 void validate(const ParticleFilterParams& params);
 
+/// The sensor model `params` names, on `grid`. Throws std::invalid_argument
+/// for an out-of-range parameter.
+std::unique_ptr<SensorModel> makeSensorModel(const OccupancyGrid& grid,
+                                             const ParticleFilterParams& params);
+
 /// What one call to ParticleFilter::update did.
 struct UpdateReport {
   bool updated = false;     // motion and sensor update ran
   std::string skip_reason;  // why not, when !updated
   int beams_used = 0;
   int beams_dropped = 0;
+  int beams_skipped = 0;  // of beams_used, left out by beam skipping
   std::size_t particles = 0;
   double ess = 0.0;  // before resampling
   bool resampled = false;
@@ -195,7 +215,7 @@ class ParticleFilter {
   ParticleFilterParams params_;
   Random random_;
   OdometryMotionModel motion_model_;
-  std::unique_ptr<LikelihoodFieldModel> model_;
+  std::unique_ptr<SensorModel> model_;
   ParticleSet particles_;
   ParticleSet spare_;  // the resampler's output, swapped with particles_
   PoseEstimate estimate_;

@@ -24,9 +24,9 @@ const std::vector<std::pair<std::string, std::string>>& amclAliases();
 /// So p = Phi(kld_z), the normal CDF. amcl's default kld_z 0.99 is p = 0.839.
 double kldConfidenceFromZ(double kld_z);
 
-/// Empty when `type` names a laser model we implement (likelihood_field, and
-/// likelihood_field_prob, whose only difference is beam skipping, which we do
-/// not do); otherwise why it is refused.
+/// Empty when `type` names one of amcl's laser models (likelihood_field,
+/// likelihood_field_prob: the same with beam skipping when do_beamskip is
+/// set, beam); otherwise why it is refused.
 std::string laserModelTypeError(const std::string& type);
 
 /// A parameter amcl reads that has no effect here.
@@ -36,8 +36,8 @@ struct AmclOnlyParam {
 };
 
 /// amcl parameters we accept (no "unknown parameter" warning) without using
-/// them: the beam model's, beam skipping's, diagnostics', dynamic_reconfigure's,
-/// resample_interval, selective_resampling, bag_scan_period.
+/// them: diagnostics', dynamic_reconfigure's, resample_interval,
+/// selective_resampling, bag_scan_period.
 const std::vector<AmclOnlyParam>& amclOnlyParams();
 
 }  // namespace pf_ros
