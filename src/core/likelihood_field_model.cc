@@ -185,23 +185,28 @@ void countAgreeingParticles(const ScoringFrame& f, const uint8_t* near,
   }
 }
 
+// The frame for scoring `beams` end points (in cells) on `grid`'s table.
+ScoringFrame scoringFrame(const OccupancyGrid& grid, const float* table, const float* bx,
+                          const float* by, std::size_t beams) {
+  return ScoringFrame{table,
+                      grid.width() + 2,
+                      static_cast<float>(grid.width() + 1),
+                      static_cast<float>(grid.height() + 1),
+                      static_cast<float>(1.0 / grid.resolution()),
+                      grid.origin(),
+                      std::cos(grid.origin().yaw),
+                      std::sin(grid.origin().yaw),
+                      bx,
+                      by,
+                      beams};
+}
+
 }  // namespace
 
 void LikelihoodFieldModel::score(const float* bx, const float* by, std::size_t beams,
                                  const ParticleSet& particles,
                                  std::vector<double>* log_likelihood) const {
-  const OccupancyGrid& grid = field_.grid();
-  const ScoringFrame frame{table_.data(),
-                           grid.width() + 2,
-                           static_cast<float>(grid.width() + 1),
-                           static_cast<float>(grid.height() + 1),
-                           static_cast<float>(1.0 / grid.resolution()),
-                           grid.origin(),
-                           std::cos(grid.origin().yaw),
-                           std::sin(grid.origin().yaw),
-                           bx,
-                           by,
-                           beams};
+  const ScoringFrame frame = scoringFrame(field_.grid(), table_.data(), bx, by, beams);
   log_likelihood->resize(particles.size());
   const int threads = params_.threads;
   if (threads <= 1) {
@@ -223,18 +228,7 @@ void LikelihoodFieldModel::score(const float* bx, const float* by, std::size_t b
 std::vector<uint8_t> LikelihoodFieldModel::keptBeams(const float* bx, const float* by,
                                                      std::size_t beams,
                                                      const ParticleSet& particles) const {
-  const OccupancyGrid& grid = field_.grid();
-  const ScoringFrame frame{nullptr,
-                           grid.width() + 2,
-                           static_cast<float>(grid.width() + 1),
-                           static_cast<float>(grid.height() + 1),
-                           static_cast<float>(1.0 / grid.resolution()),
-                           grid.origin(),
-                           std::cos(grid.origin().yaw),
-                           std::sin(grid.origin().yaw),
-                           bx,
-                           by,
-                           beams};
+  const ScoringFrame frame = scoringFrame(field_.grid(), nullptr, bx, by, beams);
   std::vector<std::size_t> agree;
   countAgreeingParticles(frame, near_.data(), particles, &agree);
   std::vector<uint8_t> kept(beams, 1);
