@@ -52,7 +52,10 @@ TEST(LiveParams, TheCfgListsExactlyTheLiveParamsKldZAndRestoreDefaults) {
   live.insert("restore_defaults");
   EXPECT_EQ(cfg, live);
   // And the message of a configuration fills every field of the generated type.
-  pf_localization::PfLocalizationConfig config;
+  // (From the defaults: the generated type leaves its fields uninitialised,
+  // and fromMessage reads each one before it writes it.)
+  pf_localization::PfLocalizationConfig config =
+      pf_localization::PfLocalizationConfig::__getDefault__();
   dynamic_reconfigure::Config ours = liveParamsMessage(LocalizerConfig());
   EXPECT_TRUE(config.__fromMessage__(ours));
 }
