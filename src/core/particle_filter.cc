@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 
@@ -388,14 +387,18 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
   const std::size_t beams_counted = model_->logLikelihoods(scan, particles_, &log_likelihood_);
   // After a resampling every weight is the same, and a constant prior does
   // not change the normalised result: zeros spare N logarithms.
+  // The prior's effective sample size is then N, too, without a pass of
+  // exponentials.
   const std::vector<double>& w = particles_.weight;
+  const std::vector<double>& ll = log_likelihood_;
+  double prior_ess = static_cast<double>(particles_.size());
   if (std::all_of(w.begin(), w.end(), [&](double v) { return v == w.front(); })) {
     log_prior_.assign(particles_.size(), 0.0);
   } else {
     log_prior_.resize(particles_.size());
     for (std::size_t i = 0; i < particles_.size(); ++i) log_prior_[i] = std::log(w[i]);
+    prior_ess = effectiveSampleSize(log_prior_, ll, 0.0);
   }
-  const std::vector<double>& ll = log_likelihood_;
   double beta = 1.0;
   // A filter that is not sure of itself weighs evidence more cautiously:
   // rival hypotheses (twin rooms) then survive until the scans really
@@ -407,7 +410,6 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
   // recovery's barely weighted guesses count as particles but not as
   // effective ones, and measured against N a cloud salted with them could
   // never keep enough, so every scan was tempered away to nothing.
-  const double prior_ess = effectiveSampleSize(log_prior_, ll, 0.0);
   const double min_ess = fraction * prior_ess;
   if (min_ess > 0.0 && effectiveSampleSize(log_prior_, ll, 1.0) < min_ess) {
     // Bisection for the largest exponent that keeps min_ess particles.
