@@ -521,9 +521,9 @@ void ParticleFilter::resample(UpdateReport* report) {
   const double usual = params_.recovery.trigger_ratio * w_slow_;
   const double dip = usual > 0.0 ? std::max(0.0, 1.0 - w_fast_ / usual) : 0.0;
   low_fit_updates_ = dip > 0.0 ? low_fit_updates_ + 1 : 0;
-  const bool patient = fit_state_ == LocalizationState::kLocalized ||
-                       (fit_state_ != LocalizationState::kLost &&
-                        low_fit_updates_ <= params_.recovery.patience);
+  const bool patient =
+      fit_state_ == LocalizationState::kLocalized ||
+      (fit_state_ != LocalizationState::kLost && low_fit_updates_ <= params_.recovery.patience);
   const bool can_inject = !model_->field().grid().freeCells().empty() && !patient;
   const double inject_probability = can_inject ? dip : 0.0;
   const std::size_t n = particles_.size();

@@ -653,8 +653,7 @@ TEST(ParticleFilterUpdate, AScanThatStopsFittingThePredictedPoseUpdatesAtOnce) {
 
 // The number of updates with bad scans before recovery injects (-1: none in
 // 30), for a filter whose thresholds keep it in `state` whatever the fit.
-int updatesBeforeInjection(int patience,
-                           LocalizationState state = LocalizationState::kUncertain) {
+int updatesBeforeInjection(int patience, LocalizationState state = LocalizationState::kUncertain) {
   const OccupancyGrid grid = trackingRoom();
   ParticleFilterParams params = recoveryParams();
   params.recovery.patience = patience;

@@ -89,9 +89,9 @@ enum class LaserModelType {
 };
 
 struct ParticleFilterParams {
-  KldParams kld;                       // particle count bounds and KLD-sampling
-  double update_min_d = 0.2;           // m of travel between updates
-  double update_min_a = M_PI / 6.0;    // rad of rotation between updates
+  KldParams kld;                     // particle count bounds and KLD-sampling
+  double update_min_d = 0.2;         // m of travel between updates
+  double update_min_a = M_PI / 6.0;  // rad of rotation between updates
   // Between those updates every scan is checked, at the pose the odometry
   // predicts, for the share of its beams that end within update_fit_distance
   // of a mapped obstacle (one pose: the cost of one particle). When that
@@ -102,7 +102,7 @@ struct ParticleFilterParams {
   // tight (a few map cells): a 0.3 m error barely moves the share within
   // 0.4 m, but halves it within 0.1 m. 0 disables. [0, 1]
   double update_fit_drop = 0.25;
-  double update_fit_distance = 0.1;  // m, > 0
+  double update_fit_distance = 0.1;    // m, > 0
   double odom_jump_limit = 5.0;        // m; a longer odometry step between updates is a fault
   double resample_ess_fraction = 0.5;  // resample when ESS < this * N (0..1]
   // When one scan would leave fewer than this fraction of the effective
