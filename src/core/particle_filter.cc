@@ -414,8 +414,13 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
   double beta = 1.0;
   // A filter that is not sure of itself weighs evidence more cautiously:
   // rival hypotheses (twin rooms) then survive until the scans really
-  // separate them, instead of the luckiest one winning outright.
-  const double fraction = fit_state_ == LocalizationState::kLocalized
+  // separate them, instead of the luckiest one winning outright. Not when
+  // the one thing wrong is a wide cloud whose beams fit: along a corridor
+  // between sparse scans (intel_lab: 1 m of odometry per scan), caution
+  // would only keep the cloud wide, and the estimate, its mean, off.
+  const bool spread_only = fit_state_ == LocalizationState::kUncertain && confidence_.rivals == 0 &&
+                           confidence_.hit_fraction >= params_.confidence.localized_hit_fraction;
+  const double fraction = fit_state_ == LocalizationState::kLocalized || spread_only
                               ? params_.tempering_ess_fraction
                               : params_.tempering_ess_fraction_uncertain;
   // A share of the effective particles before the scan, not of all of them:

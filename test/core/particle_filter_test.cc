@@ -550,6 +550,36 @@ TEST(ParticleFilterUpdate, RecoveryGuessesDoNotTemperTheNextScanAway) {
   EXPECT_NEAR(0.99 * prior_ess, next.ess, 0.01 * prior_ess);  // the bisection's target
 }
 
+// The tempering exponent of the second update of a filter started from a
+// Gaussian of std `spread` m at the truth, tempering to keep 0.9 of the
+// effective particles while uncertain (and none while localized).
+double secondTempering(double spread, Confidence* after_first) {
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilterParams params = baseParams();
+  params.kld.min_particles = params.kld.max_particles = 1000;
+  params.tempering_ess_fraction = 0.0;
+  params.tempering_ess_fraction_uncertain = 0.9;
+  params.confidence.localized_std_xy = 0.3;
+  ParticleFilter filter(params);
+  filter.setMap(grid);
+  const Pose2 truth{1.5, 1.5, 0.0};
+  filter.initializeGaussian(truth, diag(spread, spread, 0.02));
+  EXPECT_TRUE(filter.update({0.0, 0.0, 0.0}, simulateScan(grid, truth)).updated);
+  *after_first = filter.confidence();
+  filter.requestNoMotionUpdate();
+  return filter.update({0.0, 0.0, 0.0}, simulateScan(grid, truth)).tempering;
+}
+
+TEST(ParticleFilterUpdate, AWideCloudWhoseBeamsFitIsNotTempered) {
+  // Wide (0.6 m) but one cluster whose estimate's beams fit: uncertain for
+  // its spread alone, which caution would only preserve.
+  Confidence c;
+  EXPECT_EQ(1.0, secondTempering(0.6, &c));
+  EXPECT_EQ(LocalizationState::kUncertain, c.state);
+  EXPECT_EQ(0, c.rivals);
+  EXPECT_NE(std::string::npos, c.reason.find("spread")) << c.reason;
+}
+
 // The share of particles the filter gives to odometry faults after each of
 // `steps` updates in which the odometry reports 0.3 m forwards along x and the
 // scans are taken at `truth_step` metres per update from `start`.

@@ -101,7 +101,7 @@ struct ParticleFilterParams {
   // than after update_min_d of motion it cannot trust. The distance is
   // tight (a few map cells): a 0.3 m error barely moves the share within
   // 0.4 m, but halves it within 0.1 m. 0 disables. [0, 1]
-  double update_fit_drop = 0.25;
+  double update_fit_drop = 0.2;
   double update_fit_distance = 0.1;    // m, > 0
   double odom_jump_limit = 5.0;        // m; a longer odometry step between updates is a fault
   double resample_ess_fraction = 0.5;  // resample when ESS < this * N (0..1]
@@ -111,7 +111,9 @@ struct ParticleFilterParams {
   // global initialisation, then narrows it over several scans instead of
   // collapsing it onto one lucky particle. 0 disables. [0, 1]
   double tempering_ess_fraction = 0.02;
-  // The same while the filter is not localized (see Confidence). [0, 1]
+  // The same while the filter is not localized (see Confidence) because of
+  // rivals or a poor fit; a cloud that is only wide, with its beams fitting,
+  // keeps tempering_ess_fraction. [0, 1]
   double tempering_ess_fraction_uncertain = 0.1;
   uint64_t seed = 0;
   OdometryMotionParams motion;
