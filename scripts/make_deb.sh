@@ -3,8 +3,8 @@
 # packages (installed under /usr, found by rospack/roslaunch without sourcing
 # anything):
 #   /usr/lib/pf_localization/        the nodes and Python tools (catkin's libexec)
-#   /usr/lib/<multiarch>/            libpf_core.so, libpf_ros.so, libpf_sim.so
-#   /usr/share/pf_localization/      package.xml, launch, config, maps, bags, rviz, cmake
+#   /usr/lib/<multiarch>/            libpf_core.so, libpf_ros.so, libpf_sim.so; cmake/, pkgconfig/
+#   /usr/share/pf_localization/      package.xml, launch, config, maps, bags, rviz
 #   /usr/include/pf_localization/    the headers
 #   /usr/lib/python3/dist-packages/pf_localization/   the dynamic_reconfigure client module
 #   /usr/share/doc/ros-pf-localization/               copyright, changelog
@@ -206,6 +206,8 @@ $longdesc
 EOF
 sed -i 's/\\n/\n/g' "$stage/DEBIAN/control"
 (cd "$stage" && find usr -type f -print0 | sort -z | xargs -0 md5sum) >"$stage/DEBIAN/md5sums"
+# Shared libraries in /usr/lib/<multiarch>: refresh ld.so's cache (as dh_makeshlibs does).
+echo 'activate-noawait ldconfig' >"$stage/DEBIAN/triggers"
 # Debian's modes: nothing group- or world-writable.
 chmod -R go-w "$stage"
 find "$stage" -type d -exec chmod 755 {} +
