@@ -60,7 +60,7 @@ done
 # --- What package.xml says ----------------------------------------------------
 # name, version, maintainer, license, description, then one run dependency a line
 # (<depend> and <exec_depend>, which catkin_pkg lists as exec_depends).
-mapfile -t meta < <(/usr/bin/python3 - "$repo/package.xml" <<'EOF'
+meta_out=$(/usr/bin/python3 - "$repo/package.xml" <<'EOF'
 import sys, textwrap
 from catkin_pkg.package import parse_package
 p = parse_package(sys.argv[1])
@@ -75,6 +75,7 @@ for d in sorted({d.name for d in p.exec_depends}):
     print(d)
 EOF
 ) || die "cannot read $repo/package.xml (python3-catkin-pkg installed?)"
+mapfile -t meta <<<"$meta_out"
 name=${meta[0]} version=${meta[1]} maintainer=${meta[2]} license=${meta[3]} longdesc=${meta[4]}
 rundeps=("${meta[@]:5}")
 [ "$name" = pf_localization ] || die "package.xml names '$name', not pf_localization"
