@@ -9,6 +9,8 @@ set -euo pipefail
 packages=(
   # build tools
   build-essential cmake catkin catkin-lint python3-catkin-pkg clang-format
+  # scripts/make_deb.sh: dpkg-shlibdeps, dpkg-architecture (build-essential pulls it in too)
+  dpkg-dev
   # `catkin build` (catkin_tools; Debian calls it catkin-tools, not python3-catkin-tools)
   catkin-tools
   # ROS 1 core, messages and tools
