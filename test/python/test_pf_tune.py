@@ -221,6 +221,41 @@ class StudyTest(unittest.TestCase):
         self.assertTrue(all(r['ok'] for t in trials for r in t.user_attrs['bags']), out)
         self.assertTrue(os.path.isfile(os.path.join(self.out, 'best.yaml')))
 
+    def test_a_study_killed_mid_trial_runs_that_trial_again(self):
+        import psutil
+        from optuna.trial import TrialState
+        proc = subprocess.Popen(tune_cmd(self.out, '--trials', '4', *SMALL), stdout=subprocess.PIPE,
+                                stderr=subprocess.STDOUT, universal_newlines=True)
+        try:
+            deadline, stopped = time.monotonic() + 300, False
+            while not stopped and time.monotonic() < deadline and proc.poll() is None:
+                for d in psutil.Process(proc.pid).children(recursive=True):
+                    try:
+                        if 'pf_bag_runner' in ' '.join(d.cmdline()) and os.path.isfile(
+                                os.path.join(self.out, 'study.db')):
+                            proc.send_signal(signal.SIGTERM)  # as `kill PID` does
+                            stopped = True
+                            break
+                    except psutil.NoSuchProcess:
+                        pass
+                time.sleep(0.02)
+            out, _ = proc.communicate(timeout=300)
+        finally:
+            if proc.poll() is None:
+                proc.kill()
+        self.assertTrue(stopped, out)
+        self.assertEqual(proc.returncode, 130, out)
+        self.assertIn('run the same command again to continue', out)
+        p = subprocess.run(tune_cmd(self.out, '--trials', '4', *SMALL), stdout=subprocess.PIPE,
+                           stderr=subprocess.STDOUT, universal_newlines=True, timeout=600)
+        self.assertEqual(p.returncode, 0, p.stdout)
+        self.assertRegex(p.stdout, r'trial \d+ was interrupted: it is run again')
+        trials, study = completed_trials(self.out)
+        self.assertEqual(len(trials), 4)
+        failed = study.get_trials(deepcopy=False, states=(TrialState.FAIL,))
+        self.assertEqual(len(failed), 1)
+        self.assertIn(failed[0].params, [t.params for t in trials if t.number > failed[0].number])
+
     def test_a_study_stopped_after_three_trials_continues_at_the_fourth(self):
         p = subprocess.run(tune_cmd(self.out, '--trials', '3', *SMALL), stdout=subprocess.PIPE,
                            stderr=subprocess.STDOUT, universal_newlines=True, timeout=600)
