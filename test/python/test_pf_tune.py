@@ -7,6 +7,7 @@ Run from the repository root:  /usr/bin/python3 -m unittest discover -s test/pyt
 Needs pf_bag_runner built (scripts/build.sh; the workspace is $PF_WS or scripts/workspace.bash's
 default), python3-optuna, python3-distributed, python3-sklearn and ROS 1's rosbag. About 2 minutes.
 """
+import csv
 import importlib.machinery
 import importlib.util
 import os
@@ -281,6 +282,26 @@ class StudyTest(unittest.TestCase):
                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, timeout=600)
         self.assertEqual(p.returncode, 2, p.stdout)
         self.assertIn('set up differently (objective differ)', p.stdout)
+
+
+class BenchmarkOnDaskTest(unittest.TestCase):
+    def test_benchmark_datasets_on_a_local_cluster_gives_the_sequential_table(self):
+        self.assertTrue(os.access(RUNNER, os.X_OK), 'pf_bag_runner not built at %s (scripts/build.sh; PF_WS)' % RUNNER)
+        tables = []
+        with tempfile.TemporaryDirectory() as d:
+            for extra in ([], ['--workers', '2']):
+                out = os.path.join(d, 'dask' if extra else 'plain')
+                p = subprocess.run(['/usr/bin/python3', os.path.join(REPO, 'scripts', 'benchmark_datasets'),
+                                    '--data', os.path.join(d, 'no_data'), '--no-plots', '--out', out] + extra,
+                                   stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
+                                   timeout=600)
+                self.assertEqual(p.returncode, 0, p.stdout)
+                with open(os.path.join(out, 'results.csv')) as f:
+                    rows = list(csv.DictReader(f))
+                tables.append([(r['dataset'], r['ate_rmse_m'], r['max_m'], r['status']) for r in rows])
+        self.assertEqual(len(tables[0]), 5)  # the five bundled bags with ground truth
+        self.assertTrue(all(r[3] == 'ok' for r in tables[0]))
+        self.assertEqual(tables[0], tables[1])
 
 
 if __name__ == '__main__':
