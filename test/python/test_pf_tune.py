@@ -257,6 +257,27 @@ class StudyTest(unittest.TestCase):
         self.assertEqual(len(failed), 1)
         self.assertIn(failed[0].params, [t.params for t in trials if t.number > failed[0].number])
 
+    def test_a_bag_that_breaks_the_runner_is_reported_and_the_study_goes_on(self):
+        broken = os.path.join(self.out, 'broken.bag')
+        with open(broken, 'w') as f:
+            f.write('not a bag\n')
+        p = subprocess.run(tune_cmd(self.out, '--trials', '2', '--bags', os.path.join(REPO, 'bags', 'small.bag'),
+                                    broken, '--map', os.path.join(REPO, 'maps', 'small.yaml'),
+                                    '--initial-pose', '2.5', '2.6', '0'),
+                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True, timeout=600)
+        self.assertEqual(p.returncode, 0, p.stdout)
+        self.assertIn('objective: self (no reference for broken.bag)', p.stdout)
+        self.assertIn('trial 1: broken.bag failed: pf_bag_runner exit 2', p.stdout)
+        self.assertIn('trial 2: broken.bag failed: pf_bag_runner exit 2', p.stdout)
+        trials, _ = completed_trials(self.out)
+        self.assertEqual(len(trials), 2)
+        for t in trials:
+            ok = {os.path.basename(r['bag']): (r['ok'], r['score']) for r in t.user_attrs['bags']}
+            self.assertEqual(ok['broken.bag'], (False, pft.FAIL_SCORE['self']))
+            self.assertTrue(ok['small.bag'][0])
+        with open(os.path.join(self.out, 'report.md')) as f:
+            self.assertIn('| broken.bag | failed: pf_bag_runner exit 2', f.read())
+
     def test_a_study_stopped_after_three_trials_continues_at_the_fourth(self):
         p = subprocess.run(tune_cmd(self.out, '--trials', '3', *SMALL), stdout=subprocess.PIPE,
                            stderr=subprocess.STDOUT, universal_newlines=True, timeout=600)
