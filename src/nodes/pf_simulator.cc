@@ -232,7 +232,7 @@ double simulate(const Options& o, const pf::OccupancyGrid& map, const pf::sim::P
       scan.angle_min = 0.0;
       scan.angle_increment = 2.0 * M_PI / kBeams;
       scan.angle_max = (kBeams - 1) * scan.angle_increment;
-      scan.time_increment = 0.0;  // every beam is cast from the pose at the stamp
+      scan.time_increment = 0.0;            // every beam is cast from the pose at the stamp
       scan.scan_time = kScanEvery * kTick;  // one turn of the laser, however sparse the log
       scan.range_min = laser.range_min;
       scan.range_max = laser.range_max;
