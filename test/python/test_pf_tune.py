@@ -48,6 +48,28 @@ def tune_cmd(out, *extra):
     return ['/usr/bin/python3', TUNE, '--out', out, '--workers', '2', '--seed', '3', '--no-progress'] + list(extra)
 
 
+def run_until(cmd, act, period):
+    """Runs pf_tune as `cmd` and calls act(proc) every `period` s until it
+    returns something other than None (or 300 s pass); then waits for the end.
+    Returns what act returned, the output and the exit status."""
+    import psutil
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True)
+    done = None
+    try:
+        deadline = time.monotonic() + 300
+        while done is None and time.monotonic() < deadline and proc.poll() is None:
+            try:
+                done = act(proc)
+            except psutil.NoSuchProcess:
+                pass  # a process ended while it was looked at: look again
+            time.sleep(period)
+        out, _ = proc.communicate(timeout=600)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    return done, out, proc.returncode
+
+
 def completed_trials(out):
     import optuna
     from optuna.trial import TrialState
@@ -194,28 +216,19 @@ class StudyTest(unittest.TestCase):
     def test_killing_a_worker_mid_study_still_completes_every_trial(self):
         import psutil
         n = 6
-        proc = subprocess.Popen(tune_cmd(self.out, '--trials', str(n), *TWO_BAGS), stdout=subprocess.PIPE,
-                                stderr=subprocess.STDOUT, universal_newlines=True)
-        killed = None
-        try:
-            deadline = time.monotonic() + 300
-            while killed is None and time.monotonic() < deadline and proc.poll() is None:
-                # a worker process (a child of pf_tune) that is running pf_bag_runner right now
-                for child in psutil.Process(proc.pid).children():
-                    try:
-                        if any('pf_bag_runner' in ' '.join(g.cmdline()) for g in child.children()):
-                            child.send_signal(signal.SIGKILL)
-                            killed = child.pid
-                            break
-                    except psutil.NoSuchProcess:
-                        pass
-                time.sleep(0.05)
-            out, _ = proc.communicate(timeout=600)
-        finally:
-            if proc.poll() is None:
-                proc.kill()
+
+        def kill_worker(proc):
+            # a worker process (a child of pf_tune) that is running pf_bag_runner right now
+            for child in psutil.Process(proc.pid).children():
+                if any('pf_bag_runner' in ' '.join(g.cmdline()) for g in child.children()):
+                    child.send_signal(signal.SIGKILL)
+                    return child.pid
+            return None
+
+        killed, out, returncode = run_until(tune_cmd(self.out, '--trials', str(n), *TWO_BAGS), kill_worker,
+                                            0.05)
         self.assertIsNotNone(killed, 'no worker was caught running pf_bag_runner')
-        self.assertEqual(proc.returncode, 0, out)
+        self.assertEqual(returncode, 0, out)
         trials, _ = completed_trials(self.out)
         self.assertEqual(len(trials), n, out)
         # the task on the killed worker ran again: no bag of any trial is scored as a failure
@@ -225,27 +238,18 @@ class StudyTest(unittest.TestCase):
     def test_a_study_killed_mid_trial_runs_that_trial_again(self):
         import psutil
         from optuna.trial import TrialState
-        proc = subprocess.Popen(tune_cmd(self.out, '--trials', '4', *SMALL), stdout=subprocess.PIPE,
-                                stderr=subprocess.STDOUT, universal_newlines=True)
-        try:
-            deadline, stopped = time.monotonic() + 300, False
-            while not stopped and time.monotonic() < deadline and proc.poll() is None:
-                for d in psutil.Process(proc.pid).children(recursive=True):
-                    try:
-                        if 'pf_bag_runner' in ' '.join(d.cmdline()) and os.path.isfile(
-                                os.path.join(self.out, 'study.db')):
-                            proc.send_signal(signal.SIGTERM)  # as `kill PID` does
-                            stopped = True
-                            break
-                    except psutil.NoSuchProcess:
-                        pass
-                time.sleep(0.02)
-            out, _ = proc.communicate(timeout=300)
-        finally:
-            if proc.poll() is None:
-                proc.kill()
+
+        def stop_study(proc):
+            for d in psutil.Process(proc.pid).children(recursive=True):
+                if 'pf_bag_runner' in ' '.join(d.cmdline()) and os.path.isfile(
+                        os.path.join(self.out, 'study.db')):
+                    proc.send_signal(signal.SIGTERM)  # as `kill PID` does
+                    return True
+            return None
+
+        stopped, out, returncode = run_until(tune_cmd(self.out, '--trials', '4', *SMALL), stop_study, 0.02)
         self.assertTrue(stopped, out)
-        self.assertEqual(proc.returncode, 130, out)
+        self.assertEqual(returncode, 130, out)
         self.assertIn('run the same command again to continue', out)
         p = subprocess.run(tune_cmd(self.out, '--trials', '4', *SMALL), stdout=subprocess.PIPE,
                            stderr=subprocess.STDOUT, universal_newlines=True, timeout=600)
@@ -320,7 +324,7 @@ class BenchmarkOnDaskTest(unittest.TestCase):
                 with open(os.path.join(out, 'results.csv')) as f:
                     rows = list(csv.DictReader(f))
                 tables.append([(r['dataset'], r['ate_rmse_m'], r['max_m'], r['status']) for r in rows])
-        self.assertEqual(len(tables[0]), 5)  # the five bundled bags with ground truth
+        self.assertEqual(len(tables[0]), 6)  # the six bundled bags with ground truth
         self.assertTrue(all(r[3] == 'ok' for r in tables[0]))
         self.assertEqual(tables[0], tables[1])
 
