@@ -76,6 +76,9 @@ void validate(const ParticleFilterParams& p) {
   requireParameter(p.recovery.kidnap_prior > 0.0 && p.recovery.kidnap_prior <= 1.0,
                    "recovery_kidnap_prior", "in (0, 1]", p.recovery.kidnap_prior);
   requireParameter(p.recovery.patience >= 0, "recovery_patience", ">= 0", p.recovery.patience);
+  requireParameter(p.recovery.patience_localized >= p.recovery.patience,
+                   "recovery_patience_localized", ">= recovery_patience",
+                   p.recovery.patience_localized);
   requireParameter(p.recovery.expansion_ratio >= 0.0 && p.recovery.expansion_ratio < 1.0,
                    "recovery_expansion_ratio", "in [0, 1)", p.recovery.expansion_ratio);
   requireParameter(p.recovery.expansion_std_xy >= 0.0 && finite(p.recovery.expansion_std_xy),
@@ -389,6 +392,16 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
   }
   refineEstimate(scan, &report);
   resample(&report);
+  // Scans that have fitted worse than usual for longer than recovery's
+  // patience cast doubt on a "localized" verdict, whatever share of the
+  // beams fits: a cloud settled on a wrong place that fits most beams looks
+  // just so, and says it while recovery waits.
+  if (confidence_.state == LocalizationState::kLocalized &&
+      low_fit_updates_ > params_.recovery.patience) {
+    confidence_.state = LocalizationState::kUncertain;
+    confidence_.reason = "the scans have fitted worse than usual for " +
+                         std::to_string(low_fit_updates_) + " updates";
+  }
   has_estimate_ = true;
   report.updated = true;
   report.particles = particles_.size();
@@ -516,19 +529,16 @@ void ParticleFilter::resample(UpdateReport* report) {
   // to fit those scans better. A robot that is really lost or kidnapped is
   // soon "lost" (see Confidence), or stays badly fitted for longer (a cloud
   // that settled on a look-alike place).
-  // Nor does it inject while "localized": most beams then end on mapped
-  // obstacles at the estimate (within a fixed distance, not sigma_hit), so
-  // the dip is the map's poverty there, not a kidnapping. In a large building
-  // the likelihood sags wherever a fifth of the beams see what the map lacks,
-  // and a random guess that fits those few scans better is only a rival to
-  // jump to (fr079: 28 m, from an estimate 0.14 m off with 87 % of its beams
-  // fitting).
+  // While "localized" it waits longer (patience_localized): most beams then
+  // end on mapped obstacles at the estimate, and the dip is more likely the
+  // map's poverty there than a kidnapping.
   const double usual = params_.recovery.trigger_ratio * w_slow_;
   const double dip = usual > 0.0 ? std::max(0.0, 1.0 - w_fast_ / usual) : 0.0;
   low_fit_updates_ = dip > 0.0 ? low_fit_updates_ + 1 : 0;
-  const bool patient =
-      fit_state_ == LocalizationState::kLocalized ||
-      (fit_state_ != LocalizationState::kLost && low_fit_updates_ <= params_.recovery.patience);
+  const int patience = fit_state_ == LocalizationState::kLocalized
+                           ? params_.recovery.patience_localized
+                           : params_.recovery.patience;
+  const bool patient = fit_state_ != LocalizationState::kLost && low_fit_updates_ <= patience;
   const bool can_inject = !model_->field().grid().freeCells().empty() && !patient;
   const double inject_probability = can_inject ? dip : 0.0;
   const std::size_t n = particles_.size();

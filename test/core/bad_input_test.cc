@@ -375,6 +375,8 @@ TEST(BadParams, EachInvalidParameterThrowsNamingIt) {
       {"update_min_d", [](ParticleFilterParams* p) { p->update_min_d = -0.1; }},
       {"update_min_a", [](ParticleFilterParams* p) { p->update_min_a = kNaN; }},
       {"update_fit_drop", [](ParticleFilterParams* p) { p->update_fit_drop = 1.5; }},
+      {"recovery_patience_localized",
+       [](ParticleFilterParams* p) { p->recovery.patience_localized = p->recovery.patience - 1; }},
       {"update_fit_distance", [](ParticleFilterParams* p) { p->update_fit_distance = 0.0; }},
       {"resample_ess_fraction", [](ParticleFilterParams* p) { p->resample_ess_fraction = 0.0; }},
       {"resample_ess_fraction", [](ParticleFilterParams* p) { p->resample_ess_fraction = 1.5; }},
