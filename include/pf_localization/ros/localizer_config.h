@@ -31,6 +31,12 @@ struct LocalizerConfig {
   // pf_node only: pf_bag_runner has neither topics to throttle nor a
   // parameter server to save to.
   double gui_publish_rate = -1.0;  // Hz limit of particlecloud; <= 0: after every update
+  // Poses at most in a particlecloud message (0: every particle): a larger
+  // cloud is shown by a systematic resample to this many (toPoseArray).
+  int cloud_max_poses = 5000;
+  // s an update may take (wall, p95): when > 0 the particle count is capped
+  // so that it does (UpdateTimeGovernor); <= 0: off, max_particles alone.
+  double max_update_time = 0.0;
   double save_pose_rate = 0.5;     // Hz the estimate is saved to ~initial_pose_*; <= 0: never
   bool first_map_only = false;     // keep the first map; ignore later ones on the map topic
 };

@@ -1,0 +1,47 @@
+// max_update_time: "use what the CPU allows" instead of a guessed
+// max_particles (issue 15). After each update it learns the wall time one
+// particle costs on this computer, as it is loaded now, and caps the particle
+// count so that an update fits in the budget; KLD-sampling still chooses the
+// count below the cap. A slower computer, or another process taking the CPU,
+// lowers the cap within a few updates; when the CPU is free again it rises.
+#pragma once
+
+#include <cstddef>
+
+namespace pf_ros {
+
+struct UpdateTimeGovernorOptions {
+  double max_update_time = 0.0;  // s of wall time an update may take; <= 0: no cap
+  // The cap aims at this fraction of max_update_time, so that the update
+  // times' spread (cache misses, preemption) stays under it at p95.
+  double headroom = 0.7;
+  // Weight of the newest update in the running per-particle cost: 0.2 follows
+  // a change of load within about 5 updates without chasing single outliers.
+  double smoothing = 0.2;
+  // The cap rises by at most this factor per update: a cost measured on a
+  // small cloud underestimates a large one's (caches), so growth is gradual.
+  double max_growth = 1.25;
+  std::size_t min_cap = 100;  // particles; the cap never goes below this
+};
+
+class UpdateTimeGovernor {
+ public:
+  explicit UpdateTimeGovernor(const UpdateTimeGovernorOptions& options = {});
+
+  bool enabled() const { return options_.max_update_time > 0.0; }
+  void setMaxUpdateTime(double seconds) { options_.max_update_time = seconds; }
+
+  /// One update of `particles` particles took `seconds` (wall). Returns the
+  /// new cap (0 when disabled, or before the first update with particles).
+  std::size_t addUpdate(std::size_t particles, double seconds);
+
+  /// The current cap on the particle count (0: none).
+  std::size_t cap() const { return enabled() ? cap_ : 0; }
+
+ private:
+  UpdateTimeGovernorOptions options_;
+  double cost_per_particle_ = 0.0;  // s, running average
+  std::size_t cap_ = 0;
+};
+
+}  // namespace pf_ros
