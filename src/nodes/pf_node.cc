@@ -25,13 +25,17 @@
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
 #include <std_srvs/Empty.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/message_filter.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <csignal>
 #include <memory>
 #include <mutex>
@@ -69,6 +73,10 @@ std::string failureText(tf2_ros::filter_failure_reasons::FilterFailureReason rea
 // s of odometry messages to wait for odom -> base on /tf before the odometry
 // topic is taken as the source instead.
 constexpr double kOdomSourceGrace = 0.5;
+
+// How much lower the filter thread's priority is than the rest of the node
+// (nice); see filterLoop().
+constexpr int kFilterNiceIncrement = 5;
 
 // s between two log lines about the same kind of bad input.
 constexpr double kLogPeriod = 5.0;
@@ -122,7 +130,6 @@ class PfNode {
         nh_.advertiseService("request_nomotion_update", &PfNode::onNoMotionUpdate, this);
     set_map_srv_ = nh_.advertiseService("set_map", &PfNode::onSetMap, this);
     republisher_ = std::make_unique<MapToOdomRepublisher>(
-        nh_,
         MapToOdomRepublisherOptions{config.tf_publish_rate, config.transform_tolerance,
                                     config.tf_broadcast},
         [this](const ros::Time& now) { onTfTick(now); });
@@ -141,6 +148,7 @@ class PfNode {
     } else {
       ROS_INFO("pf_node: no initial pose given: global localization once a map arrives");
     }
+    republisher_->start();
     filter_thread_ = std::thread([this] { filterLoop(); });
   }
 
@@ -185,7 +193,8 @@ class PfNode {
       p.kld.min_particles = std::min(p.kld.min_particles, p.kld.max_particles);
     }
     const pf::KldParams& now = localizer_.filter().params().kld;
-    if (now.max_particles == p.kld.max_particles && now.min_particles == p.kld.min_particles) return;
+    if (now.max_particles == p.kld.max_particles && now.min_particles == p.kld.min_particles)
+      return;
     localizer_.filter().setParams(p);
   }
 
@@ -242,14 +251,23 @@ class PfNode {
   void onScan(const sensor_msgs::LaserScanConstPtr& scan) {
     if (!slot_.put(PendingScan{scan, ros::WallTime::now(), ros::Time::now()})) return;
     const std::uint64_t dropped = slot_.dropped();
-    warn("overload", "the filter cannot keep up: a scan waiting for it was dropped for a newer one (" +
-                         std::to_string(dropped) +
-                         " since start; see dropped_scans and latency_* in the diagnostics). Lower "
-                         "max_particles, or set max_update_time");
+    warn("overload",
+         "the filter cannot keep up: a scan waiting for it was dropped for a newer one (" +
+             std::to_string(dropped) +
+             " since start; see dropped_scans and latency_* in the diagnostics). Lower "
+             "max_particles, or set max_update_time");
   }
 
   // The filter thread: the newest waiting scan, one at a time.
   void filterLoop() {
+    // The filter yields the CPU to this node's other threads (map -> odom,
+    // odometry and tf, the clock): a lower priority for this thread and
+    // the threads it starts (OpenMP's, with sensor_threads > 1). Raising
+    // the nice value needs no privilege; failing, it changes nothing.
+    const id_t tid = static_cast<id_t>(::syscall(SYS_gettid));
+    errno = 0;
+    const int nice = ::getpriority(PRIO_PROCESS, tid);
+    if (errno == 0) ::setpriority(PRIO_PROCESS, tid, std::min(19, nice + kFilterNiceIncrement));
     while (ros::ok() && !slot_.closed()) {
       if (auto pending = slot_.take(ros::WallDuration(0.1))) processScan(*pending);
     }

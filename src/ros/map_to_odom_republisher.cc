@@ -1,24 +1,26 @@
 #include "pf_localization/ros/map_to_odom_republisher.h"
 
-
 #include <algorithm>
+#include <chrono>
 #include <utility>
 
 namespace pf_ros {
 
-MapToOdomRepublisher::MapToOdomRepublisher(const ros::NodeHandle& nh,
-                                           const MapToOdomRepublisherOptions& options,
+MapToOdomRepublisher::MapToOdomRepublisher(const MapToOdomRepublisherOptions& options,
                                            TickHook hook)
-    : options_(options), hook_(std::move(hook)), nh_(nh) {
-  nh_.setCallbackQueue(&queue_);
-  timer_ = nh_.createTimer(ros::Duration(1.0 / options_.rate), &MapToOdomRepublisher::onTimer, this);
-  spinner_ = std::make_unique<ros::AsyncSpinner>(1, &queue_);
-  spinner_->start();
+    : options_(options), hook_(std::move(hook)) {}
+
+void MapToOdomRepublisher::start() {
+  if (!thread_.joinable()) thread_ = std::thread([this] { run(); });
 }
 
 MapToOdomRepublisher::~MapToOdomRepublisher() {
-  timer_.stop();
-  spinner_->stop();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  if (thread_.joinable()) thread_.join();
 }
 
 bool MapToOdomRepublisher::set(const std::optional<geometry_msgs::TransformStamped>& map_to_odom,
@@ -42,10 +44,11 @@ void MapToOdomRepublisher::reset() {
 }
 
 void MapToOdomRepublisher::setRate(double hz) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (hz == options_.rate) return;
-  options_.rate = hz;
-  timer_.setPeriod(ros::Duration(1.0 / hz));
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    options_.rate = hz;
+  }
+  wake_.notify_all();
 }
 
 void MapToOdomRepublisher::setTransformTolerance(double seconds) {
@@ -58,15 +61,34 @@ std::size_t MapToOdomRepublisher::published() const {
   return published_;
 }
 
-void MapToOdomRepublisher::onTimer(const ros::TimerEvent&) {
-  const ros::Time now = ros::Time::now();
-  if (now.isZero()) return;  // simulated time has not started
-  if (hook_) hook_(now);
-  std::lock_guard<std::mutex> lock(mutex_);
-  const ros::Time stamp = std::max(now, scan_stamp_) + ros::Duration(options_.transform_tolerance);
-  // Between updates, only a later stamp is news (and tf2 refuses a repeated one).
-  if (stamp <= last_stamp_) return;
-  publishLocked(stamp);
+void MapToOdomRepublisher::run() {
+  std::unique_lock<std::mutex> lock(mutex_);
+  ros::Time next_due;
+  while (!stop_) {
+    const ros::Duration period(1.0 / options_.rate);
+    const ros::Time now = ros::Time::now();
+    if (!now.isZero()) {  // zero: simulated time has not started
+      // The first tick, or time went back (a bag restarted): start again now.
+      if (next_due.isZero() || now + period < next_due) next_due = now;
+      if (now >= next_due) {
+        next_due += period;
+        if (next_due <= now) next_due = now + period;  // late by more than a period
+        lock.unlock();
+        if (hook_) hook_(now);
+        lock.lock();
+        if (stop_) break;
+        const ros::Time stamp =
+            std::max(now, scan_stamp_) + ros::Duration(options_.transform_tolerance);
+        // Between updates, only a later stamp is news (and tf2 refuses a repeated one).
+        if (stamp > last_stamp_) publishLocked(stamp);
+      }
+    }
+    double wait = 0.001;
+    if (!ros::Time::isSimTime() && !now.isZero()) {
+      wait = std::clamp((next_due - ros::Time::now()).toSec(), 0.0005, 0.1);
+    }
+    wake_.wait_for(lock, std::chrono::duration<double>(wait));
+  }
 }
 
 bool MapToOdomRepublisher::publishLocked(ros::Time stamp) {

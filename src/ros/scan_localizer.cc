@@ -174,7 +174,7 @@ geometry_msgs::PoseArray ScanLocalizer::particleCloud(const ros::Time& stamp) co
 }
 
 geometry_msgs::PoseArray ScanLocalizer::particleCloud(const ros::Time& stamp,
-                                                     std::size_t max_poses) const {
+                                                      std::size_t max_poses) const {
   geometry_msgs::PoseArray msg;
   msg.header.stamp = stamp;
   msg.header.frame_id = config_.global_frame;

@@ -19,10 +19,9 @@ void add(diagnostic_msgs::DiagnosticStatus* status, const std::string& key,
 
 void addMs(diagnostic_msgs::DiagnosticStatus* status, const std::string& prefix,
            const RollingPercentiles& r) {
-  for (const auto& [suffix, value] :
-       {std::pair<const char*, double>{"_p50_ms", r.percentile(0.5)},
-        std::pair<const char*, double>{"_p95_ms", r.percentile(0.95)},
-        std::pair<const char*, double>{"_max_ms", r.max()}}) {
+  for (const auto& [suffix, value] : {std::pair<const char*, double>{"_p50_ms", r.percentile(0.5)},
+                                      std::pair<const char*, double>{"_p95_ms", r.percentile(0.95)},
+                                      std::pair<const char*, double>{"_max_ms", r.max()}}) {
     std::ostringstream text;
     text.precision(1);
     text << std::fixed << value * 1e3;
@@ -32,7 +31,8 @@ void addMs(diagnostic_msgs::DiagnosticStatus* status, const std::string& prefix,
 
 }  // namespace
 
-RollingPercentiles::RollingPercentiles(std::size_t window) : window_(std::max<std::size_t>(1, window)) {}
+RollingPercentiles::RollingPercentiles(std::size_t window)
+    : window_(std::max<std::size_t>(1, window)) {}
 
 void RollingPercentiles::add(double value) {
   values_.push_back(value);

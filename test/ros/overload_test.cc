@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <boost/make_shared.hpp>
-
 #include <map>
 #include <thread>
 
@@ -103,19 +102,21 @@ TEST(UpdateTimeGovernor, CapsTheCountToTheBudgetAndFollowsTheLoad) {
   UpdateTimeGovernorOptions o;
   o.max_update_time = 0.02;
   UpdateTimeGovernor g(o);
-  // 1 000 000 particles in 160 ms: 160 ns each; 70 % of 20 ms is 87 500.
-  EXPECT_NEAR(static_cast<double>(g.addUpdate(1000000, 0.16)), 87500.0, 1.0);
+  // 1 000 000 particles in 160 ms: 160 ns each; 60 % of 20 ms is 75 000.
+  EXPECT_NEAR(static_cast<double>(g.addUpdate(1000000, 0.16)), 75000.0, 1.0);
   // Twice as slow (another process took a core): halved at once.
-  EXPECT_NEAR(static_cast<double>(g.addUpdate(87500, 0.028)), 43750.0, 1.0);
+  EXPECT_NEAR(static_cast<double>(g.addUpdate(75000, 0.024)), 37500.0, 1.0);
   // The CPU is free again: the cap grows back, 25 % per update at most.
   std::size_t cap = g.cap();
-  for (int i = 0; i < 50; ++i) {
+  for (int i = 0; i < 40; ++i) {
     const std::size_t next = g.addUpdate(cap, cap * 160e-9);
     EXPECT_LE(next, static_cast<std::size_t>(1.25 * cap) + 1);
     cap = next;
   }
-  EXPECT_NEAR(static_cast<double>(cap), 87500.0, 1000.0);
-  // Never below min_cap, whatever an update costs.
+  EXPECT_NEAR(static_cast<double>(cap), 75000.0, 1000.0);
+  // A single slow update is an outlier of the window's p95 (its second
+  // largest of 20); two of them are a new load. Never below min_cap.
+  EXPECT_NEAR(static_cast<double>(g.addUpdate(100, 10.0)), 75000.0, 1000.0);
   EXPECT_EQ(g.addUpdate(100, 10.0), o.min_cap);
   // Nonsense measurements change nothing.
   EXPECT_EQ(g.addUpdate(0, 0.01), o.min_cap);

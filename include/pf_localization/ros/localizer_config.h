@@ -37,8 +37,8 @@ struct LocalizerConfig {
   // s an update may take (wall, p95): when > 0 the particle count is capped
   // so that it does (UpdateTimeGovernor); <= 0: off, max_particles alone.
   double max_update_time = 0.0;
-  double save_pose_rate = 0.5;     // Hz the estimate is saved to ~initial_pose_*; <= 0: never
-  bool first_map_only = false;     // keep the first map; ignore later ones on the map topic
+  double save_pose_rate = 0.5;  // Hz the estimate is saved to ~initial_pose_*; <= 0: never
+  bool first_map_only = false;  // keep the first map; ignore later ones on the map topic
 };
 
 /// What readConfig has to tell besides errors: amcl parameters that are

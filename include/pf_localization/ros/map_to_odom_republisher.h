@@ -1,21 +1,24 @@
-// map -> odom on /tf from its own thread: published after every filter update
-// and republished at tf_publish_rate by a timer on a callback queue of its
-// own, served by a spinner thread of its own. A filter update (80 ms for
-// 500 000 particles) or anything else on the node's main spinner therefore
-// never delays it (issue 15: under load the timer used to wait behind the
-// filter, and tf users downstream saw 8 s gaps). It only ever touches the
-// latest transform handed to it, under its own mutex, never the filter.
+// map -> odom on /tf from a thread of its own: published after every filter
+// update and republished at tf_publish_rate in between. A filter update
+// (80 ms for 500 000 particles) or anything else on the node's spinner
+// therefore never delays it (issue 15: under load the ros::Timer used to wait
+// behind the filter on the one spinner, and tf users downstream saw 8 s
+// gaps). It only ever touches the latest transform handed to it, under its
+// own mutex, never the filter. Its own loop rather than a ros::Timer on a
+// callback queue of its own: that would take two thread hops (roscpp's timer
+// thread, then the queue's spinner) per tick, each a chance to be descheduled
+// on a loaded computer.
 #pragma once
 
 #include <geometry_msgs/TransformStamped.h>
-#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <tf2_ros/transform_broadcaster.h>
 
+#include <condition_variable>
 #include <functional>
-#include <memory>
 #include <mutex>
 #include <optional>
+#include <thread>
 
 namespace pf_ros {
 
@@ -32,9 +35,10 @@ class MapToOdomRepublisher {
   /// simulated time jumped back).
   using TickHook = std::function<void(const ros::Time& now)>;
 
-  /// Starts the timer and its thread at once (with nothing to publish yet).
-  MapToOdomRepublisher(const ros::NodeHandle& nh, const MapToOdomRepublisherOptions& options,
-                       TickHook hook = {});
+  explicit MapToOdomRepublisher(const MapToOdomRepublisherOptions& options, TickHook hook = {});
+
+  /// Starts the thread (once; the hook may be called from then on).
+  void start();
   ~MapToOdomRepublisher();
   MapToOdomRepublisher(const MapToOdomRepublisher&) = delete;
   MapToOdomRepublisher& operator=(const MapToOdomRepublisher&) = delete;
@@ -58,21 +62,22 @@ class MapToOdomRepublisher {
   std::size_t published() const;
 
  private:
-  void onTimer(const ros::TimerEvent&);
-  // Publishes the stored transform stamped at least `stamp`; mutex_ held.
+  // The thread: under simulated time it polls the clock every ms of wall
+  // time (as roscpp's timers do); under wall time it sleeps until due.
+  void run();
+  // Publishes the stored transform stamped `stamp`; mutex_ held.
   bool publishLocked(ros::Time stamp);
 
   MapToOdomRepublisherOptions options_;
   TickHook hook_;
-  ros::CallbackQueue queue_;
-  ros::NodeHandle nh_;
   tf2_ros::TransformBroadcaster broadcaster_;
   mutable std::mutex mutex_;
+  std::condition_variable wake_;
+  bool stop_ = false;
   std::optional<geometry_msgs::TransformStamped> transform_;
   ros::Time scan_stamp_, last_stamp_;
   std::size_t published_ = 0;
-  ros::Timer timer_;
-  std::unique_ptr<ros::AsyncSpinner> spinner_;
+  std::thread thread_;
 };
 
 }  // namespace pf_ros
