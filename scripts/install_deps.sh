@@ -9,6 +9,8 @@ set -euo pipefail
 packages=(
   # build tools
   build-essential cmake catkin catkin-lint python3-catkin-pkg clang-format
+  # scripts/make_deb.sh: dpkg-shlibdeps, dpkg-architecture (build-essential pulls it in too)
+  dpkg-dev
   # `catkin build` (catkin_tools; Debian calls it catkin-tools, not python3-catkin-tools)
   catkin-tools
   # ROS 1 core, messages and tools
@@ -31,6 +33,9 @@ packages=(
   python3-tf2-ros
   # evaluation reports
   python3-numpy python3-matplotlib python3-pil python3-yaml
+  # pf_tune: Optuna (its parameter-importance plot needs scikit-learn), Dask's distributed
+  # scheduler and workers, scipy's distance transform, the progress bar; psutil for its tests
+  python3-optuna python3-sklearn python3-distributed python3-scipy python3-tqdm python3-psutil
   # rviz test (scripts/rviz_click_test.sh): rviz under a virtual X server,
   # driven by xdotool, its window found by xwininfo, screenshots by import
   rviz xvfb xdotool x11-utils imagemagick

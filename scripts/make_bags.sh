@@ -24,7 +24,8 @@ bags="tracking  building  1
       kidnap    building  3
       small     small     4
       reverse   building  5     --unsigned-odometry
-      crowd     building  6"
+      crowd     building  6
+      sparse    building  7     --scan-period 2"
 
 check=false
 case "${1:-}" in

@@ -2,7 +2,8 @@
 # Installs the dependencies, builds the package and runs every test: the
 # GoogleTest unit tests, the rostest integration tests on the bundled bags,
 # the catkin checks (catkin_lint, rosrun and bag_demo.launch from the devel
-# and the install space: scripts/space_checks.bash), the Python unit tests,
+# and the install space: scripts/space_checks.bash), the Debian package
+# (scripts/make_deb.sh: its contents, and the demo from it unpacked), the Python unit tests,
 # the source checks (clang-format, a ROS-free core) and
 # the unit tests once more under AddressSanitizer + UndefinedBehaviorSanitizer.
 # Ends with one line "N passed, N failed"; exits non-zero when anything failed
@@ -58,6 +59,21 @@ check "rosrun pf_evaluate from the devel space: no prompt, no loop" pf_check_ros
 check "catkin_make install" install_space
 check "rosrun pf_evaluate from the install space: no prompt, no loop" pf_check_rosrun "$ws/install/setup.bash"
 check "bag_demo.launch from the install space alone: pf_node publishes pf_pose" pf_check_install_demo "$ws"
+
+# --- The Debian package (scripts/make_deb.sh) -------------------------------------
+# Built in $ws/build_deb (kept: the next run recompiles only what changed),
+# written to $ws/deb; read, then unpacked with dpkg -x into a temporary root
+# and run from there (installing it would need root and change /usr).
+make_deb() {
+  rm -rf "$ws/deb"
+  bash scripts/make_deb.sh --out "$ws/deb" --build-dir "$ws/build_deb" >"$ws/make_deb.log" 2>&1 && return 0
+  tail -n 30 "$ws/make_deb.log"
+  return 1
+}
+check "make_deb.sh builds ros-pf-localization_VERSION_ARCH.deb" make_deb
+deb=$(tail -n 1 "$ws/make_deb.log" 2>/dev/null)
+check "the .deb: fields, files under /usr, Depends cover its libraries and nodes" pf_check_deb "$deb" package.xml
+check "bag_demo.launch from the .deb unpacked with dpkg -x: pf_node publishes pf_pose" pf_check_deb_demo "$deb"
 
 # --- Python unit tests (pf_evaluate's metrics) ------------------------------
 if [ -d test/python ]; then

@@ -3,7 +3,7 @@
 //
 //   pf_simulator --map maps/building.yaml --path bags/tracking.path
 //                --seed 1 --out bags/tracking.bag [--compression bz2|lz4|none]
-//                [--odom-error K] [--unsigned-odometry] [--no-people]
+//                [--odom-error K] [--unsigned-odometry] [--no-people] [--scan-period S]
 //                [--start-time SECONDS]
 //
 // Topics, as on the real robot (see /work/shared/data/neato_ac109_1):
@@ -48,7 +48,7 @@ constexpr int64_t kTickNs = 10'000'000;   // 100 Hz simulation step
 constexpr double kTick = kTickNs * 1e-9;  // s
 constexpr int kOdomEvery = 5;             // ticks: 20 Hz /odom and /tf
 constexpr int kTruthEvery = 10;           // 10 Hz /ground_truth
-constexpr int kScanEvery = 20;            // 5 Hz /scan ...
+constexpr int kScanEvery = 20;            // 5 Hz /scan by default ...
 constexpr int kScanOffset = 7;            // ... 70 ms after an odometry tick
 constexpr int kBeams = 360;
 constexpr double kRobotRadius = 0.17;         // m, a Neato is 0.33 m across
@@ -63,6 +63,9 @@ struct Options {
   bool unsigned_odometry = false;
   bool people = true;
   double start_time = 1000.0;
+  // Ticks between scans: the Neato's 5 Hz, or a sparse log's period (the
+  // CARMEN logs keep one scan every few seconds).
+  int scan_every = kScanEvery;
 };
 
 [[noreturn]] void usage(const std::string& problem) {
@@ -72,7 +75,8 @@ struct Options {
                "                    [--odom-error K]   scale the odometry errors (0: perfect)\n"
                "                    [--unsigned-odometry]  log reversing as driving forwards\n"
                "                    [--no-people]      ignore the script's 'person' lines\n"
-               "                    [--start-time S]   first stamp, s (default 1000)\n";
+               "                    [--start-time S]   first stamp, s (default 1000)\n"
+               "                    [--scan-period S]  s between scans (default 0.2: 5 Hz)\n";
   std::exit(2);
 }
 
@@ -113,6 +117,12 @@ Options parseOptions(int argc, char** argv) {
       o.unsigned_odometry = true;
     } else if (arg == "--no-people") {
       o.people = false;
+    } else if (arg == "--scan-period") {
+      const double period = number();
+      o.scan_every = static_cast<int>(std::lround(period / kTick));
+      if (o.scan_every < 1 || std::fabs(o.scan_every * kTick - period) > 1e-9 || period > 60.0) {
+        usage("--scan-period must be a multiple of 0.01 s, at most 60 s");
+      }
     } else if (arg == "--start-time") {
       o.start_time = number();
       if (o.start_time <= 0.0) usage("--start-time must be positive");
@@ -201,7 +211,7 @@ double simulate(const Options& o, const pf::OccupancyGrid& map, const pf::sim::P
       truth.pose = pf_ros::toPoseMsg(robot.truePose());
       bag->write("/ground_truth", stamp, truth);
     }
-    if (tick % kScanEvery == kScanOffset) {
+    if (tick % o.scan_every == kScanOffset % o.scan_every) {
       const Pose2 sensor = pf::compose(robot.truePose(), kLaserMount);
       const double t = tick * kTick;
       std::vector<double> ideal(kBeams);
@@ -222,8 +232,8 @@ double simulate(const Options& o, const pf::OccupancyGrid& map, const pf::sim::P
       scan.angle_min = 0.0;
       scan.angle_increment = 2.0 * M_PI / kBeams;
       scan.angle_max = (kBeams - 1) * scan.angle_increment;
-      scan.time_increment = 0.0;  // every beam is cast from the pose at the stamp
-      scan.scan_time = kScanEvery * kTick;
+      scan.time_increment = 0.0;            // every beam is cast from the pose at the stamp
+      scan.scan_time = kScanEvery * kTick;  // one turn of the laser, however sparse the log
       scan.range_min = laser.range_min;
       scan.range_max = laser.range_max;
       scan.ranges = pf::sim::neatoReadings(ideal, laser, &laser_random);

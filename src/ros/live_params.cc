@@ -102,6 +102,10 @@ const std::vector<LiveParam>& liveParams() {
        field<double>([](LocalizerConfig& c) -> double& { return c.filter.update_min_d; })},
       {"update_min_a",
        field<double>([](LocalizerConfig& c) -> double& { return c.filter.update_min_a; })},
+      {"update_fit_drop",
+       field<double>([](LocalizerConfig& c) -> double& { return c.filter.update_fit_drop; })},
+      {"update_fit_distance",
+       field<double>([](LocalizerConfig& c) -> double& { return c.filter.update_fit_distance; })},
       {"resample_ess_fraction",
        field<double>([](LocalizerConfig& c) -> double& { return c.filter.resample_ess_fraction; })},
       {"tempering_ess_fraction", field<double>([](LocalizerConfig& c) -> double& {

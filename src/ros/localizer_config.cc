@@ -263,6 +263,8 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
   p.get("kld_bin_yaw", &f.kld.bin_yaw);
   p.get("update_min_d", &f.update_min_d);
   p.get("update_min_a", &f.update_min_a);
+  p.get("update_fit_drop", &f.update_fit_drop);
+  p.get("update_fit_distance", &f.update_fit_distance);
   p.get("odom_jump_limit", &f.odom_jump_limit);
   p.get("resample_ess_fraction", &f.resample_ess_fraction);
   p.get("tempering_ess_fraction", &f.tempering_ess_fraction);

@@ -374,6 +374,8 @@ TEST(BadParams, EachInvalidParameterThrowsNamingIt) {
       {"kld_bin_yaw", [](ParticleFilterParams* p) { p->kld.bin_yaw = -0.1; }},
       {"update_min_d", [](ParticleFilterParams* p) { p->update_min_d = -0.1; }},
       {"update_min_a", [](ParticleFilterParams* p) { p->update_min_a = kNaN; }},
+      {"update_fit_drop", [](ParticleFilterParams* p) { p->update_fit_drop = 1.5; }},
+      {"update_fit_distance", [](ParticleFilterParams* p) { p->update_fit_distance = 0.0; }},
       {"resample_ess_fraction", [](ParticleFilterParams* p) { p->resample_ess_fraction = 0.0; }},
       {"resample_ess_fraction", [](ParticleFilterParams* p) { p->resample_ess_fraction = 1.5; }},
       {"laser_sigma_hit", [](ParticleFilterParams* p) { p->sensor.sigma_hit = 0.0; }},

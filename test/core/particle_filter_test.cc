@@ -343,7 +343,12 @@ TEST(ParticleFilterUpdate, SkipsBadScansAndBadOdometry) {
 
 TEST(ParticleFilterUpdate, RunsOnTheFirstScanThenOnlyAfterMotion) {
   const OccupancyGrid grid = trackingRoom();
-  ParticleFilter filter(baseParams());  // update_min_d 0.2 m, update_min_a pi/6
+  ParticleFilterParams params = baseParams();  // update_min_d 0.2 m, update_min_a pi/6
+  // The odometry below moves while the scan stays: only the thresholds are
+  // under test here, not the check that the scan still fits (see
+  // AScanThatStopsFittingThePredictedPoseUpdatesAtOnce).
+  params.update_fit_drop = 0.0;
+  ParticleFilter filter(params);
   filter.setMap(grid);
   filter.initializeGaussian({1.0, 1.5, 0.0}, diag(0.1, 0.1, 0.1));
   const LaserScan scan = simulateScan(grid, {1.0, 1.5, 0.0});
@@ -545,6 +550,36 @@ TEST(ParticleFilterUpdate, RecoveryGuessesDoNotTemperTheNextScanAway) {
   EXPECT_NEAR(0.99 * prior_ess, next.ess, 0.01 * prior_ess);  // the bisection's target
 }
 
+// The tempering exponent of the second update of a filter started from a
+// Gaussian of std `spread` m at the truth, tempering to keep 0.9 of the
+// effective particles while uncertain (and none while localized).
+double secondTempering(double spread, Confidence* after_first) {
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilterParams params = baseParams();
+  params.kld.min_particles = params.kld.max_particles = 1000;
+  params.tempering_ess_fraction = 0.0;
+  params.tempering_ess_fraction_uncertain = 0.9;
+  params.confidence.localized_std_xy = 0.3;
+  ParticleFilter filter(params);
+  filter.setMap(grid);
+  const Pose2 truth{1.5, 1.5, 0.0};
+  filter.initializeGaussian(truth, diag(spread, spread, 0.02));
+  EXPECT_TRUE(filter.update({0.0, 0.0, 0.0}, simulateScan(grid, truth)).updated);
+  *after_first = filter.confidence();
+  filter.requestNoMotionUpdate();
+  return filter.update({0.0, 0.0, 0.0}, simulateScan(grid, truth)).tempering;
+}
+
+TEST(ParticleFilterUpdate, AWideCloudWhoseBeamsFitIsNotTempered) {
+  // Wide (0.6 m) but one cluster whose estimate's beams fit: uncertain for
+  // its spread alone, which caution would only preserve.
+  Confidence c;
+  EXPECT_EQ(1.0, secondTempering(0.6, &c));
+  EXPECT_EQ(LocalizationState::kUncertain, c.state);
+  EXPECT_EQ(0, c.rivals);
+  EXPECT_NE(std::string::npos, c.reason.find("spread")) << c.reason;
+}
+
 // The share of particles the filter gives to odometry faults after each of
 // `steps` updates in which the odometry reports 0.3 m forwards along x and the
 // scans are taken at `truth_step` metres per update from `start`.
@@ -612,19 +647,55 @@ TEST(ParticleFilterUpdate, SuspectOdometryUpdatesOnEveryScan) {
   EXPECT_TRUE(updatesOnAShortStepAfter(-0.3));
 }
 
-// The number of updates with bad scans before recovery injects, for a filter
-// whose thresholds keep it "localized" whatever the fit.
-int updatesBeforeInjection(int patience) {
+// Whether the filter updates on a scan taken after the robot moved
+// `truth_step` m forward while the odometry counted 0.15 m (below
+// update_min_d 0.2 m).
+UpdateReport shortStepUpdate(double truth_step, double fit_drop) {
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilterParams params = exactParams();
+  params.update_fit_drop = fit_drop;
+  params.update_fit_distance = 0.1;
+  ParticleFilter filter(params);
+  filter.setMap(grid);
+  const Pose2 start{1.5, 1.5, 0.0};
+  filter.initializeGaussian(start, Eigen::Matrix3d::Zero());
+  EXPECT_TRUE(filter.update({0.0, 0.0, 0.0}, simulateScan(grid, start)).updated);
+  return filter.update({0.15, 0.0, 0.0}, simulateScan(grid, {start.x + truth_step, start.y, 0.0}));
+}
+
+TEST(ParticleFilterUpdate, AScanThatStopsFittingThePredictedPoseUpdatesAtOnce) {
+  // The odometry was right: the scan fits where it says, so the filter waits
+  // for update_min_d.
+  UpdateReport r = shortStepUpdate(0.15, 0.25);
+  EXPECT_FALSE(r.updated);
+  EXPECT_FALSE(r.fit_dropped);
+  // The robot reversed while the encoders counted forwards: at the predicted
+  // pose, 0.3 m from the truth, most beams miss the walls by more than 0.1 m.
+  r = shortStepUpdate(-0.15, 0.25);
+  EXPECT_TRUE(r.updated) << r.skip_reason;
+  EXPECT_TRUE(r.fit_dropped);
+  // The robot stalled: 0.15 m off, still a clear drop.
+  EXPECT_TRUE(shortStepUpdate(0.0, 0.25).fit_dropped);
+  // A drop of 1 can never happen: the check is off in effect, as with 0.
+  EXPECT_FALSE(shortStepUpdate(-0.15, 1.0).updated);
+  EXPECT_FALSE(shortStepUpdate(-0.15, 0.0).updated);
+}
+
+// The number of updates with bad scans before recovery injects (-1: none in
+// 30), for a filter whose thresholds keep it in `state` whatever the fit.
+int updatesBeforeInjection(int patience, LocalizationState state = LocalizationState::kUncertain) {
   const OccupancyGrid grid = trackingRoom();
   ParticleFilterParams params = recoveryParams();
   params.recovery.patience = patience;
   params.confidence.lost_hit_fraction = params.confidence.localized_hit_fraction = 0.0;
-  params.confidence.localized_std_xy = params.confidence.localized_std_yaw = 100.0;
+  // Uncertain: no cloud is ever compact enough. Localized: every cloud is.
+  const double std_limit = state == LocalizationState::kLocalized ? 100.0 : 1e-9;
+  params.confidence.localized_std_xy = params.confidence.localized_std_yaw = std_limit;
   ParticleFilter filter(params);
   trackFiveScans(grid, &filter);
   for (int k = 1; k <= 30; ++k) {
     const UpdateReport r = filter.update({0.0, 0.0, 0.0}, simulateScan(grid, kMoved));
-    EXPECT_EQ(LocalizationState::kLocalized, filter.confidence().state);
+    EXPECT_EQ(state, filter.confidence().state);
     if (r.injected > 0) return k;
   }
   return -1;
@@ -637,6 +708,14 @@ TEST(ParticleFilterUpdate, AFilterThatIsNotLostWaitsOutShortDipsBeforeInjecting)
   EXPECT_EQ(2, updatesBeforeInjection(0));
   EXPECT_EQ(5, updatesBeforeInjection(3));
   EXPECT_EQ(12, updatesBeforeInjection(10));
+}
+
+TEST(ParticleFilterUpdate, AFilterThatIsLocalizedNeverInjects) {
+  // The same dip, while the estimate's beams fit the map and the cloud is
+  // compact: a poor map there, not a kidnapping (fr079 jumped 28 m from
+  // random particles injected while 87 % of the beams fitted).
+  EXPECT_EQ(-1, updatesBeforeInjection(0, LocalizationState::kLocalized));
+  EXPECT_EQ(-1, updatesBeforeInjection(3, LocalizationState::kLocalized));
 }
 
 TEST(ParticleFilterUpdate, MotionIsAppliedFromTheLastUpdateOnly) {

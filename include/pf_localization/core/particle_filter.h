@@ -11,7 +11,9 @@
 // The filter runs an update only after the robot has moved update_min_d or
 // turned update_min_a since the last one, and on the first scan after an
 // initialisation: a robot standing still would otherwise keep multiplying
-// the same evidence into its weights and grow falsely confident.
+// the same evidence into its weights and grow falsely confident. It updates
+// sooner when a scan no longer fits where the odometry says the robot is
+// (update_fit_drop): that is when waiting for more odometry costs most.
 //
 // Deterministic: the same parameters (seed included) and the same calls give
 // the same particles, bit for bit.
@@ -87,9 +89,20 @@ enum class LaserModelType {
 };
 
 struct ParticleFilterParams {
-  KldParams kld;                       // particle count bounds and KLD-sampling
-  double update_min_d = 0.2;           // m of travel between updates
-  double update_min_a = M_PI / 6.0;    // rad of rotation between updates
+  KldParams kld;                     // particle count bounds and KLD-sampling
+  double update_min_d = 0.2;         // m of travel between updates
+  double update_min_a = M_PI / 6.0;  // rad of rotation between updates
+  // Between those updates every scan is checked, at the pose the odometry
+  // predicts, for the share of its beams that end within update_fit_distance
+  // of a mapped obstacle (one pose: the cost of one particle). When that
+  // share falls more than update_fit_drop below the last update's, the
+  // odometry has gone wrong (a robot reversing while the encoders count
+  // forwards, a wheel slipping in a turn) and the filter updates now rather
+  // than after update_min_d of motion it cannot trust. The distance is
+  // tight (a few map cells): a 0.3 m error barely moves the share within
+  // 0.4 m, but halves it within 0.1 m. 0 disables. [0, 1]
+  double update_fit_drop = 0.2;
+  double update_fit_distance = 0.1;    // m, > 0
   double odom_jump_limit = 5.0;        // m; a longer odometry step between updates is a fault
   double resample_ess_fraction = 0.5;  // resample when ESS < this * N (0..1]
   // When one scan would leave fewer than this fraction of the effective
@@ -98,7 +111,9 @@ struct ParticleFilterParams {
   // global initialisation, then narrows it over several scans instead of
   // collapsing it onto one lucky particle. 0 disables. [0, 1]
   double tempering_ess_fraction = 0.02;
-  // The same while the filter is not localized (see Confidence). [0, 1]
+  // The same while the filter is not localized (see Confidence) because of
+  // rivals or a poor fit; a cloud that is only wide, with its beams fitting,
+  // keeps tempering_ess_fraction. [0, 1]
   double tempering_ess_fraction_uncertain = 0.1;
   uint64_t seed = 0;
   OdometryMotionParams motion;
@@ -144,6 +159,9 @@ struct UpdateReport {
   double tempering = 1.0;             // exponent applied to this scan's likelihood (1: none)
   bool expanded = false;              // the survivors were spread by expansion resetting
   double fault_fraction = 0.0;        // share of particles to assume an odometry fault next step
+  // The update came before update_min_d / update_min_a because the scan no
+  // longer fitted at the pose the odometry predicted (update_fit_drop).
+  bool fit_dropped = false;
   // The scan fit of the estimate (when refine_estimate is on): accepted, or
   // the reason it was not, as in refinement.rejection.
   ScanRefinement refinement;
@@ -183,8 +201,9 @@ class ParticleFilter {
   bool isInitialized() const { return !particles_.empty(); }
 
   /// Feeds the odometry pose at the scan's time and the scan. Runs a filter
-  /// update when the robot moved enough, on the first scan after an
-  /// initialisation, or after requestNoMotionUpdate().
+  /// update when the robot moved enough, when the scan stopped fitting the
+  /// pose the odometry predicts (update_fit_drop), on the first scan after
+  /// an initialisation, or after requestNoMotionUpdate().
   UpdateReport update(const Pose2& odom, const LaserScan& scan);
 
   /// The next update() runs even without motion.
@@ -205,6 +224,10 @@ class ParticleFilter {
   void weigh(const PreparedScan& scan, UpdateReport* report);
   void resample(UpdateReport* report);
   void adaptFaultFraction();
+  // The scan, prepared, when it fits the pose the odometry predicts
+  // `since_update` after the last update's estimate clearly worse than that
+  // update's scan fitted its estimate (update_fit_drop); nothing otherwise.
+  std::optional<PreparedScan> fitDropped(const LaserScan& scan, const Pose2& since_update) const;
   void refineEstimate(const LaserScan& scan, UpdateReport* report);
   void refineBetweenUpdates(const Pose2& odom, const LaserScan& scan, UpdateReport* report);
   bool refinedIsCurrent() const;
@@ -231,6 +254,9 @@ class ParticleFilter {
   };
   std::optional<RefinedMapToOdom> refined_;
   bool force_update_ = false;
+  // The share of the last update's beams that ended within
+  // update_fit_distance of an obstacle at its estimate (see update_fit_drop).
+  double fit_at_update_ = 0.0;
   bool restart_ = false;  // the next update follows an initialisation
   bool has_estimate_ = false;
   double w_slow_ = 0.0;
