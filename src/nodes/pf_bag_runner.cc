@@ -18,6 +18,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <set>
 #include <sstream>
@@ -28,6 +29,7 @@
 #include "pf_localization/ros/conversions.h"
 #include "pf_localization/ros/localizer_config.h"
 #include "pf_localization/ros/scan_localizer.h"
+#include "pf_localization/ros/update_timing.h"
 
 namespace {
 
@@ -231,6 +233,8 @@ int main(int argc, char** argv) {
   std::map<std::string, int> errors;
   std::size_t scans = 0, written = 0, updates = 0;
   double cpu_total = 0.0;
+  // CPU time of every update, for the percentiles in the summary.
+  pf_ros::RollingPercentiles update_cpu(std::numeric_limits<std::size_t>::max());
   double first_stamp = -1.0;
 
   auto process = [&](const sensor_msgs::LaserScan& scan) {
@@ -247,6 +251,7 @@ int main(int argc, char** argv) {
     }
     if (r.report.updated) {
       ++updates;
+      update_cpu.add(cpu);
       if (log) {
         const auto& est = localizer.filter().estimate();
         const pf::Confidence& conf = localizer.filter().confidence();
@@ -314,6 +319,11 @@ int main(int argc, char** argv) {
   std::cerr << "pf_bag_runner: " << scans << " scans, " << updates << " filter updates, " << written
             << " poses written to " << opt.out << "; CPU " << std::setprecision(3) << cpu_total
             << " s (" << (updates ? 1e3 * cpu_total / updates : 0.0) << " ms per update)\n";
+  if (updates > 0) {
+    std::cerr << "pf_bag_runner: CPU per update: p50 " << 1e3 * update_cpu.percentile(0.5)
+              << " ms, p95 " << 1e3 * update_cpu.percentile(0.95) << " ms, max "
+              << 1e3 * update_cpu.max() << " ms\n";
+  }
   for (const auto& e : errors) {
     std::cerr << "pf_bag_runner: " << e.second << " scans not used: " << e.first << "...\n";
   }

@@ -8,6 +8,13 @@
 // (topics, services, parameter names, the pose saved to the parameter
 // server, dynamic_reconfigure through pf_ros::ReconfigureServer), so that it
 // can replace amcl in an existing bringup.
+//
+// Threads (README.md, "Under overload"): the main spinner moves messages and
+// serves the services; scans go through a one-scan LatestScanSlot to a filter
+// thread of their own, so that under overload the newest scan wins and
+// odometry and tf keep being consumed; map -> odom is republished by a
+// MapToOdomRepublisher on a third thread that never waits for the filter.
+// filter_mutex_ protects the filter and everything that goes with it.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
@@ -18,60 +25,39 @@
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
 #include <std_srvs/Empty.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/message_filter.h>
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <csignal>
-#include <map>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <utility>
 
 #include "pf_localization/ros/conversions.h"
 #include "pf_localization/ros/diagnostics.h"
+#include "pf_localization/ros/latest_scan_slot.h"
+#include "pf_localization/ros/limited_log.h"
 #include "pf_localization/ros/live_params.h"
 #include "pf_localization/ros/localizer_config.h"
+#include "pf_localization/ros/map_to_odom_republisher.h"
 #include "pf_localization/ros/reconfigure_server.h"
 #include "pf_localization/ros/scan_localizer.h"
+#include "pf_localization/ros/update_time_governor.h"
+#include "pf_localization/ros/update_timing.h"
 
 namespace pf_ros {
 namespace {
-
-// Bad input tends to repeat on every message; one line per kind and period
-// tells the user without drowning the log, and counts what it held back, so
-// that nothing is dropped silently. Wall time, so the limit also holds while a
-// bag is paused or replayed fast.
-class LimitedLog {
- public:
-  explicit LimitedLog(double period) : period_(period) {}
-
-  /// Whether a message of this kind is due now; if so, `suppressed` is how
-  /// many of its kind were held back since the last one logged.
-  bool due(const std::string& key, int* suppressed = nullptr) {
-    const ros::WallTime now = ros::WallTime::now();
-    Entry& e = entries_[key];
-    if (!e.last.isZero() && (now - e.last).toSec() < period_) {
-      ++e.suppressed;
-      return false;
-    }
-    if (suppressed) *suppressed = e.suppressed;
-    e = Entry{now, 0};
-    return true;
-  }
-
- private:
-  struct Entry {
-    ros::WallTime last;
-    int suppressed = 0;
-  };
-  double period_;
-  std::map<std::string, Entry> entries_;
-};
 
 std::string failureText(tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
   switch (reason) {
@@ -87,6 +73,10 @@ std::string failureText(tf2_ros::filter_failure_reasons::FilterFailureReason rea
 // s of odometry messages to wait for odom -> base on /tf before the odometry
 // topic is taken as the source instead.
 constexpr double kOdomSourceGrace = 0.5;
+
+// How much lower the filter thread's priority is than the rest of the node
+// (nice); see filterLoop().
+constexpr int kFilterNiceIncrement = 5;
 
 // s between two log lines about the same kind of bad input.
 constexpr double kLogPeriod = 5.0;
@@ -113,6 +103,7 @@ class PfNode {
         buffer_(ros::Duration(30.0)),
         listener_(buffer_),
         localizer_(config, &buffer_),
+        governor_(UpdateTimeGovernorOptions{config.max_update_time}),
         scan_sub_(nh_, "scan", 20),
         scan_filter_(scan_sub_, buffer_, config.odom_frame, 20, nh_) {
     scan_filter_.registerCallback(&PfNode::onScan, this);
@@ -138,8 +129,10 @@ class PfNode {
     nomotion_srv_ =
         nh_.advertiseService("request_nomotion_update", &PfNode::onNoMotionUpdate, this);
     set_map_srv_ = nh_.advertiseService("set_map", &PfNode::onSetMap, this);
-    tf_timer_ =
-        nh_.createTimer(ros::Duration(1.0 / config.tf_publish_rate), &PfNode::onTfTimer, this);
+    republisher_ = std::make_unique<MapToOdomRepublisher>(
+        MapToOdomRepublisherOptions{config.tf_publish_rate, config.transform_tolerance,
+                                    config.tf_broadcast},
+        [this](const ros::Time& now) { onTfTick(now); });
     if (config.save_pose_rate > 0.0) {
       save_timer_ = nh_.createTimer(ros::Duration(1.0 / config.save_pose_rate),
                                     [this](const ros::TimerEvent&) { savePose(); });
@@ -155,6 +148,13 @@ class PfNode {
     } else {
       ROS_INFO("pf_node: no initial pose given: global localization once a map arrives");
     }
+    republisher_->start();
+    filter_thread_ = std::thread([this] { filterLoop(); });
+  }
+
+  ~PfNode() {
+    slot_.close();
+    filter_thread_.join();
   }
 
  private:
@@ -166,21 +166,39 @@ class PfNode {
       }
       return;
     }
+    std::lock_guard<std::mutex> lock(filter_mutex_);
     installMap(*msg);
   }
 
   // The live parameters from ReconfigureServer: the filter's at its next
   // update, this node's own (tf and particlecloud rates, transform_tolerance) now.
   std::string reconfigure(const LocalizerConfig& next) {
+    std::lock_guard<std::mutex> lock(filter_mutex_);
     const std::string error = localizer_.reconfigure(next);
     if (!error.empty()) return error;
-    if (next.tf_publish_rate != config_.tf_publish_rate) {
-      tf_timer_.setPeriod(ros::Duration(1.0 / next.tf_publish_rate));
-    }
+    republisher_->setRate(next.tf_publish_rate);
+    republisher_->setTransformTolerance(next.transform_tolerance);
+    governor_.setMaxUpdateTime(next.max_update_time);
     copyLiveParams(next, &config_);
+    applyParticleCap(governor_.cap());
     return "";
   }
 
+  // filter_mutex_ held: max_update_time's cap on the particle count, under
+  // the configured max_particles (0: none, the configured bounds alone).
+  void applyParticleCap(std::size_t cap) {
+    pf::ParticleFilterParams p = localizer_.config().filter;
+    if (cap > 0 && cap < static_cast<std::size_t>(p.kld.max_particles)) {
+      p.kld.max_particles = static_cast<int>(cap);
+      p.kld.min_particles = std::min(p.kld.min_particles, p.kld.max_particles);
+    }
+    const pf::KldParams& now = localizer_.filter().params().kld;
+    if (now.max_particles == p.kld.max_particles && now.min_particles == p.kld.min_particles)
+      return;
+    localizer_.filter().setParams(p);
+  }
+
+  // filter_mutex_ held.
   bool installMap(const nav_msgs::OccupancyGrid& map) {
     const std::string error = localizer_.setMap(map);
     if (!error.empty()) {
@@ -191,6 +209,7 @@ class PfNode {
     ROS_INFO("pf_node: map %u x %u cells at %.3f m; %zu particles", map.info.width, map.info.height,
              map.info.resolution, localizer_.filter().particles().size());
     publishEstimate(map.header.stamp, true);
+    republisher_->set(localizer_.mapToOdom(ros::Time()), ros::Time());
     return true;
   }
 
@@ -227,10 +246,41 @@ class PfNode {
     }
   }
 
+  // On the main spinner, once tf has the scan's stamp: only hands the scan to
+  // the filter thread, so that this thread never waits for an update.
   void onScan(const sensor_msgs::LaserScanConstPtr& scan) {
-    if (fromBeforeTheJump(scan->header.stamp)) return;
-    if (timeJumpedBack(scan->header.stamp)) return;
-    const ScanResult result = localizer_.processScan(*scan);
+    if (!slot_.put(PendingScan{scan, ros::WallTime::now(), ros::Time::now()})) return;
+    const std::uint64_t dropped = slot_.dropped();
+    warn("overload",
+         "the filter cannot keep up: a scan waiting for it was dropped for a newer one (" +
+             std::to_string(dropped) +
+             " since start; see dropped_scans and latency_* in the diagnostics). Lower "
+             "max_particles, or set max_update_time");
+  }
+
+  // The filter thread: the newest waiting scan, one at a time.
+  void filterLoop() {
+    // The filter yields the CPU to this node's other threads (map -> odom,
+    // odometry and tf, the clock): a lower priority for this thread and
+    // the threads it starts (OpenMP's, with sensor_threads > 1). Raising
+    // the nice value needs no privilege; failing, it changes nothing.
+    const id_t tid = static_cast<id_t>(::syscall(SYS_gettid));
+    errno = 0;
+    const int nice = ::getpriority(PRIO_PROCESS, tid);
+    if (errno == 0) ::setpriority(PRIO_PROCESS, tid, std::min(19, nice + kFilterNiceIncrement));
+    while (ros::ok() && !slot_.closed()) {
+      if (auto pending = slot_.take(ros::WallDuration(0.1))) processScan(*pending);
+    }
+  }
+
+  void processScan(const PendingScan& pending) {
+    const sensor_msgs::LaserScan& scan = *pending.scan;
+    std::lock_guard<std::mutex> lock(filter_mutex_);
+    if (fromBeforeTheJump(scan.header.stamp)) return;
+    if (timeJumpedBack(scan.header.stamp)) return;
+    const ros::WallTime start = ros::WallTime::now();
+    const ScanResult result = localizer_.processScan(scan);
+    const double update_s = (ros::WallTime::now() - start).toSec();
     if (!result.error.empty()) {
       warn(result.error.substr(0, 24), result.error);
       return;
@@ -238,16 +288,20 @@ class PfNode {
     if (!result.warning.empty()) warn("scan inconsistent", result.warning);
     const pf::UpdateReport& r = result.report;
     last_odom_ = result.odom;
+    last_scan_stamp_ = scan.header.stamp;
+    // map -> odom first: tf users wait for it, nobody waits for the rest.
+    republisher_->set(localizer_.mapToOdom(ros::Time()), scan.header.stamp);
     if (r.updated) {
-      publishEstimate(scan->header.stamp, false);
-      publishConfidence(scan->header.stamp, r);
-      ROS_DEBUG("pf_node: update with %d beams, %zu particles, ESS %.0f%s", r.beams_used,
-                r.particles, r.ess, r.resampled ? ", resampled" : "");
+      timing_.addUpdate((ros::WallTime::now() - pending.arrival_wall).toSec(),
+                        (pending.arrival_clock - scan.header.stamp).toSec(), update_s);
+      if (governor_.enabled()) applyParticleCap(governor_.addUpdate(r.particles, update_s));
+      publishEstimate(scan.header.stamp, false);
+      publishConfidence(scan.header.stamp, r);
+      ROS_DEBUG("pf_node: update with %d beams, %zu particles, ESS %.0f%s in %.1f ms", r.beams_used,
+                r.particles, r.ess, r.resampled ? ", resampled" : "", update_s * 1e3);
     } else if (r.skip_reason.rfind("not moved", 0) != 0) {
       warn(r.skip_reason.substr(0, 16), "scan not used: " + r.skip_reason);
     }
-    last_scan_stamp_ = scan->header.stamp;
-    publishMapToOdom(scan->header.stamp + ros::Duration(config_.transform_tolerance));
   }
 
   // A scan older than the previous one by more than a second means time
@@ -268,7 +322,8 @@ class PfNode {
     const std::string error = localizer_.restart();
     if (!error.empty()) ROS_WARN("pf_node: %s", error.c_str());
     last_scan_stamp_ = ros::Time();
-    last_tf_stamp_ = ros::Time();
+    republisher_->reset();
+    republisher_->set(localizer_.mapToOdom(ros::Time()), ros::Time());
     return true;
   }
 
@@ -322,6 +377,7 @@ class PfNode {
 
   void onScanDropped(const sensor_msgs::LaserScanConstPtr& scan,
                      tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+    std::lock_guard<std::mutex> lock(filter_mutex_);
     // The first scans after a bag starts over often land here as older than
     // the buffer, which still holds the old timeline: the jump back is
     // detected on them too, so that the filter restarts on the first scan of
@@ -352,6 +408,7 @@ class PfNode {
     } else if (pose.header.frame_id != config_.global_frame) {
       if (!transformToGlobal(&pose)) return false;
     }
+    std::lock_guard<std::mutex> lock(filter_mutex_);
     const std::string error = localizer_.setInitialPose(pose);
     if (!error.empty()) {
       warn("initialpose", error);
@@ -361,6 +418,7 @@ class PfNode {
     ROS_INFO("pf_node: re-initialised at (%.3f, %.3f, %.3f) in %s", p.x, p.y, p.yaw,
              config_.global_frame.c_str());
     publishEstimate(pose.header.stamp, true);
+    republisher_->set(localizer_.mapToOdom(ros::Time()), ros::Time());
     return true;
   }
 
@@ -368,7 +426,12 @@ class PfNode {
   // to another floor). The map is installed even when first_map_only is set:
   // that guards against map topic updates, not against an explicit request.
   bool onSetMap(nav_msgs::SetMap::Request& req, nav_msgs::SetMap::Response& res) {
-    res.success = installMap(req.map) && applyInitialPose(req.initial_pose);
+    bool installed = false;
+    {
+      std::lock_guard<std::mutex> lock(filter_mutex_);
+      installed = installMap(req.map);
+    }
+    res.success = installed && applyInitialPose(req.initial_pose);
     return true;
   }
 
@@ -397,6 +460,7 @@ class PfNode {
   }
 
   bool onGlobalLocalization(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+    std::lock_guard<std::mutex> lock(filter_mutex_);
     const std::string error = localizer_.startGlobalLocalization();
     if (!error.empty()) {
       ROS_WARN("pf_node: %s", error.c_str());
@@ -405,23 +469,25 @@ class PfNode {
     ROS_INFO("pf_node: global localization: %zu particles over the free space",
              localizer_.filter().particles().size());
     publishEstimate(ros::Time::now(), true);
+    republisher_->set(localizer_.mapToOdom(ros::Time()), ros::Time());
     return true;
   }
 
   bool onNoMotionUpdate(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+    std::lock_guard<std::mutex> lock(filter_mutex_);
     localizer_.filter().requestNoMotionUpdate();
     return true;
   }
 
-  void onTfTimer(const ros::TimerEvent&) {
-    // Between scans, keep map -> odom fresh so no tf user has to extrapolate.
-    const ros::Time now = ros::Time::now();
-    if (now.isZero()) return;  // simulated time has not started
-    // Under simulated time the clock itself shows a bag starting over, often
-    // before any scan of the new timeline gets through tf. (It lags the
-    // messages a little, hence the wider tolerance.)
-    if (ros::Time::isSimTime()) timeJumpedBack(now, kSimClockLead);
-    publishMapToOdom(std::max(now, last_scan_stamp_) + ros::Duration(config_.transform_tolerance));
+  // On the republishing thread, before each timed map -> odom. Under
+  // simulated time the clock itself shows a bag starting over, often before
+  // any scan of the new timeline gets through tf. (It lags the messages a
+  // little, hence the wider tolerance.) Never waits for the filter: while an
+  // update runs, the check waits for the next tick.
+  void onTfTick(const ros::Time& now) {
+    if (!ros::Time::isSimTime()) return;
+    std::unique_lock<std::mutex> lock(filter_mutex_, std::try_to_lock);
+    if (lock.owns_lock()) timeJumpedBack(now, kSimClockLead);
   }
 
   void publishConfidence(const ros::Time& stamp, const pf::UpdateReport& report) {
@@ -430,6 +496,7 @@ class PfNode {
     array.header.stamp = stamp;
     array.status.push_back(
         toDiagnosticStatus(localizer_.filter(), report, name, reconfigure_->generation()));
+    timing_.addTo(&array.status.front(), slot_.dropped(), governor_.cap());
     diagnostics_pub_.publish(array);
     status_pub_.publish(array.status.front());
     // A change of state is news; the same state on every scan is not.
@@ -444,7 +511,8 @@ class PfNode {
   }
 
   // `always`: a re-initialisation, shown even when gui_publish_rate would
-  // hold the cloud back (that limit is for the stream of updates).
+  // hold the cloud back (that limit is for the stream of updates). The cloud
+  // is only built for a subscriber, and at most cloud_max_poses poses of it.
   void publishEstimate(const ros::Time& stamp, bool always) {
     if (const auto pose = localizer_.estimate(stamp)) {
       pose_pub_.publish(*pose);
@@ -453,8 +521,9 @@ class PfNode {
     const double period = config_.gui_publish_rate > 0.0 ? 1.0 / config_.gui_publish_rate : 0.0;
     const bool due = always || last_cloud_stamp_.isZero() || stamp < last_cloud_stamp_ ||
                      (stamp - last_cloud_stamp_).toSec() >= period;
-    if (!due) return;
-    cloud_pub_.publish(localizer_.particleCloud(stamp));
+    if (!due || cloud_pub_.getNumSubscribers() == 0) return;
+    cloud_pub_.publish(
+        localizer_.particleCloud(stamp, static_cast<std::size_t>(config_.cloud_max_poses)));
     last_cloud_stamp_ = stamp;
   }
 
@@ -463,6 +532,7 @@ class PfNode {
   // under the same master (respawn, a crash, a relaunch of this node alone)
   // resumes where the robot is instead of starting over.
   void savePose() {
+    std::lock_guard<std::mutex> lock(filter_mutex_);
     const auto estimate = localizer_.estimate(ros::Time());
     if (!estimate) return;
     pf::Pose2 pose = toPose2(estimate->pose.pose);
@@ -488,14 +558,6 @@ class PfNode {
     ros::shutdown();
   }
 
-  void publishMapToOdom(const ros::Time& stamp) {
-    if (!config_.tf_broadcast || stamp <= last_tf_stamp_) return;
-    if (const auto t = localizer_.mapToOdom(stamp)) {
-      broadcaster_.sendTransform(*t);
-      last_tf_stamp_ = stamp;
-    }
-  }
-
   void warn(const std::string& key, const std::string& text) {
     int suppressed = 0;
     if (!log_.due(key, &suppressed)) return;
@@ -510,8 +572,16 @@ class PfNode {
   ros::NodeHandle nh_, pnh_;
   tf2_ros::Buffer buffer_;
   tf2_ros::TransformListener listener_;
-  tf2_ros::TransformBroadcaster broadcaster_;
+  // Guards localizer_, config_, governor_ and the state below that goes
+  // with the filter (last_odom_, last_state_, last_scan_stamp_,
+  // last_cloud_stamp_): taken by the filter thread for a whole update, and
+  // by the main spinner's callbacks that touch the filter. The republisher
+  // never waits for it.
+  std::mutex filter_mutex_;
   ScanLocalizer localizer_;
+  UpdateTimeGovernor governor_;
+  UpdateTiming timing_;
+  LatestScanSlot slot_;
   message_filters::Subscriber<sensor_msgs::LaserScan> scan_sub_;
   tf2_ros::MessageFilter<sensor_msgs::LaserScan> scan_filter_;
   ros::Subscriber odom_sub_, map_sub_, initial_pose_sub_, tf_watch_sub_;
@@ -522,11 +592,13 @@ class PfNode {
   ros::Publisher pose_pub_, amcl_pose_pub_, cloud_pub_, diagnostics_pub_, status_pub_;
   std::optional<pf::LocalizationState> last_state_;
   ros::ServiceServer global_srv_, nomotion_srv_, set_map_srv_;
-  ros::Timer tf_timer_, save_timer_;
+  ros::Timer save_timer_;
   ros::WallTimer sigint_timer_;
-  ros::Time last_scan_stamp_, last_tf_stamp_, last_cloud_stamp_;
+  ros::Time last_scan_stamp_, last_cloud_stamp_;
   LimitedLog log_{kLogPeriod};
   std::unique_ptr<ReconfigureServer> reconfigure_;
+  std::unique_ptr<MapToOdomRepublisher> republisher_;
+  std::thread filter_thread_;  // last: started when everything else exists
 };
 
 }  // namespace

@@ -136,4 +136,32 @@ void toPoseArray(const pf::ParticleSet& particles, geometry_msgs::PoseArray* out
   for (std::size_t i = 0; i < particles.size(); ++i) out->poses[i] = toPoseMsg(particles.pose(i));
 }
 
+void toPoseArray(const pf::ParticleSet& particles, std::size_t max_poses,
+                 geometry_msgs::PoseArray* out) {
+  const std::size_t n = particles.size();
+  if (max_poses == 0 || n <= max_poses) {
+    toPoseArray(particles, out);
+    return;
+  }
+  double total = 0.0;
+  for (double w : particles.weight) total += w;
+  out->poses.clear();
+  out->poses.reserve(max_poses);
+  if (!(total > 0.0) || !std::isfinite(total)) {
+    // No usable weights: every (n / max_poses)-th particle.
+    for (std::size_t k = 0; k < max_poses; ++k) {
+      out->poses.push_back(toPoseMsg(particles.pose(k * n / max_poses)));
+    }
+    return;
+  }
+  const double step = total / static_cast<double>(max_poses);
+  double target = 0.5 * step;
+  double cumulative = particles.weight[0];
+  std::size_t i = 0;
+  for (std::size_t k = 0; k < max_poses; ++k, target += step) {
+    while (cumulative < target && i + 1 < n) cumulative += particles.weight[++i];
+    out->poses.push_back(toPoseMsg(particles.pose(i)));
+  }
+}
+
 }  // namespace pf_ros

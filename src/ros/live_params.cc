@@ -206,6 +206,9 @@ const std::vector<LiveParam>& liveParams() {
        field<double>([](LocalizerConfig& c) -> double& { return c.tf_publish_rate; })},
       {"gui_publish_rate",
        field<double>([](LocalizerConfig& c) -> double& { return c.gui_publish_rate; })},
+      {"cloud_max_poses", field<int>([](LocalizerConfig& c) -> int& { return c.cloud_max_poses; })},
+      {"max_update_time",
+       field<double>([](LocalizerConfig& c) -> double& { return c.max_update_time; })},
   };
   return params;
 }

@@ -367,6 +367,8 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
   }
 
   p.get("gui_publish_rate", &c.gui_publish_rate);
+  p.get("cloud_max_poses", &c.cloud_max_poses);
+  p.get("max_update_time", &c.max_update_time);
   p.get("save_pose_rate", &c.save_pose_rate);
   p.get("first_map_only", &c.first_map_only);
   bool use_map_topic = true;
@@ -396,6 +398,11 @@ void validate(const LocalizerConfig& c) {
                        "tf_publish_rate", "> 0 (Hz)", c.tf_publish_rate);
   pf::requireParameter(std::isfinite(c.gui_publish_rate), "gui_publish_rate",
                        "finite (Hz; <= 0: no limit)", c.gui_publish_rate);
+  pf::requireParameter(c.cloud_max_poses >= 0, "cloud_max_poses", ">= 0 (poses; 0: every particle)",
+                       c.cloud_max_poses);
+  pf::requireParameter(std::isfinite(c.max_update_time) && c.max_update_time <= 10.0,
+                       "max_update_time", "finite and <= 10 (s; <= 0: no limit)",
+                       c.max_update_time);
   pf::requireParameter(std::isfinite(c.save_pose_rate), "save_pose_rate",
                        "finite (Hz; <= 0: never)", c.save_pose_rate);
   pf::validate(c.filter);

@@ -77,7 +77,8 @@ void ReconfigureServer::onRequest(dynamic_reconfigure::Config* request) {
   ++generation_;
   std::string list;
   for (const std::string& c : change.changed) list += (list.empty() ? "" : ", ") + c;
-  ROS_INFO("%s: reconfigured (generation %d): %s", log_prefix_.c_str(), generation_, list.c_str());
+  ROS_INFO("%s: reconfigured (generation %d): %s", log_prefix_.c_str(), generation_.load(),
+           list.c_str());
   *request = liveParamsMessage(current_);
 }
 

@@ -173,6 +173,15 @@ geometry_msgs::PoseArray ScanLocalizer::particleCloud(const ros::Time& stamp) co
   return msg;
 }
 
+geometry_msgs::PoseArray ScanLocalizer::particleCloud(const ros::Time& stamp,
+                                                      std::size_t max_poses) const {
+  geometry_msgs::PoseArray msg;
+  msg.header.stamp = stamp;
+  msg.header.frame_id = config_.global_frame;
+  toPoseArray(filter_.particles(), max_poses, &msg);
+  return msg;
+}
+
 std::string scanInconsistency(const sensor_msgs::LaserScan& scan) {
   if (!scan.intensities.empty() && scan.intensities.size() != scan.ranges.size()) {
     return "the scan has " + std::to_string(scan.intensities.size()) + " intensities for " +

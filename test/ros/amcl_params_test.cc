@@ -11,6 +11,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "pf_localization/ros/localizer_config.h"
@@ -205,6 +206,31 @@ TEST(AmclParams, RefinementParametersAreReadAndValidated) {
   } catch (const std::invalid_argument& e) {
     EXPECT_EQ(std::string("invalid parameter refine_max_rotation = 4: must be in [0, pi]"),
               e.what());
+  }
+}
+
+// Issue 15's parameters: read, and refused with the start-up message.
+TEST(AmclParams, OverloadParametersAreReadAndValidated) {
+  ConfigNotes notes;
+  LocalizerConfig c =
+      readConfig(*yaml("cloud_max_poses: 200\nmax_update_time: 0.02\n"), nullptr, &notes);
+  EXPECT_EQ(c.cloud_max_poses, 200);
+  EXPECT_EQ(c.max_update_time, 0.02);
+  EXPECT_TRUE(notes.warnings.empty());
+  const std::pair<const char*, const char*> bad[] = {
+      {"cloud_max_poses: -1\n",
+       "invalid parameter cloud_max_poses = -1: must be >= 0 (poses; 0: every particle)"},
+      {"max_update_time: .nan\n",
+       "invalid parameter max_update_time = nan: must be finite and <= 10 (s; <= 0: no limit)"},
+      {"max_update_time: 60\n",
+       "invalid parameter max_update_time = 60: must be finite and <= 10 (s; <= 0: no limit)"}};
+  for (const auto& [text, message] : bad) {
+    try {
+      readConfig(*yaml(text), nullptr, &notes);
+      ADD_FAILURE() << text << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_EQ(std::string(message), e.what());
+    }
   }
 }
 

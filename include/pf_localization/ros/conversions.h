@@ -44,4 +44,14 @@ Eigen::Matrix3d fromRosCovariance(const boost::array<double, 36>& cov);
 /// Every particle as a pose (weights are not part of a PoseArray); the header is left as it is.
 void toPoseArray(const pf::ParticleSet& particles, geometry_msgs::PoseArray* out);
 
+/// At most `max_poses` poses that show the cloud's shape (0: every particle):
+/// with more particles than that, a systematic resample by weight (evenly
+/// spaced points on the cumulative weight, the first at half a step), so
+/// that each pose stands for the same share of the weight, as the
+/// particles themselves do after a resampling. Deterministic; O(N). For
+/// particlecloud: 500 000 poses are 28 MB a message, and rviz shows the same
+/// shape with a few thousand.
+void toPoseArray(const pf::ParticleSet& particles, std::size_t max_poses,
+                 geometry_msgs::PoseArray* out);
+
 }  // namespace pf_ros

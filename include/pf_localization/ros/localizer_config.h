@@ -31,8 +31,14 @@ struct LocalizerConfig {
   // pf_node only: pf_bag_runner has neither topics to throttle nor a
   // parameter server to save to.
   double gui_publish_rate = -1.0;  // Hz limit of particlecloud; <= 0: after every update
-  double save_pose_rate = 0.5;     // Hz the estimate is saved to ~initial_pose_*; <= 0: never
-  bool first_map_only = false;     // keep the first map; ignore later ones on the map topic
+  // Poses at most in a particlecloud message (0: every particle): a larger
+  // cloud is shown by a systematic resample to this many (toPoseArray).
+  int cloud_max_poses = 5000;
+  // s an update may take (wall, p95): when > 0 the particle count is capped
+  // so that it does (UpdateTimeGovernor); <= 0: off, max_particles alone.
+  double max_update_time = 0.0;
+  double save_pose_rate = 0.5;  // Hz the estimate is saved to ~initial_pose_*; <= 0: never
+  bool first_map_only = false;  // keep the first map; ignore later ones on the map topic
 };
 
 /// What readConfig has to tell besides errors: amcl parameters that are

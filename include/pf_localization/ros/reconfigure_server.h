@@ -15,6 +15,7 @@
 #include <dynamic_reconfigure/Config.h>
 #include <ros/node_handle.h>
 
+#include <atomic>
 #include <functional>
 #include <memory>
 #include <string>
@@ -40,7 +41,7 @@ class ReconfigureServer {
   /// The configuration in effect (its live parameters are the server's).
   const LocalizerConfig& config() const { return current_; }
   /// How many changes were accepted since start-up (0: the start-up values).
-  int generation() const { return generation_; }
+  int generation() const { return generation_.load(); }
 
  private:
   struct Server;
@@ -52,7 +53,8 @@ class ReconfigureServer {
   LocalizerConfig current_;
   Apply apply_;
   std::string log_prefix_;
-  int generation_ = 0;
+  // Atomic: pf_node's filter thread reads it for the diagnostics.
+  std::atomic<int> generation_{0};
   std::unique_ptr<Server> server_;
 };
 

@@ -73,6 +73,9 @@ class ScanLocalizer {
   std::optional<geometry_msgs::PoseWithCovarianceStamped> estimate(const ros::Time& stamp) const;
   /// The particles, stamped `stamp`, in the global frame.
   geometry_msgs::PoseArray particleCloud(const ros::Time& stamp) const;
+  /// At most `max_poses` of them (0: all), a systematic resample by weight
+  /// when there are more (toPoseArray in conversions.h).
+  geometry_msgs::PoseArray particleCloud(const ros::Time& stamp, std::size_t max_poses) const;
 
  private:
   LocalizerConfig config_;
