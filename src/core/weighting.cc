@@ -1,0 +1,93 @@
+#include "pf_localization/core/weighting.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace pf {
+namespace {
+
+// ESS of the weights prior * likelihood^beta, from their logarithms.
+double effectiveSampleSize(const std::vector<double>& log_prior,
+                           const std::vector<double>& log_likelihood, double beta) {
+  double max_log = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < log_prior.size(); ++i) {
+    max_log = std::max(max_log, log_prior[i] + beta * log_likelihood[i]);
+  }
+  if (!std::isfinite(max_log)) return 0.0;
+  double sum = 0.0, sum_sq = 0.0;
+  for (std::size_t i = 0; i < log_prior.size(); ++i) {
+    const double w = std::exp(log_prior[i] + beta * log_likelihood[i] - max_log);
+    sum += w;
+    sum_sq += w * w;
+  }
+  return sum * sum / sum_sq;
+}
+
+}  // namespace
+
+double applyLikelihood(const std::vector<double>& ll, double min_ess_fraction,
+                       std::vector<double>* weights, WeightingScratch* scratch) {
+  std::vector<double>& w = *weights;
+  std::vector<double>& log_prior = scratch->log_prior;
+  const std::size_t n = w.size();
+  // After a resampling every weight is the same, and a constant prior does
+  // not change the normalised result: zeros spare N logarithms.
+  // The prior's effective sample size is then N, too, without a pass of
+  // exponentials.
+  double prior_ess = static_cast<double>(n);
+  if (std::all_of(w.begin(), w.end(), [&](double v) { return v == w.front(); })) {
+    log_prior.assign(n, 0.0);
+  } else {
+    log_prior.resize(n);
+    for (std::size_t i = 0; i < n; ++i) log_prior[i] = std::log(w[i]);
+    prior_ess = effectiveSampleSize(log_prior, ll, 0.0);
+  }
+  double beta = 1.0;
+  // A share of the effective particles before the scan, not of all of them:
+  // recovery's barely weighted guesses count as particles but not as
+  // effective ones, and measured against N a cloud salted with them could
+  // never keep enough, so every scan was tempered away to nothing.
+  const double min_ess = min_ess_fraction * prior_ess;
+  if (min_ess > 0.0 && effectiveSampleSize(log_prior, ll, 1.0) < min_ess) {
+    // Bisection for the largest exponent that keeps min_ess particles.
+    double lo = 0.0, hi = 1.0;
+    for (int k = 0; k < 20; ++k) {
+      const double mid = 0.5 * (lo + hi);
+      (effectiveSampleSize(log_prior, ll, mid) >= min_ess ? lo : hi) = mid;
+    }
+    beta = lo;
+  }
+  std::vector<double>& scratch_ = scratch->log_posterior;
+  scratch_.resize(n);
+  double max_log = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < n; ++i) {
+    scratch_[i] = log_prior[i] + beta * ll[i];
+    max_log = std::max(max_log, scratch_[i]);
+  }
+  // When every particle scores zero (possible with z_rand = 0: an end point
+  // far from any obstacle has likelihood exp(-800) = 0), max_log is -inf and
+  // normalising would give 0/0 = NaN weights, which the resampler collapses
+  // onto particle 0. Evidence that rules out all particles alike favours
+  // none: the weights are left as they were.
+  if (std::isfinite(max_log)) {
+    double total = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      w[i] = std::exp(scratch_[i] - max_log);
+      total += w[i];
+    }
+    for (double& v : w) v /= total;
+  }
+  return beta;
+}
+
+double meanBeamLikelihood(const std::vector<double>& weights,
+                          const std::vector<double>& log_likelihood, double beams) {
+  double mean_beam = 0.0;
+  for (std::size_t i = 0; i < weights.size(); ++i) {
+    mean_beam += weights[i] * std::exp(log_likelihood[i] / beams);
+  }
+  return mean_beam;
+}
+
+}  // namespace pf
