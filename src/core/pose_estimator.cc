@@ -6,6 +6,7 @@
 
 #include "pf_localization/core/bin_index.h"
 #include "pf_localization/core/bin_table.h"
+#include "pf_localization/core/fast_math.h"
 
 namespace pf {
 namespace {
@@ -60,14 +61,22 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
   bin_of.reset(particles.size());
   keys.clear();
   particle_bin.resize(particles.size());
+  // Resampling leaves the copies of one particle side by side, so the bin of
+  // the particle before is the likeliest: it spares most hash look-ups.
+  uint64_t last_key = ~uint64_t{0};
+  int last_id = -1;
   for (std::size_t i = 0; i < particles.size(); ++i) {
     const double yaw01 = (normalizeAngle(particles.yaw[i]) + M_PI) / (2.0 * M_PI);
     const BinKey key{binIndex(particles.x[i], params.cell_xy),
                      binIndex(particles.y[i], params.cell_xy),
                      std::clamp<int64_t>(binIndex(yaw01, 1.0 / yaw_bins), 0, yaw_bins - 1)};
-    const int id = bin_of.insert(BinTable::key(key.x, key.y, key.yaw));
-    if (static_cast<std::size_t>(id) == keys.size()) keys.push_back(key);
-    particle_bin[i] = id;
+    const uint64_t packed = BinTable::key(key.x, key.y, key.yaw);
+    if (packed != last_key) {
+      last_id = bin_of.insert(packed);
+      last_key = packed;
+      if (static_cast<std::size_t>(last_id) == keys.size()) keys.push_back(key);
+    }
+    particle_bin[i] = last_id;
   }
 
   // Join occupied bins that touch (26-neighbourhood) into clusters, but only
@@ -100,14 +109,22 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
 
   // Cluster ids in order of first appearance, then the weighted sums of each
   // cluster in two passes (means, then covariances) over flat arrays.
+  // The roots are found once per bin, not once per particle.
+  for (std::size_t b = 0; b < keys.size(); ++b) parent[b] = find(parent, static_cast<int>(b));
   cluster_of_root.assign(keys.size(), -1);
   cluster.resize(particles.size());
   int clusters = 0;
   for (std::size_t i = 0; i < particles.size(); ++i) {
-    int& id = cluster_of_root[find(parent, particle_bin[i])];
+    int& id = cluster_of_root[parent[particle_bin[i]]];
     if (id < 0) id = clusters++;
     cluster[i] = id;
   }
+  // The headings' sines and cosines for the whole cloud at once (sinCos
+  // vectorises), for the mean directions.
+  thread_local std::vector<double> sin_yaw, cos_yaw;
+  sin_yaw.resize(particles.size());
+  cos_yaw.resize(particles.size());
+  sinCos(particles.yaw.data(), particles.size(), sin_yaw.data(), cos_yaw.data());
   std::vector<Cluster> c(clusters);
   std::vector<Eigen::Vector4d> sums(clusters, Eigen::Vector4d::Zero());  // x, y, sin, cos
   for (std::size_t i = 0; i < particles.size(); ++i) {
@@ -115,11 +132,7 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
     Cluster& k = c[cluster[i]];
     k.weight += w;
     ++k.count;
-    // Single precision (1e-7 rad) is ample for a mean direction, and its
-    // sine and cosine cost half as much, once per particle and update.
-    const float yaw = static_cast<float>(particles.yaw[i]);
-    sums[cluster[i]] +=
-        w * Eigen::Vector4d(particles.x[i], particles.y[i], std::sin(yaw), std::cos(yaw));
+    sums[cluster[i]] += w * Eigen::Vector4d(particles.x[i], particles.y[i], sin_yaw[i], cos_yaw[i]);
   }
   for (int k = 0; k < clusters; ++k) {
     const double w = c[k].weight > 0.0 ? c[k].weight : 1.0;

@@ -33,23 +33,53 @@ double applyLikelihood(const std::vector<double>& ll, double min_ess_fraction,
   const std::size_t n = w.size();
   // After a resampling every weight is the same, and a constant prior does
   // not change the normalised result: zeros spare N logarithms.
-  // The prior's effective sample size is then N, too, without a pass of
-  // exponentials.
+  // The prior's effective sample size is then N, too; otherwise it comes
+  // from the weights themselves, (sum w)^2 / sum w^2, without exponentials.
   double prior_ess = static_cast<double>(n);
   if (std::all_of(w.begin(), w.end(), [&](double v) { return v == w.front(); })) {
     log_prior.assign(n, 0.0);
   } else {
     log_prior.resize(n);
-    for (std::size_t i = 0; i < n; ++i) log_prior[i] = std::log(w[i]);
-    prior_ess = effectiveSampleSize(log_prior, ll, 0.0);
+    double sum = 0.0, sum_sq = 0.0;
+    for (std::size_t i = 0; i < n; ++i) {
+      log_prior[i] = std::log(w[i]);
+      sum += w[i];
+      sum_sq += w[i] * w[i];
+    }
+    prior_ess = sum_sq > 0.0 ? sum * sum / sum_sq : 0.0;
   }
-  double beta = 1.0;
+  // The untempered posterior, in one pass of exponentials that serves both
+  // the tempering test and (nearly always) the result: log_posterior holds
+  // prior * likelihood / max.
+  std::vector<double>& e = scratch->log_posterior;
+  e.resize(n);
+  double max_log = -std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < n; ++i) {
+    e[i] = log_prior[i] + ll[i];
+    max_log = std::max(max_log, e[i]);
+  }
   // A share of the effective particles before the scan, not of all of them:
   // recovery's barely weighted guesses count as particles but not as
   // effective ones, and measured against N a cloud salted with them could
   // never keep enough, so every scan was tempered away to nothing.
   const double min_ess = min_ess_fraction * prior_ess;
-  if (min_ess > 0.0 && effectiveSampleSize(log_prior, ll, 1.0) < min_ess) {
+  // When every particle scores zero (possible with z_rand = 0: an end point
+  // far from any obstacle has likelihood exp(-800) = 0), max_log is -inf and
+  // normalising would give 0/0 = NaN weights, which the resampler collapses
+  // onto particle 0. Evidence that rules out all particles alike favours
+  // none: the weights are left as they were (or, tempered to nothing, are
+  // the prior again).
+  double total = 0.0, total_sq = 0.0;
+  if (std::isfinite(max_log)) {
+    for (std::size_t i = 0; i < n; ++i) {
+      e[i] = std::exp(e[i] - max_log);
+      total += e[i];
+      total_sq += e[i] * e[i];
+    }
+  }
+  const double ess = total_sq > 0.0 ? total * total / total_sq : 0.0;
+  double beta = 1.0;
+  if (min_ess > 0.0 && ess < min_ess) {
     // Bisection for the largest exponent that keeps min_ess particles.
     double lo = 0.0, hi = 1.0;
     for (int k = 0; k < 20; ++k) {
@@ -57,27 +87,21 @@ double applyLikelihood(const std::vector<double>& ll, double min_ess_fraction,
       (effectiveSampleSize(log_prior, ll, mid) >= min_ess ? lo : hi) = mid;
     }
     beta = lo;
-  }
-  std::vector<double>& scratch_ = scratch->log_posterior;
-  scratch_.resize(n);
-  double max_log = -std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < n; ++i) {
-    scratch_[i] = log_prior[i] + beta * ll[i];
-    max_log = std::max(max_log, scratch_[i]);
-  }
-  // When every particle scores zero (possible with z_rand = 0: an end point
-  // far from any obstacle has likelihood exp(-800) = 0), max_log is -inf and
-  // normalising would give 0/0 = NaN weights, which the resampler collapses
-  // onto particle 0. Evidence that rules out all particles alike favours
-  // none: the weights are left as they were.
-  if (std::isfinite(max_log)) {
-    double total = 0.0;
+    max_log = -std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i < n; ++i) {
-      w[i] = std::exp(scratch_[i] - max_log);
-      total += w[i];
+      e[i] = log_prior[i] + beta * ll[i];
+      max_log = std::max(max_log, e[i]);
     }
-    for (double& v : w) v /= total;
+    total = 0.0;
+    if (std::isfinite(max_log)) {
+      for (std::size_t i = 0; i < n; ++i) {
+        e[i] = std::exp(e[i] - max_log);
+        total += e[i];
+      }
+    }
   }
+  if (!std::isfinite(max_log)) return beta;
+  for (std::size_t i = 0; i < n; ++i) w[i] = e[i] / total;
   return beta;
 }
 
