@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <vector>
 
 namespace pf {
 namespace {
@@ -58,7 +59,51 @@ __attribute__((target_clones("avx2", "default"))) void sinCosKernel(const double
   }
 }
 
+// fdlibm (e_exp.c).
+constexpr double kLn2Hi = 6.93147180369123816490e-01, kLn2Lo = 1.90821492927058770002e-10,
+                 kInvLn2 = 1.44269504088896338700e+00;
+constexpr double kP1 = 1.66666666666666019037e-01, kP2 = -2.77777777770155933842e-03,
+                 kP3 = 6.61375632143793436117e-05, kP4 = -1.65339022054652515390e-06,
+                 kP5 = 4.13813679705723846039e-08;
+
+__attribute__((target_clones("avx2", "default"))) void expKernel(const double* x, std::size_t n,
+                                                                 double* out) {
+  for (std::size_t i = 0; i < n; ++i) {
+    // Outside [-708, 709] the result is wrong here, and replaced by exps().
+    const double v = x[i];
+    // v = k ln2 + r, |r| <= ln2 / 2.
+    const double k = (v * kInvLn2 + kShifter) - kShifter;
+    const double hi = v - k * kLn2Hi;
+    const double lo = k * kLn2Lo;
+    const double r = hi - lo;
+    const double t = r * r;
+    const double c = r - t * (kP1 + t * (kP2 + t * (kP3 + t * (kP4 + t * kP5))));
+    const double y = 1.0 - ((lo - (r * c) / (2.0 - c)) - hi);
+    // 2^k in two factors, so that neither leaves the exponent's range (the
+    // product may: subnormal, zero or infinite, as exp is). The biased
+    // exponents are the low mantissa bits of e + 1023 + the shifter.
+    const double k1 = (k * 0.5 + kShifter) - kShifter, k2 = k - k1;
+    const double scale1 = fromBits(toBits(k1 + (1023.0 + kShifter)) << 52);
+    const double scale2 = fromBits(toBits(k2 + (1023.0 + kShifter)) << 52);
+    out[i] = y * scale1 * scale2;
+  }
+}
+
 }  // namespace
+
+void exps(const double* x, std::size_t n, double* out) {
+  // Saved first: out may be x.
+  thread_local std::vector<std::size_t> outside;
+  outside.clear();
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!(x[i] >= -708.0 && x[i] <= 709.0)) outside.push_back(i);
+  }
+  thread_local std::vector<double> saved;
+  saved.clear();
+  for (std::size_t i : outside) saved.push_back(x[i]);
+  expKernel(x, n, out);
+  for (std::size_t j = 0; j < outside.size(); ++j) out[outside[j]] = std::exp(saved[j]);
+}
 
 void sinCos(const double* angle, std::size_t n, double* s, double* c) {
   sinCosKernel(angle, n, s, c);

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "pf_localization/core/fast_math.h"
+
 namespace pf {
 namespace {
 
@@ -15,11 +17,16 @@ double effectiveSampleSize(const std::vector<double>& log_prior,
     max_log = std::max(max_log, log_prior[i] + beta * log_likelihood[i]);
   }
   if (!std::isfinite(max_log)) return 0.0;
-  double sum = 0.0, sum_sq = 0.0;
+  thread_local std::vector<double> w;  // kept: no allocation per update
+  w.resize(log_prior.size());
   for (std::size_t i = 0; i < log_prior.size(); ++i) {
-    const double w = std::exp(log_prior[i] + beta * log_likelihood[i] - max_log);
-    sum += w;
-    sum_sq += w * w;
+    w[i] = log_prior[i] + beta * log_likelihood[i] - max_log;
+  }
+  exps(w.data(), w.size(), w.data());
+  double sum = 0.0, sum_sq = 0.0;
+  for (double v : w) {
+    sum += v;
+    sum_sq += v * v;
   }
   return sum * sum / sum_sq;
 }
@@ -71,8 +78,9 @@ double applyLikelihood(const std::vector<double>& ll, double min_ess_fraction,
   // the prior again).
   double total = 0.0, total_sq = 0.0;
   if (std::isfinite(max_log)) {
+    for (std::size_t i = 0; i < n; ++i) e[i] -= max_log;
+    exps(e.data(), n, e.data());
     for (std::size_t i = 0; i < n; ++i) {
-      e[i] = std::exp(e[i] - max_log);
       total += e[i];
       total_sq += e[i] * e[i];
     }
@@ -94,10 +102,9 @@ double applyLikelihood(const std::vector<double>& ll, double min_ess_fraction,
     }
     total = 0.0;
     if (std::isfinite(max_log)) {
-      for (std::size_t i = 0; i < n; ++i) {
-        e[i] = std::exp(e[i] - max_log);
-        total += e[i];
-      }
+      for (std::size_t i = 0; i < n; ++i) e[i] -= max_log;
+      exps(e.data(), n, e.data());
+      for (std::size_t i = 0; i < n; ++i) total += e[i];
     }
   }
   if (!std::isfinite(max_log)) return beta;
@@ -107,10 +114,13 @@ double applyLikelihood(const std::vector<double>& ll, double min_ess_fraction,
 
 double meanBeamLikelihood(const std::vector<double>& weights,
                           const std::vector<double>& log_likelihood, double beams) {
+  thread_local std::vector<double> per_beam;  // kept: no allocation per update
+  const std::size_t n = weights.size();
+  per_beam.resize(n);
+  for (std::size_t i = 0; i < n; ++i) per_beam[i] = log_likelihood[i] / beams;
+  exps(per_beam.data(), n, per_beam.data());
   double mean_beam = 0.0;
-  for (std::size_t i = 0; i < weights.size(); ++i) {
-    mean_beam += weights[i] * std::exp(log_likelihood[i] / beams);
-  }
+  for (std::size_t i = 0; i < n; ++i) mean_beam += weights[i] * per_beam[i];
   return mean_beam;
 }
 
