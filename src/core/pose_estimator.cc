@@ -139,14 +139,25 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
     c[k].mean = {sums[k][0] / w, sums[k][1] / w,
                  normalizeAngle(std::atan2(sums[k][2], sums[k][3]))};
   }
+  // The second moments in plain arrays (an Eigen temporary per particle went
+  // through the stack and stalled on store forwarding), with the same
+  // products in the same order as w d d^T.
+  thread_local std::vector<double> moments;
+  moments.assign(9 * static_cast<std::size_t>(clusters), 0.0);
   for (std::size_t i = 0; i < particles.size(); ++i) {
-    Cluster& k = c[cluster[i]];
-    const Eigen::Vector3d d(particles.x[i] - k.mean.x, particles.y[i] - k.mean.y,
-                            angleDiff(particles.yaw[i], k.mean.yaw));
-    k.covariance += particles.weight[i] * d * d.transpose();
+    const Cluster& k = c[cluster[i]];
+    const double d[3] = {particles.x[i] - k.mean.x, particles.y[i] - k.mean.y,
+                         angleDiff(particles.yaw[i], k.mean.yaw)};
+    const double w = particles.weight[i];
+    double* m = &moments[9 * static_cast<std::size_t>(cluster[i])];
+    for (int r = 0; r < 3; ++r) {
+      const double wd = w * d[r];
+      for (int col = 0; col < 3; ++col) m[3 * col + r] += wd * d[col];
+    }
   }
-  for (Cluster& k : c) {
-    if (k.weight > 0.0) k.covariance /= k.weight;
+  for (int k = 0; k < clusters; ++k) {
+    c[k].covariance = Eigen::Map<const Eigen::Matrix3d>(&moments[9 * static_cast<std::size_t>(k)]);
+    if (c[k].weight > 0.0) c[k].covariance /= c[k].weight;
   }
   estimate.clusters = std::move(c);
   // Heaviest first; ties broken by the mean so the order never depends on hashing.
