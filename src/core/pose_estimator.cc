@@ -21,6 +21,26 @@ int find(std::vector<int>& parent, int i) {
   return i;
 }
 
+// Adds term(i, row) for every particle i into the row (kWidth values) of
+// its group, group[i], in `rows`. Runs of particles in one group (nearly
+// the whole cloud when tracking) add in registers, starting from and
+// returning to the group's row: the additions are the same, in the same
+// order, as adding each term to the row in memory, which made every
+// particle wait for the one before through a store and a load.
+template <int kWidth, typename Term>
+void accumulateRuns(const std::vector<int>& group, double* rows, Term term) {
+  const std::size_t n = group.size();
+  std::size_t i = 0;
+  while (i < n) {
+    const int g = group[i];
+    double* row = rows + static_cast<std::size_t>(kWidth) * g;
+    double acc[kWidth];
+    std::copy(row, row + kWidth, acc);
+    for (; i < n && group[i] == g; ++i) term(i, acc);
+    std::copy(acc, acc + kWidth, row);
+  }
+}
+
 }  // namespace
 
 Cluster summarize(const ParticleSet& particles, const std::vector<std::size_t>& indices) {
@@ -82,9 +102,8 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
   // Join occupied bins that touch (26-neighbourhood) into clusters, but only
   // bins that carry weight (see ClusterParams::join_weight_ratio).
   bin_weight.assign(keys.size(), 0.0);
-  for (std::size_t i = 0; i < particles.size(); ++i) {
-    bin_weight[particle_bin[i]] += particles.weight[i];
-  }
+  accumulateRuns<1>(particle_bin, bin_weight.data(),
+                    [&](std::size_t i, double* a) { a[0] += particles.weight[i]; });
   const double join_weight =
       params.join_weight_ratio * *std::max_element(bin_weight.begin(), bin_weight.end());
   parent.resize(keys.size());
@@ -126,35 +145,40 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
   cos_yaw.resize(particles.size());
   sinCos(particles.yaw.data(), particles.size(), sin_yaw.data(), cos_yaw.data());
   std::vector<Cluster> c(clusters);
-  std::vector<Eigen::Vector4d> sums(clusters, Eigen::Vector4d::Zero());  // x, y, sin, cos
-  for (std::size_t i = 0; i < particles.size(); ++i) {
+  // Per cluster: the count, the weight and the weighted sums of x, y, sin, cos.
+  thread_local std::vector<double> sums;
+  sums.assign(6 * static_cast<std::size_t>(clusters), 0.0);
+  accumulateRuns<6>(cluster, sums.data(), [&](std::size_t i, double* a) {
     const double w = particles.weight[i];
-    Cluster& k = c[cluster[i]];
-    k.weight += w;
-    ++k.count;
-    sums[cluster[i]] += w * Eigen::Vector4d(particles.x[i], particles.y[i], sin_yaw[i], cos_yaw[i]);
-  }
+    a[0] += 1.0;
+    a[1] += w;
+    a[2] += w * particles.x[i];
+    a[3] += w * particles.y[i];
+    a[4] += w * sin_yaw[i];
+    a[5] += w * cos_yaw[i];
+  });
   for (int k = 0; k < clusters; ++k) {
+    const double* sum = &sums[6 * static_cast<std::size_t>(k)];
+    c[k].count = static_cast<std::size_t>(sum[0]);
+    c[k].weight = sum[1];
     const double w = c[k].weight > 0.0 ? c[k].weight : 1.0;
-    c[k].mean = {sums[k][0] / w, sums[k][1] / w,
-                 normalizeAngle(std::atan2(sums[k][2], sums[k][3]))};
+    c[k].mean = {sum[2] / w, sum[3] / w, normalizeAngle(std::atan2(sum[4], sum[5]))};
   }
   // The second moments in plain arrays (an Eigen temporary per particle went
   // through the stack and stalled on store forwarding), with the same
   // products in the same order as w d d^T.
   thread_local std::vector<double> moments;
   moments.assign(9 * static_cast<std::size_t>(clusters), 0.0);
-  for (std::size_t i = 0; i < particles.size(); ++i) {
+  accumulateRuns<9>(cluster, moments.data(), [&](std::size_t i, double* m) {
     const Cluster& k = c[cluster[i]];
     const double d[3] = {particles.x[i] - k.mean.x, particles.y[i] - k.mean.y,
                          angleDiff(particles.yaw[i], k.mean.yaw)};
     const double w = particles.weight[i];
-    double* m = &moments[9 * static_cast<std::size_t>(cluster[i])];
     for (int r = 0; r < 3; ++r) {
       const double wd = w * d[r];
       for (int col = 0; col < 3; ++col) m[3 * col + r] += wd * d[col];
     }
-  }
+  });
   for (int k = 0; k < clusters; ++k) {
     c[k].covariance = Eigen::Map<const Eigen::Matrix3d>(&moments[9 * static_cast<std::size_t>(k)]);
     if (c[k].weight > 0.0) c[k].covariance /= c[k].weight;
