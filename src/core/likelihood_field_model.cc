@@ -212,7 +212,10 @@ void LikelihoodFieldModel::score(const float* bx, const float* by, std::size_t b
   // vectorises), not one C library call per particle. Kept per thread: no
   // allocation per update.
   const std::size_t n = particles.size();
-  thread_local std::vector<double> heading, sin_yaw, cos_yaw;
+  thread_local std::vector<double> heading_tls, sin_yaw_tls, cos_yaw_tls;
+  std::vector<double>& heading = heading_tls;
+  std::vector<double>& sin_yaw = sin_yaw_tls;
+  std::vector<double>& cos_yaw = cos_yaw_tls;
   sin_yaw.resize(n);
   cos_yaw.resize(n);
   const double* yaw = particles.yaw.data();

@@ -89,8 +89,12 @@ std::size_t kldParticleCount(const ParticleSet& particles, const KldParams& para
   // will be empty after resampling and must not inflate k.
   const double threshold = particles.empty() ? 0.0 : 1.0 / static_cast<double>(particles.size());
   // Kept between calls (per thread), so that binning allocates nothing.
-  thread_local BinTable bins;
-  thread_local std::vector<double> bin_weight;
+  // Each used through a reference taken once: in a shared library every
+  // access to a thread_local is a call (__tls_get_addr), per particle here.
+  thread_local BinTable bins_tls;
+  BinTable& bins = bins_tls;
+  thread_local std::vector<double> bin_weight_tls;
+  std::vector<double>& bin_weight = bin_weight_tls;
   bins.reset(particles.size());
   bin_weight.clear();
   // Resampling leaves the copies of one particle side by side, so the bin of
