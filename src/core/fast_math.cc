@@ -5,6 +5,8 @@
 #include <cstring>
 #include <vector>
 
+#include "pf_localization/core/thread_scratch.h"
+
 namespace pf {
 namespace {
 
@@ -93,14 +95,17 @@ __attribute__((target_clones("avx2", "default"))) void expKernel(const double* x
 
 void exps(const double* x, std::size_t n, double* out) {
   // Saved first: out may be x.
-  thread_local std::vector<std::size_t> outside_tls;
-  std::vector<std::size_t>& outside = outside_tls;
+  struct Scratch {
+    std::vector<std::size_t> outside;
+    std::vector<double> saved;
+  };
+  Scratch& scratch = threadScratch<Scratch>();
+  std::vector<std::size_t>& outside = scratch.outside;
+  std::vector<double>& saved = scratch.saved;
   outside.clear();
   for (std::size_t i = 0; i < n; ++i) {
     if (!(x[i] >= -708.0 && x[i] <= 709.0)) outside.push_back(i);
   }
-  thread_local std::vector<double> saved_tls;
-  std::vector<double>& saved = saved_tls;
   saved.clear();
   for (std::size_t i : outside) saved.push_back(x[i]);
   expKernel(x, n, out);

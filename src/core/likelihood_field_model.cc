@@ -7,6 +7,7 @@
 
 #include "pf_localization/core/fast_math.h"
 #include "pf_localization/core/parameter_check.h"
+#include "pf_localization/core/thread_scratch.h"
 
 namespace pf {
 namespace {
@@ -212,10 +213,13 @@ void LikelihoodFieldModel::score(const float* bx, const float* by, std::size_t b
   // vectorises), not one C library call per particle. Kept per thread: no
   // allocation per update.
   const std::size_t n = particles.size();
-  thread_local std::vector<double> heading_tls, sin_yaw_tls, cos_yaw_tls;
-  std::vector<double>& heading = heading_tls;
-  std::vector<double>& sin_yaw = sin_yaw_tls;
-  std::vector<double>& cos_yaw = cos_yaw_tls;
+  struct HeadingScratch {
+    std::vector<double> heading, sin_yaw, cos_yaw;
+  };
+  HeadingScratch& heading_scratch = threadScratch<HeadingScratch>();
+  std::vector<double>& heading = heading_scratch.heading;
+  std::vector<double>& sin_yaw = heading_scratch.sin_yaw;
+  std::vector<double>& cos_yaw = heading_scratch.cos_yaw;
   sin_yaw.resize(n);
   cos_yaw.resize(n);
   const double* yaw = particles.yaw.data();

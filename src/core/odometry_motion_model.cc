@@ -6,6 +6,7 @@
 #include <string>
 
 #include "pf_localization/core/fast_math.h"
+#include "pf_localization/core/thread_scratch.h"
 
 namespace pf {
 namespace {
@@ -104,12 +105,14 @@ void OdometryMotionModel::applyDifferential(const Pose2& from, const Pose2& to,
   // vectorises; one C library call per particle was most of this step).
   ParticleSet& p = *particles;
   const std::size_t n = p.size();
-  thread_local std::vector<double> trans_tls, turn2_tls, s_tls,
-      c_tls;  // kept: no allocation per update
-  std::vector<double>& trans = trans_tls;
-  std::vector<double>& turn2 = turn2_tls;
-  std::vector<double>& s = s_tls;
-  std::vector<double>& c = c_tls;
+  struct TransScratch {
+    std::vector<double> trans, turn2, s, c;
+  };  // kept: no allocation per update
+  TransScratch& trans_scratch = threadScratch<TransScratch>();
+  std::vector<double>& trans = trans_scratch.trans;
+  std::vector<double>& turn2 = trans_scratch.turn2;
+  std::vector<double>& s = trans_scratch.s;
+  std::vector<double>& c = trans_scratch.c;
   trans.resize(n);
   turn2.resize(n);
   s.resize(n);

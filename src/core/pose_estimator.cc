@@ -7,6 +7,7 @@
 #include "pf_localization/core/bin_index.h"
 #include "pf_localization/core/bin_table.h"
 #include "pf_localization/core/fast_math.h"
+#include "pf_localization/core/thread_scratch.h"
 
 namespace pf {
 namespace {
@@ -74,19 +75,20 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
   // first. The working storage is kept between calls (per thread), so that
   // estimating allocates nothing once the widest cloud has been seen.
   const int64_t yaw_bins = std::max<int64_t>(1, std::llround(2.0 * M_PI / params.cell_yaw));
-  // Each used through a reference taken once: in a shared library every
-  // access to a thread_local is a call (__tls_get_addr), per particle here.
-  thread_local BinTable bin_of_tls;
-  BinTable& bin_of = bin_of_tls;
-  thread_local std::vector<BinKey> keys_tls;
-  std::vector<BinKey>& keys = keys_tls;
-  thread_local std::vector<int> particle_bin_tls, parent_tls, cluster_of_root_tls, cluster_tls;
-  std::vector<int>& particle_bin = particle_bin_tls;
-  std::vector<int>& parent = parent_tls;
-  std::vector<int>& cluster_of_root = cluster_of_root_tls;
-  std::vector<int>& cluster = cluster_tls;
-  thread_local std::vector<double> bin_weight_tls;
-  std::vector<double>& bin_weight = bin_weight_tls;
+  struct Scratch {
+    BinTable bin_of;
+    std::vector<BinKey> keys;
+    std::vector<int> particle_bin, parent, cluster_of_root, cluster;
+    std::vector<double> bin_weight, sin_yaw, cos_yaw, sums, moments;
+  };
+  Scratch& scratch = threadScratch<Scratch>();
+  BinTable& bin_of = scratch.bin_of;
+  std::vector<BinKey>& keys = scratch.keys;
+  std::vector<int>& particle_bin = scratch.particle_bin;
+  std::vector<int>& parent = scratch.parent;
+  std::vector<int>& cluster_of_root = scratch.cluster_of_root;
+  std::vector<int>& cluster = scratch.cluster;
+  std::vector<double>& bin_weight = scratch.bin_weight;
   bin_of.reset(particles.size());
   keys.clear();
   particle_bin.resize(particles.size());
@@ -149,16 +151,14 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
   }
   // The headings' sines and cosines for the whole cloud at once (sinCos
   // vectorises), for the mean directions.
-  thread_local std::vector<double> sin_yaw_tls, cos_yaw_tls;
-  std::vector<double>& sin_yaw = sin_yaw_tls;
-  std::vector<double>& cos_yaw = cos_yaw_tls;
+  std::vector<double>& sin_yaw = scratch.sin_yaw;
+  std::vector<double>& cos_yaw = scratch.cos_yaw;
   sin_yaw.resize(particles.size());
   cos_yaw.resize(particles.size());
   sinCos(particles.yaw.data(), particles.size(), sin_yaw.data(), cos_yaw.data());
   std::vector<Cluster> c(clusters);
   // Per cluster: the count, the weight and the weighted sums of x, y, sin, cos.
-  thread_local std::vector<double> sums_tls;
-  std::vector<double>& sums = sums_tls;
+  std::vector<double>& sums = scratch.sums;
   sums.assign(6 * static_cast<std::size_t>(clusters), 0.0);
   accumulateRuns<6>(cluster, sums.data(), [&](std::size_t i, double* a) {
     const double w = particles.weight[i];
@@ -179,8 +179,7 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
   // The second moments in plain arrays (an Eigen temporary per particle went
   // through the stack and stalled on store forwarding), with the same
   // products in the same order as w d d^T.
-  thread_local std::vector<double> moments_tls;
-  std::vector<double>& moments = moments_tls;
+  std::vector<double>& moments = scratch.moments;
   moments.assign(9 * static_cast<std::size_t>(clusters), 0.0);
   accumulateRuns<9>(cluster, moments.data(), [&](std::size_t i, double* m) {
     const Cluster& k = c[cluster[i]];

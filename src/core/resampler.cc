@@ -6,6 +6,7 @@
 
 #include "pf_localization/core/bin_index.h"
 #include "pf_localization/core/bin_table.h"
+#include "pf_localization/core/thread_scratch.h"
 
 namespace pf {
 
@@ -89,12 +90,13 @@ std::size_t kldParticleCount(const ParticleSet& particles, const KldParams& para
   // will be empty after resampling and must not inflate k.
   const double threshold = particles.empty() ? 0.0 : 1.0 / static_cast<double>(particles.size());
   // Kept between calls (per thread), so that binning allocates nothing.
-  // Each used through a reference taken once: in a shared library every
-  // access to a thread_local is a call (__tls_get_addr), per particle here.
-  thread_local BinTable bins_tls;
-  BinTable& bins = bins_tls;
-  thread_local std::vector<double> bin_weight_tls;
-  std::vector<double>& bin_weight = bin_weight_tls;
+  struct Scratch {
+    BinTable bins;
+    std::vector<double> bin_weight;
+  };
+  Scratch& scratch = threadScratch<Scratch>();
+  BinTable& bins = scratch.bins;
+  std::vector<double>& bin_weight = scratch.bin_weight;
   bins.reset(particles.size());
   bin_weight.clear();
   // Resampling leaves the copies of one particle side by side, so the bin of

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "pf_localization/core/fast_math.h"
+#include "pf_localization/core/thread_scratch.h"
 
 namespace pf {
 namespace {
@@ -17,8 +18,11 @@ double effectiveSampleSize(const std::vector<double>& log_prior,
     max_log = std::max(max_log, log_prior[i] + beta * log_likelihood[i]);
   }
   if (!std::isfinite(max_log)) return 0.0;
-  thread_local std::vector<double> w_tls;  // kept: no allocation per update
-  std::vector<double>& w = w_tls;
+  struct WScratch {
+    std::vector<double> w;
+  };  // kept: no allocation per update
+  WScratch& w_scratch = threadScratch<WScratch>();
+  std::vector<double>& w = w_scratch.w;
   w.resize(log_prior.size());
   for (std::size_t i = 0; i < log_prior.size(); ++i) {
     w[i] = log_prior[i] + beta * log_likelihood[i] - max_log;
@@ -141,8 +145,11 @@ double applyLikelihood(const std::vector<double>& ll, double min_ess_fraction,
 
 double meanBeamLikelihood(const std::vector<double>& weights,
                           const std::vector<double>& log_likelihood, double beams) {
-  thread_local std::vector<double> per_beam_tls;  // kept: no allocation per update
-  std::vector<double>& per_beam = per_beam_tls;
+  struct PerBeamScratch {
+    std::vector<double> per_beam;
+  };  // kept: no allocation per update
+  PerBeamScratch& per_beam_scratch = threadScratch<PerBeamScratch>();
+  std::vector<double>& per_beam = per_beam_scratch.per_beam;
   const std::size_t n = weights.size();
   per_beam.resize(n);
   for (std::size_t i = 0; i < n; ++i) per_beam[i] = log_likelihood[i] / beams;
