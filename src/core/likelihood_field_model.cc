@@ -5,7 +5,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "pf_localization/core/fast_math.h"
 #include "pf_localization/core/parameter_check.h"
+#include "pf_localization/core/thread_scratch.h"
 
 namespace pf {
 namespace {
@@ -113,13 +115,13 @@ struct ScoringFrame {
   std::size_t beams;
 };
 
-// Scores particles [begin, end). Cloned for AVX2 next to the portable
-// version: the beam loop vectorises, and the best clone is picked at load.
-__attribute__((target_clones("avx2", "default"))) void scoreParticles(const ScoringFrame& f,
-                                                                      const ParticleSet& particles,
-                                                                      std::size_t begin,
-                                                                      std::size_t end,
-                                                                      double* out) {
+// Scores particles [begin, end), whose headings in the grid's frame have
+// the sines and cosines `sin_yaw` and `cos_yaw`. Cloned for AVX2 next to the
+// portable version: the beam loop vectorises, and the best clone is picked
+// at load.
+__attribute__((target_clones("avx2", "default"))) void scoreParticles(
+    const ScoringFrame& f, const ParticleSet& particles, const double* sin_yaw,
+    const double* cos_yaw, std::size_t begin, std::size_t end, double* out) {
   // Locals, not the frame's fields: the compiler can then prove that the
   // stores to `out` change none of them, and vectorises the beam loop.
   const float* table = f.table;
@@ -135,9 +137,8 @@ __attribute__((target_clones("avx2", "default"))) void scoreParticles(const Scor
     const float px = static_cast<float>((f.origin_cos * dx + f.origin_sin * dy) * f.inv_res) + 1.0f;
     const float py =
         static_cast<float>((-f.origin_sin * dx + f.origin_cos * dy) * f.inv_res) + 1.0f;
-    const float yaw = static_cast<float>(particles.yaw[i] - f.origin.yaw);
-    const float c = std::cos(yaw);
-    const float s = std::sin(yaw);
+    const float c = static_cast<float>(cos_yaw[i]);
+    const float s = static_cast<float>(sin_yaw[i]);
     float sum = 0.0f;
     for (std::size_t b = 0; b < beams; ++b) {
       // Clamping before truncation sends every point outside the map to the
@@ -208,9 +209,31 @@ void LikelihoodFieldModel::score(const float* bx, const float* by, std::size_t b
                                  std::vector<double>* log_likelihood) const {
   const ScoringFrame frame = scoringFrame(field_.grid(), table_.data(), bx, by, beams);
   log_likelihood->resize(particles.size());
+  // The headings' sines and cosines for the whole cloud at once (sinCos
+  // vectorises), not one C library call per particle. Kept per thread: no
+  // allocation per update.
+  const std::size_t n = particles.size();
+  struct HeadingScratch {
+    std::vector<double> heading, sin_yaw, cos_yaw;
+  };
+  HeadingScratch& heading_scratch = threadScratch<HeadingScratch>();
+  std::vector<double>& heading = heading_scratch.heading;
+  std::vector<double>& sin_yaw = heading_scratch.sin_yaw;
+  std::vector<double>& cos_yaw = heading_scratch.cos_yaw;
+  sin_yaw.resize(n);
+  cos_yaw.resize(n);
+  const double* yaw = particles.yaw.data();
+  if (frame.origin.yaw != 0.0) {
+    heading.resize(n);
+    for (std::size_t i = 0; i < n; ++i) heading[i] = particles.yaw[i] - frame.origin.yaw;
+    yaw = heading.data();
+  }
+  sinCos(yaw, n, sin_yaw.data(), cos_yaw.data());
+  const double* s = sin_yaw.data();
+  const double* c = cos_yaw.data();
   const int threads = params_.threads;
   if (threads <= 1) {
-    scoreParticles(frame, particles, 0, particles.size(), log_likelihood->data());
+    scoreParticles(frame, particles, s, c, 0, n, log_likelihood->data());
     return;
   }
   // One contiguous slice per thread; every particle's score is computed
@@ -220,7 +243,7 @@ void LikelihoodFieldModel::score(const float* bx, const float* by, std::size_t b
 #endif
   for (int t = 0; t < threads; ++t) {
     const std::size_t size = particles.size();
-    scoreParticles(frame, particles, size * t / threads, size * (t + 1) / threads,
+    scoreParticles(frame, particles, s, c, size * t / threads, size * (t + 1) / threads,
                    log_likelihood->data());
   }
 }

@@ -5,6 +5,9 @@
 #include <stdexcept>
 #include <string>
 
+#include "pf_localization/core/fast_math.h"
+#include "pf_localization/core/thread_scratch.h"
+
 namespace pf {
 namespace {
 
@@ -96,16 +99,36 @@ void OdometryMotionModel::applyDifferential(const Pose2& from, const Pose2& to,
       std::sqrt(params_.alpha3 * trans2 + params_.alpha4 * (rot1 * rot1 + rot2 * rot2));
   const double sigma_rot2 = std::sqrt(params_.alpha1 * rot2 * rot2 + params_.alpha2 * trans2);
 
+  // Two passes: the random draws, one particle after the other (the random
+  // stream is the same as drawing and moving each particle in turn), then
+  // the headings' sines and cosines for the whole cloud at once (sinCos
+  // vectorises; one C library call per particle was most of this step).
   ParticleSet& p = *particles;
-  for (std::size_t i = 0; i < p.size(); ++i) {
+  const std::size_t n = p.size();
+  struct TransScratch {
+    std::vector<double> trans, turn2, s, c;
+  };  // kept: no allocation per update
+  TransScratch& trans_scratch = threadScratch<TransScratch>();
+  std::vector<double>& trans = trans_scratch.trans;
+  std::vector<double>& turn2 = trans_scratch.turn2;
+  std::vector<double>& s = trans_scratch.s;
+  std::vector<double>& c = trans_scratch.c;
+  trans.resize(n);
+  turn2.resize(n);
+  s.resize(n);
+  c.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
     const double r1 = step.rot1 - random->gaussian(sigma_rot1);
-    const double t = sampleTranslation(step.trans, sigma_trans, fault_fraction,
-                                       params_.fault_margin, random, &faulty[i]);
-    const double r2 = step.rot2 - random->gaussian(sigma_rot2);
-    const double heading = p.yaw[i] + r1;
-    p.x[i] += t * std::cos(heading);
-    p.y[i] += t * std::sin(heading);
-    p.yaw[i] = normalizeAngle(heading + r2);
+    trans[i] = sampleTranslation(step.trans, sigma_trans, fault_fraction, params_.fault_margin,
+                                 random, &faulty[i]);
+    turn2[i] = step.rot2 - random->gaussian(sigma_rot2);
+    p.yaw[i] += r1;  // the heading of travel, until the last pass
+  }
+  sinCos(p.yaw.data(), n, s.data(), c.data());
+  for (std::size_t i = 0; i < n; ++i) {
+    p.x[i] += trans[i] * c[i];
+    p.y[i] += trans[i] * s[i];
+    p.yaw[i] = normalizeAngle(p.yaw[i] + turn2[i]);
   }
 }
 

@@ -14,23 +14,6 @@ namespace {
 
 bool finite(double v) { return std::isfinite(v); }
 
-// ESS of the weights prior * likelihood^beta, from their logarithms.
-double effectiveSampleSize(const std::vector<double>& log_prior,
-                           const std::vector<double>& log_likelihood, double beta) {
-  double max_log = -std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < log_prior.size(); ++i) {
-    max_log = std::max(max_log, log_prior[i] + beta * log_likelihood[i]);
-  }
-  if (!std::isfinite(max_log)) return 0.0;
-  double sum = 0.0, sum_sq = 0.0;
-  for (std::size_t i = 0; i < log_prior.size(); ++i) {
-    const double w = std::exp(log_prior[i] + beta * log_likelihood[i] - max_log);
-    sum += w;
-    sum_sq += w * w;
-  }
-  return sum * sum / sum_sq;
-}
-
 }  // namespace
 
 void validate(const ParticleFilterParams& p) {
@@ -176,7 +159,10 @@ void ParticleFilter::reserveStorage(std::size_t max) {
   for (ParticleSet* set : {&particles_, &spare_}) {
     for (std::vector<double>* v : {&set->x, &set->y, &set->yaw, &set->weight}) prefault(v);
   }
-  for (std::vector<double>* v : {&scratch_, &log_prior_, &log_likelihood_}) prefault(v);
+  for (std::vector<double>* v :
+       {&weighting_.log_prior, &weighting_.log_posterior, &log_likelihood_}) {
+    prefault(v);
+  }
   prefault(&faulty_);
 }
 
@@ -410,21 +396,7 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
 
 void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
   const std::size_t beams_counted = model_->logLikelihoods(scan, particles_, &log_likelihood_);
-  // After a resampling every weight is the same, and a constant prior does
-  // not change the normalised result: zeros spare N logarithms.
-  // The prior's effective sample size is then N, too, without a pass of
-  // exponentials.
-  const std::vector<double>& w = particles_.weight;
   const std::vector<double>& ll = log_likelihood_;
-  double prior_ess = static_cast<double>(particles_.size());
-  if (std::all_of(w.begin(), w.end(), [&](double v) { return v == w.front(); })) {
-    log_prior_.assign(particles_.size(), 0.0);
-  } else {
-    log_prior_.resize(particles_.size());
-    for (std::size_t i = 0; i < particles_.size(); ++i) log_prior_[i] = std::log(w[i]);
-    prior_ess = effectiveSampleSize(log_prior_, ll, 0.0);
-  }
-  double beta = 1.0;
   // A filter that is not sure of itself weighs evidence more cautiously:
   // rival hypotheses (twin rooms) then survive until the scans really
   // separate them, instead of the luckiest one winning outright. Not when
@@ -436,41 +408,8 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
   const double fraction = fit_state_ == LocalizationState::kLocalized || spread_only
                               ? params_.tempering_ess_fraction
                               : params_.tempering_ess_fraction_uncertain;
-  // A share of the effective particles before the scan, not of all of them:
-  // recovery's barely weighted guesses count as particles but not as
-  // effective ones, and measured against N a cloud salted with them could
-  // never keep enough, so every scan was tempered away to nothing.
-  const double min_ess = fraction * prior_ess;
-  if (min_ess > 0.0 && effectiveSampleSize(log_prior_, ll, 1.0) < min_ess) {
-    // Bisection for the largest exponent that keeps min_ess particles.
-    double lo = 0.0, hi = 1.0;
-    for (int k = 0; k < 20; ++k) {
-      const double mid = 0.5 * (lo + hi);
-      (effectiveSampleSize(log_prior_, ll, mid) >= min_ess ? lo : hi) = mid;
-    }
-    beta = lo;
-  }
-  report->tempering = beta;
+  report->tempering = applyLikelihood(ll, fraction, &particles_.weight, &weighting_);
   report->beams_skipped = static_cast<int>(scan.size() - beams_counted);
-  scratch_.resize(particles_.size());
-  double max_log = -std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < particles_.size(); ++i) {
-    scratch_[i] = log_prior_[i] + beta * ll[i];
-    max_log = std::max(max_log, scratch_[i]);
-  }
-  // When every particle scores zero (possible with z_rand = 0: an end point
-  // far from any obstacle has likelihood exp(-800) = 0), max_log is -inf and
-  // normalising would give 0/0 = NaN weights, which the resampler collapses
-  // onto particle 0. Evidence that rules out all particles alike favours
-  // none: the weights are left as they were.
-  if (std::isfinite(max_log)) {
-    double total = 0.0;
-    for (std::size_t i = 0; i < particles_.size(); ++i) {
-      particles_.weight[i] = std::exp(scratch_[i] - max_log);
-      total += particles_.weight[i];
-    }
-    for (double& w : particles_.weight) w /= total;
-  }
   // How well the cloud explains the scan: the per-beam geometric mean
   // likelihood (independent of the beam count, so comparable across scans and
   // robots), averaged with the posterior weights. The posterior, not the
@@ -479,10 +418,7 @@ void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
   // Over the beams the model counted: beam skipping may leave some out.
   const double beams = static_cast<double>(std::max<std::size_t>(beams_counted, 1)) *
                        params_.sensor.likelihood_exponent;
-  double mean_beam = 0.0;
-  for (std::size_t i = 0; i < particles_.size(); ++i) {
-    mean_beam += particles_.weight[i] * std::exp(ll[i] / beams);
-  }
+  const double mean_beam = meanBeamLikelihood(particles_.weight, ll, beams);
   report->mean_beam_likelihood = mean_beam;
 
   expand_ = params_.recovery.expansion_ratio > 0.0 && w_slow_ > 0.0 &&

@@ -10,11 +10,8 @@ namespace {
 // acceptance bounds, w the scale from integer to x, f the density at each
 // layer's edge (Marsaglia & Tsang 2000, with r = 3.442619855899 and layer
 // area v = 9.91256303526217e-3).
-struct Ziggurat {
+struct Ziggurat : ZigguratTables {
   static constexpr double kR = 3.442619855899;
-  uint32_t k[128];
-  double w[128];
-  double f[128];
 
   Ziggurat() {
     constexpr double m = 2147483648.0;  // 2^31
@@ -51,20 +48,9 @@ uint64_t splitmix64(uint64_t* x) {
 
 }  // namespace
 
-Random::Random(uint64_t seed) {
+Random::Random(uint64_t seed) : zig_(&ziggurat()) {
+  // The tables are built now (the first Random), not inside the first update.
   for (uint64_t& word : s_) word = splitmix64(&seed);
-  ziggurat();  // build the tables now, not inside the first update
-}
-
-double Random::normal() {
-  const Ziggurat& z = ziggurat();
-  const uint64_t r = bits();
-  // The layer and the signed 32-bit abscissa come from disjoint bits.
-  const int layer = static_cast<int>(r & 127);
-  const int64_t hz = static_cast<int32_t>(r >> 32);
-  if (static_cast<uint64_t>(std::llabs(hz)) < z.k[layer])
-    return static_cast<double>(hz) * z.w[layer];
-  return normalTail(hz, layer);
 }
 
 double Random::normalTail(int64_t hz, int layer) {

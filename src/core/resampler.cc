@@ -6,6 +6,7 @@
 
 #include "pf_localization/core/bin_index.h"
 #include "pf_localization/core/bin_table.h"
+#include "pf_localization/core/thread_scratch.h"
 
 namespace pf {
 
@@ -89,15 +90,28 @@ std::size_t kldParticleCount(const ParticleSet& particles, const KldParams& para
   // will be empty after resampling and must not inflate k.
   const double threshold = particles.empty() ? 0.0 : 1.0 / static_cast<double>(particles.size());
   // Kept between calls (per thread), so that binning allocates nothing.
-  thread_local BinTable bins;
-  thread_local std::vector<double> bin_weight;
+  struct Scratch {
+    BinTable bins;
+    std::vector<double> bin_weight;
+  };
+  Scratch& scratch = threadScratch<Scratch>();
+  BinTable& bins = scratch.bins;
+  std::vector<double>& bin_weight = scratch.bin_weight;
   bins.reset(particles.size());
   bin_weight.clear();
+  // Resampling leaves the copies of one particle side by side, so the bin of
+  // the particle before is the likeliest: it spares most hash look-ups.
+  uint64_t last_key = ~uint64_t{0};
+  int id = -1;
   for (std::size_t i = 0; i < particles.size(); ++i) {
-    const int id = bins.insert(BinTable::key(binIndex(particles.x[i], params.bin_xy),
-                                             binIndex(particles.y[i], params.bin_xy),
-                                             binIndex(particles.yaw[i], params.bin_yaw)));
-    if (static_cast<std::size_t>(id) == bin_weight.size()) bin_weight.push_back(0.0);
+    const uint64_t key = BinTable::key(binIndex(particles.x[i], params.bin_xy),
+                                       binIndex(particles.y[i], params.bin_xy),
+                                       binIndex(particles.yaw[i], params.bin_yaw));
+    if (key != last_key) {
+      id = bins.insert(key);
+      last_key = key;
+      if (static_cast<std::size_t>(id) == bin_weight.size()) bin_weight.push_back(0.0);
+    }
     bin_weight[id] += particles.weight[i];
   }
   std::size_t k = 0;

@@ -38,6 +38,7 @@
 #include "pf_localization/core/resampler.h"
 #include "pf_localization/core/scan_refiner.h"
 #include "pf_localization/core/sensor_model.h"
+#include "pf_localization/core/weighting.h"
 
 namespace pf {
 
@@ -277,8 +278,7 @@ class ParticleFilter {
   std::vector<uint8_t> faulty_;  // which particles took an odometry fault in this update
   int settle_left_ = 0;          // updates until a jumped estimate may be localized (holdAfterJump)
   bool expand_ = false;          // this scan's fit collapsed: spread the survivors
-  std::vector<double> scratch_;
-  std::vector<double> log_prior_;
+  WeightingScratch weighting_;
   std::vector<double> log_likelihood_;
 };
 

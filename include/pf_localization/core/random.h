@@ -16,6 +16,14 @@
 
 namespace pf {
 
+// The ziggurat's 128 layers (random.cc): k are the acceptance bounds, w the
+// scale from integer to x, f the density at each layer's edge.
+struct ZigguratTables {
+  uint32_t k[128];
+  double w[128];
+  double f[128];
+};
+
 class Random {
  public:
   explicit Random(uint64_t seed);
@@ -40,8 +48,17 @@ class Random {
   uint64_t index(uint64_t n) {
     return static_cast<uint64_t>((static_cast<unsigned __int128>(bits()) * n) >> 64);
   }
-  /// Standard normal variate.
-  double normal();
+  /// Standard normal variate. The common case is inline, so that a loop
+  /// drawing one per particle stays a tight loop.
+  double normal() {
+    const uint64_t r = bits();
+    // The layer and the signed 32-bit abscissa come from disjoint bits.
+    const int layer = static_cast<int>(r & 127);
+    const int64_t hz = static_cast<int32_t>(r >> 32);
+    const uint64_t magnitude = static_cast<uint64_t>(hz < 0 ? -hz : hz);
+    if (magnitude < zig_->k[layer]) return static_cast<double>(hz) * zig_->w[layer];
+    return normalTail(hz, layer);
+  }
   /// Zero-mean normal with standard deviation sigma (sigma <= 0 gives 0).
   double gaussian(double sigma) { return sigma > 0.0 ? sigma * normal() : 0.0; }
 
@@ -50,6 +67,7 @@ class Random {
   double normalTail(int64_t hz, int layer);
 
   std::array<uint64_t, 4> s_;
+  const ZigguratTables* zig_;
 };
 
 }  // namespace pf
