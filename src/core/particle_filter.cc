@@ -348,7 +348,17 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
 
   // Where the last estimate would be now had the odometry been right.
   const std::optional<Pose2> before = mapToOdom();
+  // A fault changes the odometry's translation by twice its length
+  // (reversed) or by it (stalled): on a step shorter than half
+  // odom_fault_margin even a reversal stays within the stalled particles' own
+  // spread, so a scan cannot tell faulty particles from the others, and what
+  // weight they win by chance must not grow their share (intel_lab: eight
+  // turns on the spot raised it to its maximum, and the next 0.9 m step then
+  // spread the cloud 0.6 m).
+  bool faults_observable = false;
   if (!first) {
+    const Pose2 step = between(*odom_at_update_, odom);
+    faults_observable = 2.0 * std::hypot(step.x, step.y) >= params_.motion.fault_margin;
     motion_model_.apply(*odom_at_update_, odom, fault_fraction_, &particles_, &random_, &faulty_);
   }
   odom_at_update_ = odom;
@@ -356,7 +366,7 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
   force_update_ = false;
 
   weigh(prepared, &report);
-  if (!first) adaptFaultFraction();
+  if (faults_observable) adaptFaultFraction();
   report.fault_fraction = fault_fraction_;
   report.ess = effectiveSampleSize(particles_.weight);
   // The estimate comes from the weighted cloud, before resampling: resampling

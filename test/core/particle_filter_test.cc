@@ -583,10 +583,11 @@ TEST(ParticleFilterUpdate, AWideCloudWhoseBeamsFitIsNotTempered) {
 // The share of particles the filter gives to odometry faults after each of
 // `steps` updates in which the odometry reports 0.3 m forwards along x and the
 // scans are taken at `truth_step` metres per update from `start`.
-std::vector<double> faultShares(double truth_step, int steps) {
+std::vector<double> faultShares(double truth_step, int steps, double odom_step = 0.3) {
   const OccupancyGrid grid = trackingRoom();
   ParticleFilterParams params = exactParams();
   params.kld.min_particles = params.kld.max_particles = 1000;
+  params.update_min_d = 0.0;  // every step updates, however short
   params.motion.fault_fraction = 0.02;
   params.motion.fault_fraction_max = 0.5;
   params.motion.fault_margin = 0.05;
@@ -598,11 +599,20 @@ std::vector<double> faultShares(double truth_step, int steps) {
   std::vector<double> shares;
   for (int k = 1; k <= steps; ++k) {
     const UpdateReport r = filter.update(
-        {0.3 * k, 0.0, 0.0}, simulateScan(grid, {start.x + truth_step * k, start.y, 0.0}));
+        {odom_step * k, 0.0, 0.0}, simulateScan(grid, {start.x + truth_step * k, start.y, 0.0}));
     EXPECT_TRUE(r.updated) << r.skip_reason;
     shares.push_back(r.fault_fraction);
   }
   return shares;
+}
+
+TEST(ParticleFilterUpdate, StepsTooShortToShowAFaultLeaveTheFaultShareAlone) {
+  // 0.02 m steps reversed: twice that is below the 0.05 m margin within
+  // which stalled particles spread anyway, so the scans cannot tell and the
+  // share stays at the floor (it would climb to the maximum otherwise).
+  for (double share : faultShares(-0.02, 4, 0.02)) EXPECT_DOUBLE_EQ(0.02, share);
+  // 0.03 m steps reversed are 0.06 m off: observable, and the share rises.
+  EXPECT_GT(faultShares(-0.03, 4, 0.03).back(), 0.02);
 }
 
 TEST(ParticleFilterUpdate, TheFaultShareRisesWhileTheOdometryIsReversedAndFallsBack) {
