@@ -346,8 +346,10 @@ TEST(ParticleFilterUpdate, RunsOnTheFirstScanThenOnlyAfterMotion) {
   ParticleFilterParams params = baseParams();  // update_min_d 0.2 m, update_min_a pi/6
   // The odometry below moves while the scan stays: only the thresholds are
   // under test here, not the check that the scan still fits (see
-  // AScanThatStopsFittingThePredictedPoseUpdatesAtOnce).
+  // AScanThatStopsFittingThePredictedPoseUpdatesAtOnce), nor the odometry
+  // faults the stalled particles would find (SuspectOdometryUpdatesOnEveryScan).
   params.update_fit_drop = 0.0;
+  params.motion.fault_fraction = 0.0;
   ParticleFilter filter(params);
   filter.setMap(grid);
   filter.initializeGaussian({1.0, 1.5, 0.0}, diag(0.1, 0.1, 0.1));
