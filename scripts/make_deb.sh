@@ -97,7 +97,10 @@ for d in "${rundeps[@]}"; do
     # messages and services, tf2_geometry_msgs, Eigen: headers, compiled in
     tf2_msgs|sensor_msgs|nav_msgs|geometry_msgs|std_srvs|diagnostic_msgs|tf2_geometry_msgs|eigen) ;;
     roslaunch) ;;          # python3-roslaunch (above)
-    python3-numpy) ;;      # above
+    python3-numpy|python3-yaml) ;;  # above
+    # pf_tune only (Optuna, Dask, its plots and progress bar): suggested, not
+    # forced on a robot that only localizes
+    python3-optuna|python3-distributed|python3-sklearn|python3-scipy|python3-tqdm) suggests+=("$d") ;;
     python3-matplotlib) ;; # pf_evaluate's plots only: recommended
     rviz) ;;               # bag_demo.launch rviz:=true only: recommended (Qt, OGRE)
     *) die "package.xml's run dependency '$d' has no Debian package in scripts/make_deb.sh: add it to the table" ;;
