@@ -18,6 +18,17 @@ void require(bool ok, const std::string& what) {
 
 }  // namespace
 
+void validateBeamSkip(const LikelihoodFieldModelParams& params) {
+  if (!params.beam_skip) return;
+  requireParameter(params.beam_skip_distance > 0.0 && std::isfinite(params.beam_skip_distance),
+                   "beam_skip_distance", "> 0", params.beam_skip_distance);
+  requireParameter(params.beam_skip_threshold >= 0.0 && params.beam_skip_threshold <= 1.0,
+                   "beam_skip_threshold", "in [0, 1]", params.beam_skip_threshold);
+  requireParameter(
+      params.beam_skip_error_threshold >= 0.0 && params.beam_skip_error_threshold <= 1.0,
+      "beam_skip_error_threshold", "in [0, 1]", params.beam_skip_error_threshold);
+}
+
 LikelihoodFieldModel::LikelihoodFieldModel(const OccupancyGrid& grid,
                                            const LikelihoodFieldModelParams& params)
     : params_(params), field_(grid, params.max_distance) {
@@ -36,14 +47,8 @@ LikelihoodFieldModel::LikelihoodFieldModel(const OccupancyGrid& grid,
           "laser_max_beams must be >= 1, got " + std::to_string(params.max_beams));
   require(params.range_min >= 0.0 && params.range_max >= 0.0,
           "laser_min_range and laser_max_range must be >= 0");
+  validateBeamSkip(params);
   if (!params.beam_skip) return;
-  requireParameter(params.beam_skip_distance > 0.0 && std::isfinite(params.beam_skip_distance),
-                   "beam_skip_distance", "> 0", params.beam_skip_distance);
-  requireParameter(params.beam_skip_threshold >= 0.0 && params.beam_skip_threshold <= 1.0,
-                   "beam_skip_threshold", "in [0, 1]", params.beam_skip_threshold);
-  requireParameter(
-      params.beam_skip_error_threshold >= 0.0 && params.beam_skip_error_threshold <= 1.0,
-      "beam_skip_error_threshold", "in [0, 1]", params.beam_skip_error_threshold);
   const int stride = grid.width() + 2;
   near_.assign(static_cast<std::size_t>(stride) * (grid.height() + 2), 0);
   const std::vector<float>& dist = field_.distances();

@@ -96,14 +96,7 @@ void validate(const ParticleFilterParams& p) {
     requireParameter(p.beam.lambda_short > 0.0 && finite(p.beam.lambda_short), "laser_lambda_short",
                      "> 0", p.beam.lambda_short);
   }
-  if (s.beam_skip) {
-    requireParameter(s.beam_skip_distance > 0.0 && finite(s.beam_skip_distance),
-                     "beam_skip_distance", "> 0", s.beam_skip_distance);
-    requireParameter(s.beam_skip_threshold >= 0.0 && s.beam_skip_threshold <= 1.0,
-                     "beam_skip_threshold", "in [0, 1]", s.beam_skip_threshold);
-    requireParameter(s.beam_skip_error_threshold >= 0.0 && s.beam_skip_error_threshold <= 1.0,
-                     "beam_skip_error_threshold", "in [0, 1]", s.beam_skip_error_threshold);
-  }
+  validateBeamSkip(s);
   const auto& m = p.motion;
   const double alphas[] = {m.alpha1, m.alpha2, m.alpha3, m.alpha4, m.alpha5};
   for (int i = 0; i < 5; ++i) {

@@ -60,6 +60,11 @@ struct LikelihoodFieldModelParams {
   double beam_skip_error_threshold = 0.9;  // skip nothing when this share would be skipped, [0, 1]
 };
 
+/// When params.beam_skip is set, throws std::invalid_argument naming the
+/// first beam_skip_* parameter out of range; the start-up check
+/// (pf::validate) and the model's constructor share it.
+void validateBeamSkip(const LikelihoodFieldModelParams& params);
+
 class LikelihoodFieldModel : public SensorModel {
  public:
   /// Throws std::invalid_argument naming the parameter when one is out of range.
