@@ -297,9 +297,10 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
 
   const bool first = restart_ || !odom_at_update_;
   std::optional<PreparedScan> checked;  // prepared for the fit check, reused by the update
+  double step = 0.0;                    // m of odometry since the last update
   if (!first) {
     const Pose2 delta = between(*odom_at_update_, odom);
-    const double step = std::hypot(delta.x, delta.y);
+    step = std::hypot(delta.x, delta.y);
     if (!(step <= params_.odom_jump_limit)) {
       // Wheels do not carry a robot this far between two scans: the odometry
       // was reset or glitched. Moving the particles by it would throw them
@@ -348,10 +349,8 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
   // weight they win by chance must not grow their share (intel_lab: eight
   // turns on the spot raised it to its maximum, and the next 0.9 m step then
   // spread the cloud 0.6 m).
-  bool faults_observable = false;
+  const bool faults_observable = !first && 2.0 * step >= params_.motion.fault_margin;
   if (!first) {
-    const Pose2 step = between(*odom_at_update_, odom);
-    faults_observable = 2.0 * std::hypot(step.x, step.y) >= params_.motion.fault_margin;
     motion_model_.apply(*odom_at_update_, odom, fault_fraction_, &particles_, &random_, &faulty_);
   }
   odom_at_update_ = odom;
