@@ -209,7 +209,7 @@ class PfNode {
     ROS_INFO("pf_node: map %u x %u cells at %.3f m; %zu particles", map.info.width, map.info.height,
              map.info.resolution, localizer_.filter().particles().size());
     publishEstimate(map.header.stamp, true);
-    republisher_->set(localizer_.mapToOdom(ros::Time()), ros::Time());
+    filterChanged(ros::Time());
     return true;
   }
 
@@ -290,7 +290,7 @@ class PfNode {
     last_odom_ = result.odom;
     last_scan_stamp_ = scan.header.stamp;
     // map -> odom first: tf users wait for it, nobody waits for the rest.
-    republisher_->set(localizer_.mapToOdom(ros::Time()), scan.header.stamp);
+    filterChanged(scan.header.stamp);
     if (r.updated) {
       timing_.addUpdate((ros::WallTime::now() - pending.arrival_wall).toSec(),
                         (pending.arrival_clock - scan.header.stamp).toSec(), update_s);
@@ -323,7 +323,7 @@ class PfNode {
     if (!error.empty()) ROS_WARN("pf_node: %s", error.c_str());
     last_scan_stamp_ = ros::Time();
     republisher_->reset();
-    republisher_->set(localizer_.mapToOdom(ros::Time()), ros::Time());
+    filterChanged(ros::Time());
     return true;
   }
 
@@ -418,7 +418,7 @@ class PfNode {
     ROS_INFO("pf_node: re-initialised at (%.3f, %.3f, %.3f) in %s", p.x, p.y, p.yaw,
              config_.global_frame.c_str());
     publishEstimate(pose.header.stamp, true);
-    republisher_->set(localizer_.mapToOdom(ros::Time()), ros::Time());
+    filterChanged(ros::Time());
     return true;
   }
 
@@ -469,7 +469,7 @@ class PfNode {
     ROS_INFO("pf_node: global localization: %zu particles over the free space",
              localizer_.filter().particles().size());
     publishEstimate(ros::Time::now(), true);
-    republisher_->set(localizer_.mapToOdom(ros::Time()), ros::Time());
+    filterChanged(ros::Time());
     return true;
   }
 
@@ -527,26 +527,46 @@ class PfNode {
     last_cloud_stamp_ = stamp;
   }
 
+  // filter_mutex_ held, after anything that moved the filter: map -> odom
+  // goes to the republisher and the pose to the saver, neither of which
+  // may wait for the filter (an update can hold it for longer than a scan
+  // period: a saver on the main spinner that waited would hold back the
+  // scans and odometry queued behind it).
+  void filterChanged(const ros::Time& scan_stamp) {
+    republisher_->set(localizer_.mapToOdom(ros::Time()), scan_stamp);
+    std::optional<PoseToSave> next;
+    if (const auto estimate = localizer_.estimate(ros::Time())) {
+      // The estimate is as old as the last filter update; the odometry of
+      // the latest scan (used or not) carries it to the robot's pose then.
+      pf::Pose2 pose = toPose2(estimate->pose.pose);
+      const auto map_to_odom = localizer_.filter().mapToOdom();
+      if (map_to_odom && last_odom_) pose = pf::compose(*map_to_odom, *last_odom_);
+      if (pose.isFinite()) {
+        next = PoseToSave{pose, estimate->pose.covariance[0], estimate->pose.covariance[7],
+                          estimate->pose.covariance[35]};
+      }
+    }
+    std::lock_guard<std::mutex> lock(save_mutex_);
+    pose_to_save_ = next;
+  }
+
   // As amcl does: the pose goes to ~initial_pose_* and its variances to
   // ~initial_cov_*, where readConfig finds them, so that a node restarted
   // under the same master (respawn, a crash, a relaunch of this node alone)
   // resumes where the robot is instead of starting over.
   void savePose() {
-    std::lock_guard<std::mutex> lock(filter_mutex_);
-    const auto estimate = localizer_.estimate(ros::Time());
-    if (!estimate) return;
-    pf::Pose2 pose = toPose2(estimate->pose.pose);
-    // The estimate is as old as the last filter update; the odometry since
-    // then carries it to the robot's latest pose.
-    const auto map_to_odom = localizer_.filter().mapToOdom();
-    if (map_to_odom && last_odom_) pose = pf::compose(*map_to_odom, *last_odom_);
-    if (!pose.isFinite()) return;
-    pnh_.setParam("initial_pose_x", pose.x);
-    pnh_.setParam("initial_pose_y", pose.y);
-    pnh_.setParam("initial_pose_a", pose.yaw);
-    pnh_.setParam("initial_cov_xx", estimate->pose.covariance[0]);
-    pnh_.setParam("initial_cov_yy", estimate->pose.covariance[7]);
-    pnh_.setParam("initial_cov_aa", estimate->pose.covariance[35]);
+    std::optional<PoseToSave> saved;
+    {
+      std::lock_guard<std::mutex> lock(save_mutex_);
+      saved = pose_to_save_;
+    }
+    if (!saved) return;
+    pnh_.setParam("initial_pose_x", saved->pose.x);
+    pnh_.setParam("initial_pose_y", saved->pose.y);
+    pnh_.setParam("initial_pose_a", saved->pose.yaw);
+    pnh_.setParam("initial_cov_xx", saved->cov_xx);
+    pnh_.setParam("initial_cov_yy", saved->cov_yy);
+    pnh_.setParam("initial_cov_aa", saved->cov_aa);
   }
 
   // Ctrl-C (and roslaunch's shutdown) saves the latest pose before the node
@@ -593,6 +613,14 @@ class PfNode {
   std::optional<pf::LocalizationState> last_state_;
   ros::ServiceServer global_srv_, nomotion_srv_, set_map_srv_;
   ros::Timer save_timer_;
+  // The pose savePose() writes, kept by filterChanged(): its own small lock,
+  // so that the saver never waits for an update.
+  struct PoseToSave {
+    pf::Pose2 pose;
+    double cov_xx, cov_yy, cov_aa;
+  };
+  std::mutex save_mutex_;
+  std::optional<PoseToSave> pose_to_save_;
   ros::WallTimer sigint_timer_;
   ros::Time last_scan_stamp_, last_cloud_stamp_;
   LimitedLog log_{kLogPeriod};
