@@ -22,6 +22,7 @@
 #include <nav_msgs/OccupancyGrid.h>
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/SetMap.h>
+#include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
 #include <std_srvs/Empty.h>
@@ -139,8 +140,6 @@ class PfNode {
     }
     reconfigure_ = std::make_unique<ReconfigureServer>(
         pnh_, config, [this](const LocalizerConfig& c) { return reconfigure(c); }, "pf_node");
-    // Wall time: a paused bag clock must not keep Ctrl-C waiting.
-    sigint_timer_ = nh_.createWallTimer(ros::WallDuration(0.1), &PfNode::onSigintCheck, this);
     if (config.initial_pose) {
       ROS_INFO("pf_node: initial pose (%.3f, %.3f, %.3f) in %s; waiting for a map",
                config.initial_pose->x, config.initial_pose->y, config.initial_pose->yaw,
@@ -216,7 +215,8 @@ class PfNode {
   void onOdom(const nav_msgs::OdometryConstPtr& msg) {
     // Robots that publish odometry only as a topic get it into the tf buffer
     // here. When tf carries it too (the usual case) the topic is ignored:
-    // tf2 would otherwise see every odometry stamp twice.
+    // tf2 would otherwise see every odometry stamp twice, and onTf
+    // unsubscribes from it.
     if (msg->header.frame_id.empty() || msg->child_frame_id.empty()) {
       warn("odom frames", "odometry message with an empty frame_id or child_frame_id: ignored");
       return;
@@ -239,6 +239,9 @@ class PfNode {
       if (t.header.frame_id == config_.odom_frame && t.child_frame_id == config_.base_frame) {
         odom_on_tf_ = true;
         tf_watch_sub_.shutdown();
+        // Nor is the odometry topic needed any more: unsubscribed, its
+        // messages no longer wake this node (twice the scans' rate, often).
+        odom_sub_.shutdown();
         ROS_INFO("pf_node: odometry %s -> %s comes from tf", config_.odom_frame.c_str(),
                  config_.base_frame.c_str());
         return;
@@ -569,15 +572,25 @@ class PfNode {
     pnh_.setParam("initial_cov_aa", saved->cov_aa);
   }
 
+ public:
+  // The main spinner: roscpp's own loop (ros::spin() waits on the queue
+  // with the same 0.1 s of wall time), plus a look at Ctrl-C after each
+  // wait, so that no timer thread has to wake ten times a second for it.
   // Ctrl-C (and roslaunch's shutdown) saves the latest pose before the node
-  // goes: the periodic save may be up to 1 / save_pose_rate old.
-  void onSigintCheck(const ros::WallTimerEvent&) {
-    if (!g_sigint) return;
-    // Without a master the save would block, waiting for one.
-    if (config_.save_pose_rate > 0.0 && ros::master::check()) savePose();
-    ros::shutdown();
+  // goes: the periodic save may be up to 1 / save_pose_rate old. Wall
+  // time: a paused bag clock must not keep Ctrl-C waiting.
+  void spin() {
+    ros::CallbackQueue* queue = ros::getGlobalCallbackQueue();
+    while (ros::ok()) {
+      queue->callAvailable(ros::WallDuration(0.1));
+      if (!g_sigint) continue;
+      // Without a master the save would block, waiting for one.
+      if (config_.save_pose_rate > 0.0 && ros::master::check()) savePose();
+      ros::shutdown();
+    }
   }
 
+ private:
   void warn(const std::string& key, const std::string& text) {
     int suppressed = 0;
     if (!log_.due(key, &suppressed)) return;
@@ -621,7 +634,6 @@ class PfNode {
   };
   std::mutex save_mutex_;
   std::optional<PoseToSave> pose_to_save_;
-  ros::WallTimer sigint_timer_;
   ros::Time last_scan_stamp_, last_cloud_stamp_;
   LimitedLog log_{kLogPeriod};
   std::unique_ptr<ReconfigureServer> reconfigure_;
@@ -659,6 +671,6 @@ int main(int argc, char** argv) {
   }
   pf_ros::PfNode node(config, nh, pnh);
   pf_ros::g_node_running = 1;
-  ros::spin();
+  node.spin();
   return 0;
 }
