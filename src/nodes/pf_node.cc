@@ -156,6 +156,23 @@ class PfNode {
     filter_thread_.join();
   }
 
+  // The main spinner: roscpp's own loop (ros::spin() waits on the queue
+  // with the same 0.1 s of wall time), plus a look at Ctrl-C after each
+  // wait, so that no timer thread has to wake ten times a second for it.
+  // Ctrl-C (and roslaunch's shutdown) saves the latest pose before the node
+  // goes: the periodic save may be up to 1 / save_pose_rate old. Wall
+  // time: a paused bag clock must not keep Ctrl-C waiting.
+  void spin() {
+    ros::CallbackQueue* queue = ros::getGlobalCallbackQueue();
+    while (ros::ok()) {
+      queue->callAvailable(ros::WallDuration(0.1));
+      if (!g_sigint) continue;
+      // Without a master the save would block, waiting for one.
+      if (config_.save_pose_rate > 0.0 && ros::master::check()) savePose();
+      ros::shutdown();
+    }
+  }
+
  private:
   void onMap(const nav_msgs::OccupancyGridConstPtr& msg) {
     if (config_.first_map_only && have_map_) {
@@ -572,25 +589,6 @@ class PfNode {
     pnh_.setParam("initial_cov_aa", saved->cov_aa);
   }
 
- public:
-  // The main spinner: roscpp's own loop (ros::spin() waits on the queue
-  // with the same 0.1 s of wall time), plus a look at Ctrl-C after each
-  // wait, so that no timer thread has to wake ten times a second for it.
-  // Ctrl-C (and roslaunch's shutdown) saves the latest pose before the node
-  // goes: the periodic save may be up to 1 / save_pose_rate old. Wall
-  // time: a paused bag clock must not keep Ctrl-C waiting.
-  void spin() {
-    ros::CallbackQueue* queue = ros::getGlobalCallbackQueue();
-    while (ros::ok()) {
-      queue->callAvailable(ros::WallDuration(0.1));
-      if (!g_sigint) continue;
-      // Without a master the save would block, waiting for one.
-      if (config_.save_pose_rate > 0.0 && ros::master::check()) savePose();
-      ros::shutdown();
-    }
-  }
-
- private:
   void warn(const std::string& key, const std::string& text) {
     int suppressed = 0;
     if (!log_.due(key, &suppressed)) return;
