@@ -554,6 +554,7 @@ class PfNode {
   // scans and odometry queued behind it).
   void filterChanged(const ros::Time& scan_stamp) {
     republisher_->set(localizer_.mapToOdom(ros::Time()), scan_stamp);
+    if (config_.save_pose_rate <= 0.0) return;  // nothing is ever saved
     std::optional<PoseToSave> next;
     if (const auto estimate = localizer_.estimate(ros::Time())) {
       // The estimate is as old as the last filter update; the odometry of
