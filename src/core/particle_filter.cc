@@ -62,6 +62,8 @@ void validate(const ParticleFilterParams& p) {
   requireParameter(p.recovery.patience_localized >= p.recovery.patience,
                    "recovery_patience_localized", ">= recovery_patience",
                    p.recovery.patience_localized);
+  requireParameter(p.recovery.lost_share >= 0.0 && p.recovery.lost_share < 1.0,
+                   "recovery_lost_share", "in [0, 1)", p.recovery.lost_share);
   requireParameter(p.recovery.expansion_ratio >= 0.0 && p.recovery.expansion_ratio < 1.0,
                    "recovery_expansion_ratio", "in [0, 1)", p.recovery.expansion_ratio);
   requireParameter(p.recovery.expansion_std_xy >= 0.0 && finite(p.recovery.expansion_std_xy),
@@ -470,6 +472,8 @@ void ParticleFilter::resample(UpdateReport* report) {
   // While "localized" it waits longer (patience_localized): most beams then
   // end on mapped obstacles at the estimate, and the dip is more likely the
   // map's poverty there than a kidnapping.
+  // A compact cloud that is "lost" searches at once with lost_share of the
+  // budget (see RecoveryParams::lost_share).
   const double usual = params_.recovery.trigger_ratio * w_slow_;
   const double dip = usual > 0.0 ? std::max(0.0, 1.0 - w_fast_ / usual) : 0.0;
   low_fit_updates_ = dip > 0.0 ? low_fit_updates_ + 1 : 0;
@@ -478,8 +482,13 @@ void ParticleFilter::resample(UpdateReport* report) {
                            : params_.recovery.patience;
   const bool patient = fit_state_ != LocalizationState::kLost && low_fit_updates_ <= patience;
   const bool can_inject = !model_->field().grid().freeCells().empty() && !patient;
-  const double inject_probability = can_inject ? dip : 0.0;
   const std::size_t n = particles_.size();
+  const double lost_share = params_.recovery.lost_share;
+  const bool compact_and_lost =
+      fit_state_ == LocalizationState::kLost &&
+      static_cast<double>(n) <= (1.0 - lost_share) * params_.kld.max_particles;
+  const double inject_probability =
+      can_inject ? std::max(dip, compact_and_lost ? lost_share : 0.0) : 0.0;
   if (report->ess >= params_.resample_ess_fraction * n && inject_probability < 0.01 && !expand_) {
     return;
   }

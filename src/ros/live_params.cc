@@ -132,6 +132,8 @@ const std::vector<LiveParam>& liveParams() {
        field<int>([](LocalizerConfig& c) -> int& { return c.filter.recovery.patience; })},
       {"recovery_patience_localized",
        field<int>([](LocalizerConfig& c) -> int& { return c.filter.recovery.patience_localized; })},
+      {"recovery_lost_share",
+       field<double>([](LocalizerConfig& c) -> double& { return c.filter.recovery.lost_share; })},
       {"recovery_kidnap_prior",
        field<double>([](LocalizerConfig& c) -> double& { return c.filter.recovery.kidnap_prior; })},
       {"recovery_expansion_ratio", field<double>([](LocalizerConfig& c) -> double& {

@@ -292,6 +292,7 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
   p.get("recovery_kidnap_prior", &f.recovery.kidnap_prior);
   p.get("recovery_patience", &f.recovery.patience);
   p.get("recovery_patience_localized", &f.recovery.patience_localized);
+  p.get("recovery_lost_share", &f.recovery.lost_share);
   p.get("recovery_expansion_ratio", &f.recovery.expansion_ratio);
   p.get("recovery_expansion_std_xy", &f.recovery.expansion_std_xy);
   p.get("recovery_expansion_std_yaw", &f.recovery.expansion_std_yaw);

@@ -375,6 +375,7 @@ TEST(BadParams, EachInvalidParameterThrowsNamingIt) {
       {"update_min_d", [](ParticleFilterParams* p) { p->update_min_d = -0.1; }},
       {"update_min_a", [](ParticleFilterParams* p) { p->update_min_a = kNaN; }},
       {"update_fit_drop", [](ParticleFilterParams* p) { p->update_fit_drop = 1.5; }},
+      {"recovery_lost_share", [](ParticleFilterParams* p) { p->recovery.lost_share = 1.0; }},
       {"recovery_patience_localized",
        [](ParticleFilterParams* p) { p->recovery.patience_localized = p->recovery.patience - 1; }},
       {"update_fit_distance", [](ParticleFilterParams* p) { p->update_fit_distance = 0.0; }},

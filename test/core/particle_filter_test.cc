@@ -513,6 +513,40 @@ TEST(ParticleFilterUpdate, RecoveryInjectsOnlyWhereThereIsFreeSpace) {
   EXPECT_EQ(injectedAfterScansStopFitting(no_free), 0u);
 }
 
+// The random particles injected on the first scan after the robot was
+// carried from kTracked to kMoved, for a filter of at least 500 and at most
+// `max_particles` particles and the given lost_share.
+std::size_t injectedOnTheFirstLostScan(std::size_t max_particles, double lost_share) {
+  const OccupancyGrid grid = trackingRoom();
+  ParticleFilterParams params = recoveryParams();
+  params.kld.max_particles = static_cast<int>(max_particles);
+  params.recovery.lost_share = lost_share;
+  params.resample_ess_fraction = 1.0;  // resample at every update: KLD shrinks the cloud
+  ParticleFilter filter(params);
+  filter.setMap(grid);
+  filter.initializeGaussian(kTracked, diag(0.01, 0.01, 0.01));
+  const LaserScan good = simulateScan(grid, kTracked);
+  for (int k = 0; k < 5; ++k) EXPECT_TRUE(filter.update({0.0, 0.0, 0.0}, good).updated);
+  // Compact (569 particles, one bin or two) for a budget of 2000; not for one of 800.
+  EXPECT_EQ(max_particles >= 2000, filter.particles().size() <= max_particles / 2);
+  const UpdateReport r = filter.update({0.0, 0.0, 0.0}, simulateScan(grid, kMoved));
+  EXPECT_TRUE(r.updated);
+  EXPECT_EQ(LocalizationState::kLost, filter.confidence().state);
+  return r.injected;
+}
+
+TEST(ParticleFilterUpdate, ACompactCloudThatIsLostSearchesAtOnceWithItsShareOfTheBudget) {
+  // 500 particles of a budget of 2000 (compact): lost_share of the budget
+  // is drawn on the very scan that finds the robot elsewhere. Without the
+  // floor, the slow averages inject nothing until the second bad scan.
+  EXPECT_EQ(1000u, injectedOnTheFirstLostScan(2000, 0.5));
+  EXPECT_EQ(600u, injectedOnTheFirstLostScan(2000, 0.3));
+  EXPECT_EQ(0u, injectedOnTheFirstLostScan(2000, 0.0));
+  // 666 particles of a budget of 800 are more than (1 - 0.5) of it: a
+  // cloud that is already searching is not thinned.
+  EXPECT_EQ(0u, injectedOnTheFirstLostScan(800, 0.5));
+}
+
 TEST(ParticleFilterUpdate, InjectedParticlesWeighTheKidnapPriorTogether) {
   // Mixture-proposal weights: whatever their number, the random particles
   // hold kidnap_prior of the weight and the survivors the rest.
