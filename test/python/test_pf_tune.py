@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Tests of scripts/pf_tune: the search space and params files, the self-supervised score on the
-bundled simulated bags, and whole studies on a 2-worker Dask LocalCluster (a 6-trial study, a worker
-killed mid-study, a study stopped after 3 trials and continued).
+bundled simulated bags, the choice of the best against the seeds' noise, and whole studies on a
+2-worker Dask LocalCluster (a 6-trial study, a worker killed mid-study, a study stopped after 3
+trials and continued).
 
 Run from the repository root:  /usr/bin/python3 -m unittest discover -s test/python -v
 Needs pf_bag_runner built (scripts/build.sh; the workspace is $PF_WS or scripts/workspace.bash's
@@ -133,6 +134,33 @@ class SpaceAndParamsTest(unittest.TestCase):
         self.assertIn('\nodom_alpha1: 0.0123456789  # [rad^2/rad^2] rotation noise from rotation\n', out)
 
 
+    def test_the_best_replaces_the_baseline_only_by_a_margin_beyond_the_seeds_noise(self):
+        # Values per seed, as the confirmation runs give them (the first is the study's own).
+        base = [0.0055, 0.0057, 0.0059, 0.0056]
+        # AC109's case: trial 49 was the luckiest single draw, trial 37 has the lowest mean, and
+        # neither is lower than the baseline by more than --min-gain.
+        lucky = {48: [0.0036, 0.0060, 0.0062, 0.0039], 36: [0.0038, 0.0057, 0.0053, 0.0040]}
+        chosen, stats, verdict = pft.choose(base, lucky, 0.005)
+        self.assertIsNone(chosen)
+        self.assertIn("trial 37's", verdict)
+        self.assertIn('not by more than --min-gain 0.005', verdict)
+        self.assertAlmostEqual(stats[36][0], 0.0047)
+        self.assertAlmostEqual(stats['baseline'][0], 0.005675)
+        # Without a minimum gain, the spread of the seeds still decides: 0.00098 is more than twice
+        # the standard error here, 0.00002 is not.
+        self.assertEqual(pft.choose(base, lucky, 0.0)[0], 36)
+        chosen, _, verdict = pft.choose(base, {5: [0.0056, 0.0058, 0.0055, 0.0058]}, 0.0)
+        self.assertIsNone(chosen)
+        self.assertIn('twice the standard error', verdict)
+        # A clear gain on every seed wins; among several, the lowest mean, not the lowest first value.
+        chosen, stats, _ = pft.choose([0.081, 0.080, 0.083, 0.085],
+                                      {33: [0.0340, 0.0347, 0.0353, 0.0345], 34: [0.0339, 0.0342, 0.0347, 0.0361]},
+                                      0.005)
+        self.assertEqual(chosen, 33)
+        # No other trial: the baseline.
+        self.assertIsNone(pft.choose(base, {}, 0.005)[0])
+
+
 class ScoreTest(unittest.TestCase):
     def setUp(self):
         self.assertTrue(os.access(RUNNER, os.X_OK), 'pf_bag_runner not built at %s (scripts/build.sh; PF_WS)' % RUNNER)
@@ -195,11 +223,14 @@ class StudyTest(unittest.TestCase):
         self.assertEqual(trials[0].params['odom_alpha1'], 0.2)  # the baseline comes first
         self.assertTrue(all(r['ok'] for t in trials for r in t.user_attrs['bags']))
         self.assertLessEqual(study.best_value, trials[0].value)
+        # best.yaml holds the trial the confirmation runs chose (the baseline unless one beat it).
+        chosen = study.trials[study.user_attrs['chosen_trial']]
         best = os.path.join(self.out, 'best.yaml')
         with open(best) as f:
             loaded = yaml.safe_load(f)
-        for k, v in study.best_params.items():
+        for k, v in chosen.params.items():
             self.assertAlmostEqual(loaded[k], v, places=12)
+        self.assertIn('pf_tune: chosen: trial %d' % (chosen.number + 1), p.stdout)
         r = subprocess.run([RUNNER, '--bag', os.path.join(REPO, 'bags', 'small.bag'), '--map',
                             os.path.join(REPO, 'maps', 'small.yaml'), '--initial-pose', '2.5', '2.6', '0',
                             '--out', os.path.join(self.out, 'check.tum'), '--quiet', '--params', best],
@@ -207,6 +238,8 @@ class StudyTest(unittest.TestCase):
         self.assertEqual(r.returncode, 0, r.stdout)
         with open(os.path.join(self.out, 'report.md')) as f:
             report = f.read()
+        self.assertIn('## Confirmation: the lowest trials again, with 4 seed(s) each', report)
+        self.assertIn('| 1 (baseline)', report)
         self.assertIn('| small.bag |', report)
         self.assertIn('| tracking.bag |', report)
         for png in ('history.png', 'importances.png'):
