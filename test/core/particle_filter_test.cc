@@ -433,9 +433,10 @@ ParticleFilterParams recoveryParams() {
 const Pose2 kTracked{1.0, 1.5, 0.2};
 const Pose2 kMoved{2.0, 2.2, 1.5};
 
-void trackFiveScans(const OccupancyGrid& grid, ParticleFilter* filter) {
+void trackFiveScans(const OccupancyGrid& grid, ParticleFilter* filter,
+                    const Eigen::Matrix3d& start_cov = Eigen::Matrix3d::Zero()) {
   filter->setMap(grid);
-  filter->initializeGaussian(kTracked, Eigen::Matrix3d::Zero());
+  filter->initializeGaussian(kTracked, start_cov);
   const LaserScan good = simulateScan(grid, kTracked);
   for (int k = 0; k < 5; ++k) EXPECT_TRUE(filter->update({0.0, 0.0, 0.0}, good).updated);
 }
@@ -523,10 +524,7 @@ std::size_t injectedOnTheFirstLostScan(std::size_t max_particles, double lost_sh
   params.recovery.lost_share = lost_share;
   params.resample_ess_fraction = 1.0;  // resample at every update: KLD shrinks the cloud
   ParticleFilter filter(params);
-  filter.setMap(grid);
-  filter.initializeGaussian(kTracked, diag(0.01, 0.01, 0.01));
-  const LaserScan good = simulateScan(grid, kTracked);
-  for (int k = 0; k < 5; ++k) EXPECT_TRUE(filter.update({0.0, 0.0, 0.0}, good).updated);
+  trackFiveScans(grid, &filter, diag(0.01, 0.01, 0.01));  // spread: the weights differ
   // Compact (569 particles, one bin or two) for a budget of 2000; not for one of 800.
   EXPECT_EQ(max_particles >= 2000, filter.particles().size() <= max_particles / 2);
   const UpdateReport r = filter.update({0.0, 0.0, 0.0}, simulateScan(grid, kMoved));
