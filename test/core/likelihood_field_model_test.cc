@@ -243,7 +243,9 @@ TEST(LikelihoodFieldModel, ParticleSetMatchesPerPoseAndBruteForce) {
   model.logLikelihoods(scan, particles, &all);
   ASSERT_EQ(particles.size(), all.size());
   for (std::size_t i = 0; i < particles.size(); ++i) {
-    EXPECT_DOUBLE_EQ(model.logLikelihood(scan, particles.pose(i)), all[i]);
+    // The same bits: the cloud is scored eight particles at a time where the
+    // processor has AVX2 (the last two one by one), a single pose one by one.
+    EXPECT_EQ(model.logLikelihood(scan, particles.pose(i)), all[i]) << "particle " << i;
     // An independent reference: every end point placed in double precision
     // and looked up in the distance field.
     double expected = 0.0;
@@ -253,6 +255,27 @@ TEST(LikelihoodFieldModel, ParticleSetMatchesPerPoseAndBruteForce) {
     }
     EXPECT_NEAR(expected, all[i], 1e-4) << "particle " << i;
   }
+
+  // A block of eight far off the map, at infinity and NaN (every end point
+  // in the border: the floor score), then one more on the map.
+  const double inf = std::numeric_limits<double>::infinity();
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  const std::vector<Pose2> odd = {{-40.0, 1.0, 0.3}, {1e7, -1e7, 1.0}, {inf, 0.5, 0.0},
+                                  {0.5, -inf, 2.0},  {nan, 0.5, 0.0},  {0.5, 0.5, nan},
+                                  {1.0, nan, -1.0},  {3.0, 2.0, 1e9},  {1.2, 0.4, -0.7}};
+  particles.resize(odd.size());
+  for (std::size_t i = 0; i < odd.size(); ++i) particles.setPose(i, odd[i]);
+  model.logLikelihoods(scan, particles, &all);
+  const double floor_score =
+      static_cast<double>(scan.size()) *
+      static_cast<float>(model.beamLogLikelihood(model.field().maxDistance(), scan.range_max));
+  for (std::size_t i = 0; i < odd.size(); ++i) {
+    EXPECT_EQ(model.logLikelihood(scan, odd[i]), all[i]) << "particle " << i;
+  }
+  for (std::size_t i : {0, 1, 2, 3, 4, 5, 6}) {
+    EXPECT_NEAR(floor_score, all[i], 1e-3) << "particle " << i;
+  }
+  EXPECT_GT(all[8], floor_score + 1.0);
 }
 
 void expectRejected(const LikelihoodFieldModelParams& p, const std::string& name) {
