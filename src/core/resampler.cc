@@ -85,6 +85,11 @@ double kldBound(std::size_t k, double kld_err, double confidence) {
 }
 
 std::size_t kldParticleCount(const ParticleSet& particles, const KldParams& params) {
+  // A fixed budget (min_particles = max_particles, as amcl is often run) is
+  // the answer whatever the bins say: no need to bin 5000 particles for it.
+  if (params.min_particles == params.max_particles) {
+    return static_cast<std::size_t>(std::max(params.max_particles, 0));
+  }
   // A bin counts when its weight promises at least one survivor out of a
   // resample of the current size: bins holding only negligible particles
   // will be empty after resampling and must not inflate k.

@@ -233,6 +233,10 @@ TEST(KldParticleCount, ClampsToMinAndMax) {
   EXPECT_EQ(150u, kldParticleCount(inSeparateBins(10), kld(100, 150)));
   // An empty set asks for the minimum.
   EXPECT_EQ(100u, kldParticleCount(ParticleSet(), kld(100, 1000)));
+  // A fixed budget, whatever the spread (one bin, ten, none).
+  EXPECT_EQ(150u, kldParticleCount(one_bin, kld(150, 150)));
+  EXPECT_EQ(150u, kldParticleCount(inSeparateBins(10), kld(150, 150)));
+  EXPECT_EQ(150u, kldParticleCount(ParticleSet(), kld(150, 150)));
 }
 
 TEST(KldParticleCount, GrowsWithSpread) {
