@@ -9,13 +9,15 @@
 // server, dynamic_reconfigure through pf_ros::ReconfigureServer), so that it
 // can replace amcl in an existing bringup.
 //
-// Threads (README.md, "Under overload"): the main spinner moves messages
-// (tf's too: the listener has no thread of its own) and serves the
-// services; scans go through a one-scan LatestScanSlot to a filter
-// thread of their own, so that under overload the newest scan wins and
-// odometry and tf keep being consumed; map -> odom is republished by a
-// MapToOdomRepublisher on a third thread that never waits for the filter.
-// filter_mutex_ protects the filter and everything that goes with it.
+// Threads (README.md, "Under overload"): tf and the scans are taken on
+// roscpp's own poll thread as they arrive (InlineCallbackQueue: no hand-off
+// to a spinner); a scan whose tf is there goes through a one-scan
+// LatestScanSlot to a filter thread of its own, so that under overload the
+// newest scan wins and tf keeps being consumed; the main spinner serves the
+// map, initialpose, the services, the timers and the scans tf dropped;
+// map -> odom is republished by a MapToOdomRepublisher on a thread that
+// never waits for the filter. filter_mutex_ protects the filter and
+// everything that goes with it.
 #include <diagnostic_msgs/DiagnosticArray.h>
 #include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
@@ -48,6 +50,7 @@
 
 #include "pf_localization/ros/conversions.h"
 #include "pf_localization/ros/diagnostics.h"
+#include "pf_localization/ros/inline_callback_queue.h"
 #include "pf_localization/ros/latest_scan_slot.h"
 #include "pf_localization/ros/limited_log.h"
 #include "pf_localization/ros/live_params.h"
@@ -60,6 +63,12 @@
 
 namespace pf_ros {
 namespace {
+
+// `nh` with its callbacks on `queue`.
+ros::NodeHandle withQueue(ros::NodeHandle nh, ros::CallbackQueueInterface* queue) {
+  nh.setCallbackQueue(queue);
+  return nh;
+}
 
 std::string failureText(tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
   switch (reason) {
@@ -103,20 +112,24 @@ class PfNode {
         nh_(nh),
         pnh_(pnh),
         buffer_(ros::Duration(30.0)),
-        // tf on the main spinner, not on a thread of the listener's own: a
-        // transform that completes a waiting scan then hands it on without
-        // waking a second thread, and the node switches threads less (about
-        // 10 % less CPU live on neato_ac109_1, docs/performance.md).
-        listener_(buffer_, nh_, false),
+        inline_queue_(ros::getGlobalCallbackQueue()),
+        // tf as it arrives, with no thread of the listener's own and no
+        // spinner: a transform that completes a waiting scan hands it to the
+        // filter thread directly (docs/performance.md, "Wake-ups").
+        listener_(buffer_, withQueue(nh_, &inline_queue_), false),
         localizer_(config, &buffer_),
         governor_(UpdateTimeGovernorOptions{config.max_update_time}),
-        scan_sub_(nh_, "scan", 20),
-        scan_filter_(scan_sub_, buffer_, config.odom_frame, 20, nh_) {
+        scan_filter_(buffer_, config.odom_frame, 20, &inline_queue_) {
+    scan_filter_.connectInput(scan_sub_);
     scan_filter_.registerCallback(&PfNode::onScan, this);
+    // A dropped scan may restart the filter (a bag that starts over), which
+    // takes filter_mutex_; the thread that dropped it may hold that mutex
+    // (its map -> odom reached tf), so the main spinner handles it.
     scan_filter_.registerFailureCallback(
         [this](const sensor_msgs::LaserScanConstPtr& scan,
                tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-          onScanDropped(scan, reason);
+          postCallback(ros::getGlobalCallbackQueue(), reinterpret_cast<uint64_t>(this),
+                       [this, scan, reason] { onScanDropped(scan, reason); });
         });
     odom_sub_ = nh_.subscribe("odom", 50, &PfNode::onOdom, this);
     tf_watch_sub_ = nh_.subscribe("/tf", 100, &PfNode::onTf, this);
@@ -154,9 +167,13 @@ class PfNode {
     }
     republisher_->start();
     filter_thread_ = std::thread([this] { filterLoop(); });
+    // Last: its callbacks may run at once, on roscpp's poll thread.
+    scan_sub_.subscribe(nh_, "scan", 20, ros::TransportHints(), &inline_queue_);
   }
 
   ~PfNode() {
+    scan_sub_.unsubscribe();
+    ros::getGlobalCallbackQueue()->removeByID(reinterpret_cast<uint64_t>(this));
     slot_.close();
     filter_thread_.join();
   }
@@ -271,8 +288,9 @@ class PfNode {
     }
   }
 
-  // On the main spinner, once tf has the scan's stamp: only hands the scan to
-  // the filter thread, so that this thread never waits for an update.
+  // Once tf has the scan's stamp, on whichever thread brought the scan or
+  // the transform that completed it (InlineCallbackQueue): only hands the
+  // scan to the filter thread, so that no thread waits here for an update.
   void onScan(const sensor_msgs::LaserScanConstPtr& scan) {
     if (!slot_.put(PendingScan{scan, ros::WallTime::now(), ros::Time::now()})) return;
     const std::uint64_t dropped = slot_.dropped();
@@ -608,6 +626,7 @@ class PfNode {
   LocalizerConfig config_;
   ros::NodeHandle nh_, pnh_;
   tf2_ros::Buffer buffer_;
+  InlineCallbackQueue inline_queue_;  // before every subscriber that uses it
   tf2_ros::TransformListener listener_;
   // Guards localizer_, config_, governor_ and the state below that goes
   // with the filter (last_odom_, last_state_, last_scan_stamp_,
