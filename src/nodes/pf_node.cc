@@ -115,7 +115,8 @@ class PfNode {
         inline_queue_(ros::getGlobalCallbackQueue()),
         // tf as it arrives, with no thread of the listener's own and no
         // spinner: a transform that completes a waiting scan hands it to the
-        // filter thread directly (docs/performance.md, "Wake-ups").
+        // filter thread directly (docs/performance.md, "Wake-ups: tf and scans on the poll
+        // thread").
         listener_(buffer_, withQueue(nh_, &inline_queue_), false),
         localizer_(config, &buffer_),
         governor_(UpdateTimeGovernorOptions{config.max_update_time}),

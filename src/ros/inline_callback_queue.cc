@@ -37,7 +37,10 @@ void InlineCallbackQueue::addCallback(const ros::CallbackInterfacePtr& callback,
                                       uint64_t owner_id) {
   ros::CallbackInterface::CallResult result;
   {
-    std::shared_lock<std::shared_mutex> running(running_);
+    // Once per thread: a callback that publishes to this node itself comes
+    // back here, and a second shared lock could wait behind removeByID.
+    std::shared_lock<std::shared_mutex> running(running_, std::defer_lock);
+    if (t_running_inline == 0) running.lock();
     RunningInline inside;
     result = callback->call();
   }
