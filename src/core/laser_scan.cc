@@ -16,6 +16,10 @@ std::optional<std::string> validateScan(const LaserScan& scan) {
            ") must be finite and above range_min (" + std::to_string(scan.range_min) + ")";
   }
   if (!scan.sensor_pose.isFinite()) return "the laser's pose on the robot is not finite";
+  if (!std::isfinite(scan.sweep.first_beam_time) || !std::isfinite(scan.sweep.time_increment) ||
+      !scan.sweep.base_velocity.isFinite()) {
+    return "the sweep's beam times or the robot's velocity during it are not finite";
+  }
   return std::nullopt;
 }
 
@@ -30,7 +34,7 @@ std::vector<Beam> selectBeams(const LaserScan& scan, int max_beams, double range
     const float r = scan.ranges[i];
     // NaN fails every comparison, so it is dropped along with inf and zero.
     if (r > 0.0f && r >= lo && r < hi) {
-      valid.push_back({r, static_cast<float>(scan.angle_min + i * scan.angle_increment)});
+      valid.push_back({r, static_cast<float>(scan.angle_min + i * scan.angle_increment), i});
     }
   }
   if (valid_count) *valid_count = valid.size();

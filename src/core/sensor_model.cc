@@ -18,9 +18,12 @@ PreparedScan prepareScan(const LaserScan& scan, int max_beams, double range_min,
   out.y.reserve(beams.size());
   out.range.reserve(beams.size());
   out.angle.reserve(beams.size());
+  const bool skewed = !scan.sweep.isStill();
   for (const Beam& b : beams) {
-    const Pose2 end = compose(scan.sensor_pose,
-                              {b.range * std::cos(b.bearing), b.range * std::sin(b.bearing), 0.0});
+    const Pose2 from =
+        skewed ? sensorPoseAtBeam(scan.sensor_pose, scan.sweep, b.index) : scan.sensor_pose;
+    const Pose2 end =
+        compose(from, {b.range * std::cos(b.bearing), b.range * std::sin(b.bearing), 0.0});
     // Ranges of 1e38 m pass the scan's own limits when range_max is absurd;
     // in float cells they overflow, so they are dropped like any bad beam.
     if (!std::isfinite(static_cast<float>(end.x / resolution)) ||
@@ -30,8 +33,16 @@ PreparedScan prepareScan(const LaserScan& scan, int max_beams, double range_min,
     }
     out.x.push_back(static_cast<float>(end.x));
     out.y.push_back(static_cast<float>(end.y));
-    out.range.push_back(b.range);
-    out.angle.push_back(static_cast<float>(normalizeAngle(scan.sensor_pose.yaw + b.bearing)));
+    if (skewed) {
+      // The beam model casts every ray from the sensor's reference position:
+      // the moved beam becomes the ray from there to its de-skewed end point.
+      const double dx = end.x - scan.sensor_pose.x, dy = end.y - scan.sensor_pose.y;
+      out.range.push_back(static_cast<float>(std::hypot(dx, dy)));
+      out.angle.push_back(static_cast<float>(std::atan2(dy, dx)));
+    } else {
+      out.range.push_back(b.range);
+      out.angle.push_back(static_cast<float>(normalizeAngle(scan.sensor_pose.yaw + b.bearing)));
+    }
   }
   return out;
 }

@@ -230,6 +230,11 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
   p.get("transform_tolerance", &c.transform_tolerance);
   p.get("tf_publish_rate", &c.tf_publish_rate);
 
+  p.get("deskew_scans", &c.deskew_scans);
+  p.get("scan_stamp", &c.scan_stamp);
+  require(c.scan_stamp == "first_beam" || c.scan_stamp == "last_beam", "scan_stamp",
+          "first_beam or last_beam (got '" + c.scan_stamp + "')");
+
   pf::Pose2 initial{std::nan(""), std::nan(""), 0.0};
   p.get("initial_pose_x", &initial.x);
   p.get("initial_pose_y", &initial.y);

@@ -2,6 +2,7 @@
 
 #include <tf2/exceptions.h>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -136,7 +137,9 @@ ScanResult ScanLocalizer::processScan(const sensor_msgs::LaserScan& scan) {
   }
   result.warning = scanInconsistency(scan);
   result.odom = toPose2(odom.transform);
-  result.report = filter_.update(*result.odom, toCore(scan, toPose2(laser.transform)));
+  pf::LaserScan core_scan = toCore(scan, toPose2(laser.transform));
+  core_scan.sweep = sweepMotion(scan, *tf_, config_, *result.odom);
+  result.report = filter_.update(*result.odom, core_scan);
   return result;
 }
 
@@ -201,6 +204,41 @@ std::string scanInconsistency(const sensor_msgs::LaserScan& scan) {
     }
   }
   return "";
+}
+
+pf::SweepMotion sweepMotion(const sensor_msgs::LaserScan& scan, const tf2::BufferCore& tf,
+                            const LocalizerConfig& config, const pf::Pose2& odom_at_stamp) {
+  pf::SweepMotion sweep;
+  const double dt = scan.time_increment;
+  if (!config.deskew_scans || !std::isfinite(dt) || dt == 0.0 || scan.ranges.size() < 2) {
+    return sweep;
+  }
+  const double span = std::fabs(dt) * static_cast<double>(scan.ranges.size() - 1);
+  // Longer than a second is not one turn of a spinning laser: a bogus
+  // time_increment is not worth bending the scan for.
+  if (span > 1.0) return sweep;
+  // The velocity over the sweep that ends at the stamp: odometry after the
+  // stamp has not arrived yet when a live scan does.
+  const double window = std::max(span, 0.05);
+  if (scan.header.stamp.toSec() <= window) return sweep;  // no time before it
+  pf::Pose2 earlier;
+  try {
+    earlier = toPose2(tf.lookupTransform(config.odom_frame, config.base_frame,
+                                           scan.header.stamp - ros::Duration(window))
+                          .transform);
+  } catch (const tf2::TransformException&) {
+    return sweep;  // the first scans of a run: used as they are
+  }
+  sweep.base_velocity = pf::velocityBetween(earlier, odom_at_stamp, window);
+  sweep.time_increment = dt;
+  // A negative time_increment means the last index was taken first.
+  const bool stamp_is_first = config.scan_stamp == "first_beam";
+  if (dt > 0.0) {
+    sweep.first_beam_time = stamp_is_first ? 0.0 : -span;
+  } else {
+    sweep.first_beam_time = stamp_is_first ? span : 0.0;
+  }
+  return sweep;
 }
 
 geometry_msgs::TransformStamped odometryToTransform(const nav_msgs::Odometry& odom) {

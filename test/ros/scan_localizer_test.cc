@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <limits>
 
 #include "pf_localization/ros/conversions.h"
@@ -35,9 +36,11 @@ nav_msgs::OccupancyGrid room() {
   return map;
 }
 
-// Marches along each beam until it enters an occupied cell.
-sensor_msgs::LaserScan scanFrom(const nav_msgs::OccupancyGrid& map, const pf::Pose2& laser,
-                                const ros::Time& stamp) {
+// Marches along each beam until it enters an occupied cell; beam i starts
+// from laser_at(i), so that a laser moving through its sweep can be drawn.
+template <typename LaserAt>
+sensor_msgs::LaserScan scanFromMoving(const nav_msgs::OccupancyGrid& map, const LaserAt& laser_at,
+                                      const ros::Time& stamp) {
   sensor_msgs::LaserScan scan;
   scan.header.frame_id = "laser";
   scan.header.stamp = stamp;
@@ -47,6 +50,7 @@ sensor_msgs::LaserScan scanFrom(const nav_msgs::OccupancyGrid& map, const pf::Po
   scan.range_min = 0.02;
   scan.range_max = 5.0;
   for (int i = 0; i < 360; ++i) {
+    const pf::Pose2 laser = laser_at(i);
     const double a = laser.yaw + scan.angle_min + i * scan.angle_increment;
     float range = std::numeric_limits<float>::infinity();
     for (double r = 0.0; r < scan.range_max; r += 0.005) {
@@ -60,6 +64,11 @@ sensor_msgs::LaserScan scanFrom(const nav_msgs::OccupancyGrid& map, const pf::Po
     scan.ranges.push_back(range);
   }
   return scan;
+}
+
+sensor_msgs::LaserScan scanFrom(const nav_msgs::OccupancyGrid& map, const pf::Pose2& laser,
+                                const ros::Time& stamp) {
+  return scanFromMoving(map, [&](int) { return laser; }, stamp);
 }
 
 geometry_msgs::TransformStamped transform(const std::string& parent, const std::string& child,
@@ -227,6 +236,105 @@ TEST_F(ScanLocalizerTest, OdometryMessageBecomesOdomToBaseTransform) {
   EXPECT_DOUBLE_EQ(t.transform.translation.x, 1.0);
   EXPECT_DOUBLE_EQ(t.transform.translation.y, -2.0);
   EXPECT_NEAR(yawOf(t.transform.rotation), 0.5, 1e-12);
+}
+
+// --- De-skewing --------------------------------------------------------------
+
+// Odometry turning on the spot at `rate` rad/s from t = 0 on, on tf at 100 Hz
+// from `from` to `to` s.
+void spinOnTf(tf2::BufferCore* tf, double rate, double from, double to) {
+  for (double t = from; t <= to + 1e-9; t += 0.01) {
+    tf->setTransform(transform("odom", "base_link", {0.0, 0.0, pf::normalizeAngle(rate * t)},
+                               ros::Time(t)),
+                     "test");
+  }
+}
+
+TEST(SweepMotion, FromOdometryOverTheSweepAndTheStampConvention) {
+  tf2::BufferCore tf;
+  spinOnTf(&tf, 1.0, 9.0, 11.0);
+  sensor_msgs::LaserScan scan;
+  scan.header.stamp = ros::Time(10.5);
+  scan.ranges.assign(361, 1.0f);
+  scan.time_increment = 0.2f / 360.0f;
+  const double span = 360.0 * scan.time_increment;
+  LocalizerConfig config;
+  config.deskew_scans = true;
+  config.scan_stamp = "last_beam";
+  const pf::Pose2 odom{0.0, 0.0, 10.5};
+  pf::SweepMotion sweep = sweepMotion(scan, tf, config, odom);
+  EXPECT_NEAR(sweep.base_velocity.yaw, 1.0, 1e-9);
+  EXPECT_NEAR(sweep.base_velocity.x, 0.0, 1e-9);
+  EXPECT_NEAR(sweep.first_beam_time, -span, 1e-12);
+  EXPECT_DOUBLE_EQ(sweep.time_increment, scan.time_increment);
+
+  config.scan_stamp = "first_beam";
+  EXPECT_EQ(sweepMotion(scan, tf, config, odom).first_beam_time, 0.0);
+  // Beams timed backwards: the last index is the first taken.
+  scan.time_increment = -scan.time_increment;
+  EXPECT_NEAR(sweepMotion(scan, tf, config, odom).first_beam_time, span, 1e-12);
+  config.scan_stamp = "last_beam";
+  EXPECT_EQ(sweepMotion(scan, tf, config, odom).first_beam_time, 0.0);
+}
+
+TEST(SweepMotion, StillWhenOffUntimedImplausibleOrWithoutHistory) {
+  tf2::BufferCore tf;
+  spinOnTf(&tf, 1.0, 10.0, 11.0);
+  sensor_msgs::LaserScan scan;
+  scan.header.stamp = ros::Time(10.5);
+  scan.ranges.assign(361, 1.0f);
+  scan.time_increment = 0.2f / 360.0f;
+  LocalizerConfig config;
+  const pf::Pose2 odom{0.0, 0.0, 10.5};
+  EXPECT_TRUE(sweepMotion(scan, tf, config, odom).isStill()) << "off by default";
+  config.deskew_scans = true;
+  EXPECT_FALSE(sweepMotion(scan, tf, config, odom).isStill());
+  scan.time_increment = 0.0f;
+  EXPECT_TRUE(sweepMotion(scan, tf, config, odom).isStill()) << "no beam timing";
+  scan.time_increment = 0.01f;  // 3.6 s for one sweep
+  EXPECT_TRUE(sweepMotion(scan, tf, config, odom).isStill()) << "implausible timing";
+  scan.time_increment = 0.2f / 360.0f;
+  scan.header.stamp = ros::Time(10.1);  // odometry starts at 10.0
+  EXPECT_TRUE(sweepMotion(scan, tf, config, odom).isStill()) << "no odometry a sweep back";
+}
+
+// Spinning at 2 rad/s, a 0.1 s sweep bends the scan by 0.2 rad from its
+// first beam to its last. Read as if taken at once, the scan puts the
+// estimate's yaw off by half of that; de-skewed, the estimate is right.
+TEST_F(ScanLocalizerTest, DeskewingRemovesTheSpinsYawBias) {
+  constexpr double kRate = 2.0, kSweep = 0.1;
+  const pf::Pose2 start{1.5, 1.2, 0.0};
+  spinOnTf(&tf_, kRate, 9.0, 12.0);
+  config_.initial_pose = pf::compose(start, {0.0, 0.0, kRate * 10.0});  // at the first scan
+  config_.initial_cov = Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal();
+  config_.scan_stamp = "last_beam";
+  auto final_yaw_error = [&](bool deskew) {
+    config_.deskew_scans = deskew;
+    ScanLocalizer localizer(config_, &tf_);
+    EXPECT_EQ(localizer.setMap(map_), "");
+    double error = 0.0;
+    for (int k = 0; k < 10; ++k) {
+      const double stamp = 10.0 + 0.1 * k;
+      // Beam i is taken (359 - i) / 359 of a sweep before the stamp.
+      auto laser_at = [&](int i) {
+        const double t = stamp - kSweep * (359 - i) / 359.0;
+        return pf::compose(pf::compose(start, {0.0, 0.0, kRate * t}), mount_);
+      };
+      sensor_msgs::LaserScan scan = scanFromMoving(map_, laser_at, ros::Time(stamp));
+      scan.time_increment = static_cast<float>(kSweep / 359.0);
+      const ScanResult r = localizer.processScan(scan);
+      EXPECT_EQ(r.error, "");
+      const pf::Pose2 truth = pf::compose(start, {0.0, 0.0, kRate * stamp});
+      const auto est = localizer.estimate(ros::Time(stamp));
+      error = pf::angleDiff(toPose2(est->pose.pose).yaw, truth.yaw);
+    }
+    return error;
+  };
+  const double bent = final_yaw_error(false);
+  const double deskewed = final_yaw_error(true);
+  std::cout << "yaw error: as taken at once " << bent << " rad, de-skewed " << deskewed << "\n";
+  EXPECT_GT(std::fabs(bent), 0.05) << "the bend this test is about";
+  EXPECT_LT(std::fabs(deskewed), 0.02);
 }
 
 }  // namespace

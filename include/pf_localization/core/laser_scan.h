@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "pf_localization/core/pose2.h"
+#include "pf_localization/core/scan_deskew.h"
 
 namespace pf {
 
@@ -17,18 +18,21 @@ struct LaserScan {
   double range_min = 0.0;        // m
   double range_max = 0.0;        // m
   Pose2 sensor_pose;             // the laser frame in the robot's base frame
+  SweepMotion sweep;             // when each beam was taken (default: all at once)
 };
 
 /// Why a scan cannot be used at all (as opposed to single bad beams, which are
 /// dropped quietly): an empty range array, a zero or non-finite angle
 /// increment, non-finite angles, range_max <= range_min, or a non-finite
-/// sensor pose. Empty when the scan is usable.
+/// sensor pose or sweep. Empty when the scan is usable.
 std::optional<std::string> validateScan(const LaserScan& scan);
 
-/// One usable beam: its measured range and its bearing in the sensor frame.
+/// One usable beam: its measured range, its bearing in the sensor frame and
+/// its index in the scan (which says when it was taken).
 struct Beam {
   float range;
   float bearing;
+  std::size_t index;
 };
 
 /// The usable beams of a scan, evenly subsampled to at most `max_beams`.

@@ -24,6 +24,15 @@ struct LocalizerConfig {
   double transform_tolerance = 0.1;  // s the published map->odom is post-dated by
   double tf_publish_rate = 20.0;     // Hz map->odom is republished between updates
   bool tf_broadcast = true;
+  // De-skewing (core/scan_deskew.h): each beam is placed from where the laser
+  // was when it took it, using the scan's time_increment and the odometry's
+  // velocity. Scans with time_increment 0 are used as they are. Off by
+  // default: on the real bags at hand it changes little (config/pf.yaml).
+  bool deskew_scans = false;
+  // Which beam the scan's header stamp is the time of: "first_beam" (ROS's
+  // convention, sensor_msgs/LaserScan) or "last_beam" (drivers that stamp a
+  // scan when it is complete).
+  std::string scan_stamp = "first_beam";
   std::optional<pf::Pose2> initial_pose;  // none: global localization
   Eigen::Matrix3d initial_cov = Eigen::Vector3d(0.25, 0.25, 0.0685).asDiagonal();
   pf::ParticleFilterParams filter;

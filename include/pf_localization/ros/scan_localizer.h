@@ -63,8 +63,8 @@ class ScanLocalizer {
   /// message (empty on success); on error nothing changed.
   std::string reconfigure(const LocalizerConfig& config);
 
-  /// Uses one scan: odometry and laser pose from tf at the scan's stamp, then
-  /// the filter update.
+  /// Uses one scan: odometry and laser pose from tf at the scan's stamp (and,
+  /// to de-skew it, the odometry one sweep earlier), then the filter update.
   ScanResult processScan(const sensor_msgs::LaserScan& scan);
 
   /// map -> odom to publish, stamped `stamp` (the caller adds transform_tolerance).
@@ -92,6 +92,15 @@ class ScanLocalizer {
 /// beams are placed by angle_min and angle_increment, as every ROS consumer
 /// does). Empty when the message is consistent.
 std::string scanInconsistency(const sensor_msgs::LaserScan& scan);
+
+/// When each beam of `scan` was taken relative to its stamp (by
+/// `config.scan_stamp`), and the base's velocity then: the odometry's motion
+/// over the sweep that ends at the stamp, from `odom_at_stamp` and tf one
+/// sweep earlier. Still (no correction) when config.deskew_scans is off, the
+/// scan has no beam timing (time_increment 0) or an implausible one (a sweep
+/// over a second), or tf has no odometry that far back.
+pf::SweepMotion sweepMotion(const sensor_msgs::LaserScan& scan, const tf2::BufferCore& tf,
+                            const LocalizerConfig& config, const pf::Pose2& odom_at_stamp);
 
 /// A nav_msgs/Odometry as the odom -> base transform it describes, for a tf
 /// buffer that has no odometry on /tf (bags that only record /odom).
