@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
 
 #include "pf_localization/core/bin_index.h"
 #include "pf_localization/core/bin_table.h"
@@ -11,11 +14,6 @@
 
 namespace pf {
 namespace {
-
-struct BinKey {
-  int64_t x, y, yaw;
-  bool operator==(const BinKey& o) const { return x == o.x && y == o.y && yaw == o.yaw; }
-};
 
 int find(std::vector<int>& parent, int i) {
   while (parent[i] != i) i = parent[i] = parent[parent[i]];
@@ -42,7 +40,83 @@ void accumulateRuns(const std::vector<int>& group, double* rows, Term term) {
   }
 }
 
+// The packed histogram bin (BinTable::key) of one particle; yaw bins wrap
+// around, [0, yaw_bins). The reference for packBinKeysAvx2.
+uint64_t packedBinOf(double x, double y, double yaw, double cell_xy, int64_t yaw_bins,
+                     double yaw_bin_size) {
+  const double yaw01 = (normalizeAngle(yaw) + M_PI) / (2.0 * M_PI);
+  return BinTable::key(binIndex(x, cell_xy), binIndex(y, cell_xy),
+                       std::clamp<int64_t>(binIndex(yaw01, yaw_bin_size), 0, yaw_bins - 1));
+}
+
+#if defined(__x86_64__)
+// Four coordinates' bins in `cell`s as BinTable fields: floor(v / cell),
+// NaN to 0, clamped to [lo, hi], offset by `half`.
+__attribute__((target("avx2"))) inline __m256i binField(__m256d v, __m256d cell, __m256d lo,
+                                                        __m256d hi, __m256i half) {
+  const __m256d b = _mm256_floor_pd(_mm256_div_pd(v, cell));
+  const __m256d nan_to_zero = _mm256_and_pd(b, _mm256_cmp_pd(b, b, _CMP_ORD_Q));
+  const __m256d clamped = _mm256_min_pd(_mm256_max_pd(nan_to_zero, lo), hi);
+  return _mm256_add_epi64(_mm256_cvtepi32_epi64(_mm256_cvttpd_epi32(clamped)), half);
+}
+
+// packedBinOf for four particles at a time, with the same operations on
+// each (division, floor, the same clamps), so the same keys. A block with a
+// heading that one step of 2 pi does not wrap (or NaN) is left to the scalar
+// code. Returns how many particles it packed (a multiple of four).
+__attribute__((target("avx2"))) std::size_t packBinKeysAvx2(const ParticleSet& particles,
+                                                            double cell_xy, int64_t yaw_bins,
+                                                            double yaw_bin_size, uint64_t* out) {
+  const std::size_t n = particles.size();
+  const __m256d cell = _mm256_set1_pd(cell_xy), yaw_cell = _mm256_set1_pd(yaw_bin_size);
+  const __m256d pi = _mm256_set1_pd(M_PI), minus_pi = _mm256_set1_pd(-M_PI);
+  const __m256d two_pi = _mm256_set1_pd(2.0 * M_PI);
+  // BinTable's fields hold [-2^20, 2^20); binIndex's own +-2^52 clamp is
+  // inside that once BinTable clamps, and NaN goes to bin 0 as in binIndex.
+  const __m256d lo = _mm256_set1_pd(-1048576.0), hi = _mm256_set1_pd(1048575.0);
+  const __m256d zero = _mm256_setzero_pd();
+  const __m256d yaw_hi = _mm256_set1_pd(static_cast<double>(yaw_bins - 1));
+  const __m256i half = _mm256_set1_epi64x(int64_t{1} << 20);
+
+  std::size_t i = 0;
+  for (; i + 4 <= n; i += 4) {
+    const __m256d a = _mm256_loadu_pd(particles.yaw.data() + i);
+    // normalizeAngle's one step: a > pi and a <= -pi never both hold.
+    __m256d w = _mm256_sub_pd(a, _mm256_and_pd(_mm256_cmp_pd(a, pi, _CMP_GT_OQ), two_pi));
+    w = _mm256_add_pd(w, _mm256_and_pd(_mm256_cmp_pd(a, minus_pi, _CMP_LE_OQ), two_pi));
+    const __m256d wrapped =
+        _mm256_and_pd(_mm256_cmp_pd(w, pi, _CMP_LE_OQ), _mm256_cmp_pd(w, minus_pi, _CMP_GT_OQ));
+    if (_mm256_movemask_pd(wrapped) != 0xF) break;
+    const __m256d yaw01 = _mm256_div_pd(_mm256_add_pd(w, pi), two_pi);
+    const __m256d yaw_bin =
+        _mm256_min_pd(_mm256_max_pd(_mm256_floor_pd(_mm256_div_pd(yaw01, yaw_cell)), zero), yaw_hi);
+    const __m256i fyaw =
+        _mm256_add_epi64(_mm256_cvtepi32_epi64(_mm256_cvttpd_epi32(yaw_bin)), half);
+    const __m256i fx = binField(_mm256_loadu_pd(particles.x.data() + i), cell, lo, hi, half);
+    const __m256i fy = binField(_mm256_loadu_pd(particles.y.data() + i), cell, lo, hi, half);
+    const __m256i key = _mm256_or_si256(
+        _mm256_or_si256(_mm256_slli_epi64(fx, 42), _mm256_slli_epi64(fy, 21)), fyaw);
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(out + i), key);
+  }
+  return i;
+}
+#endif
+
 }  // namespace
+
+void packClusterBins(const ParticleSet& particles, double cell_xy, int64_t yaw_bins,
+                     uint64_t* out) {
+  const double yaw_bin_size = 1.0 / static_cast<double>(yaw_bins);
+  std::size_t i = 0;
+#if defined(__x86_64__)
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  if (avx2) i = packBinKeysAvx2(particles, cell_xy, yaw_bins, yaw_bin_size, out);
+#endif
+  for (; i < particles.size(); ++i) {
+    out[i] = packedBinOf(particles.x[i], particles.y[i], particles.yaw[i], cell_xy, yaw_bins,
+                         yaw_bin_size);
+  }
+}
 
 Cluster summarize(const ParticleSet& particles, const std::vector<std::size_t>& indices) {
   Cluster c;
@@ -77,13 +151,14 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
   const int64_t yaw_bins = std::max<int64_t>(1, std::llround(2.0 * M_PI / params.cell_yaw));
   struct Scratch {
     BinTable bin_of;
-    std::vector<BinKey> keys;
+    std::vector<uint64_t> packed;
+    std::vector<BinTable::Bin> keys;
     std::vector<int> particle_bin, parent, cluster_of_root, cluster;
     std::vector<double> bin_weight, sin_yaw, cos_yaw, sums, moments;
   };
   Scratch& scratch = threadScratch<Scratch>();
   BinTable& bin_of = scratch.bin_of;
-  std::vector<BinKey>& keys = scratch.keys;
+  std::vector<BinTable::Bin>& keys = scratch.keys;
   std::vector<int>& particle_bin = scratch.particle_bin;
   std::vector<int>& parent = scratch.parent;
   std::vector<int>& cluster_of_root = scratch.cluster_of_root;
@@ -94,18 +169,18 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
   particle_bin.resize(particles.size());
   // Resampling leaves the copies of one particle side by side, so the bin of
   // the particle before is the likeliest: it spares most hash look-ups.
+  // The keys first, for the whole cloud (vectorised), then the look-ups.
+  std::vector<uint64_t>& packed = scratch.packed;
+  packed.resize(particles.size());
+  packClusterBins(particles, params.cell_xy, yaw_bins, packed.data());
   uint64_t last_key = ~uint64_t{0};
   int last_id = -1;
   for (std::size_t i = 0; i < particles.size(); ++i) {
-    const double yaw01 = (normalizeAngle(particles.yaw[i]) + M_PI) / (2.0 * M_PI);
-    const BinKey key{binIndex(particles.x[i], params.cell_xy),
-                     binIndex(particles.y[i], params.cell_xy),
-                     std::clamp<int64_t>(binIndex(yaw01, 1.0 / yaw_bins), 0, yaw_bins - 1)};
-    const uint64_t packed = BinTable::key(key.x, key.y, key.yaw);
-    if (packed != last_key) {
-      last_id = bin_of.insert(packed);
-      last_key = packed;
-      if (static_cast<std::size_t>(last_id) == keys.size()) keys.push_back(key);
+    if (packed[i] != last_key) {
+      last_id = bin_of.insert(packed[i]);
+      last_key = packed[i];
+      if (static_cast<std::size_t>(last_id) == keys.size())
+        keys.push_back(BinTable::unpack(last_key));
     }
     particle_bin[i] = last_id;
   }

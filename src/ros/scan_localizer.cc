@@ -224,7 +224,7 @@ pf::SweepMotion sweepMotion(const sensor_msgs::LaserScan& scan, const tf2::Buffe
   pf::Pose2 earlier;
   try {
     earlier = toPose2(tf.lookupTransform(config.odom_frame, config.base_frame,
-                                           scan.header.stamp - ros::Duration(window))
+                                         scan.header.stamp - ros::Duration(window))
                           .transform);
   } catch (const tf2::TransformException&) {
     return sweep;  // the first scans of a run: used as they are

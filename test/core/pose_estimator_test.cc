@@ -4,9 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "expect_pose.h"
+#include "pf_localization/core/bin_index.h"
+#include "pf_localization/core/bin_table.h"
 
 namespace pf {
 namespace {
@@ -200,6 +204,48 @@ TEST(Summarize, UsesOnlyTheGivenIndices) {
   EXPECT_NEAR(0.75, c.covariance(0, 0), kTol);
   EXPECT_NEAR(0.0, c.covariance(1, 1), kTol);
   EXPECT_NEAR(0.0, c.covariance(2, 2), kTol);
+}
+
+// The bins by their definition, one particle at a time, against the packed
+// keys: 21 particles (five blocks of four and a tail), with bin edges, a
+// heading on each side of +-pi, headings one step of 2 pi outside (wrapped
+// in the vector code) and one that needs the general wrap (the scalar code
+// from its block on), non-finite coordinates and clouds far off.
+TEST(PackClusterBins, EveryKeyAsByTheDefinition) {
+  const double kNaN = std::numeric_limits<double>::quiet_NaN();
+  const double kInf = std::numeric_limits<double>::infinity();
+  const std::vector<double> xs = {0.0,   0.5,  -0.5, 0.4999999, -1e-300, 1.0,  2.5,
+                                  -0.25, kNaN, kInf, -kInf,     1e9,     -1e9, 3.0,
+                                  0.75,  1.25, -3.0, 7.0,       0.1,     0.2,  0.3};
+  const std::vector<double> ys = {0.0,  0.25, 0.5, -0.5, 1.0, kNaN, 0.0,  -kInf, 0.0, 0.0, 0.0,
+                                  1e12, 0.0,  3.5, -2.0, 0.5, 1.0,  -1.0, 0.0,   0.0, 0.0};
+  const std::vector<double> yaws = {0.0,  M_PI, -M_PI, M_PI - 1e-12, -M_PI + 1e-12, 0.5236, 4.0,
+                                    -4.0, 1.0,  -1.0,  0.0,          2.0,           -2.0,   3.0,
+                                    3.1,  -3.1, 0.0,   10.0,         0.2,           0.4,    kNaN};
+  ParticleSet cloud;
+  cloud.x = xs;
+  cloud.y = ys;
+  cloud.yaw = yaws;  // as they are: setPose would wrap them
+  cloud.weight.assign(xs.size(), 1.0);
+  const int64_t yaw_bins = 12;
+  std::vector<uint64_t> keys(cloud.size());
+  packClusterBins(cloud, 0.5, yaw_bins, keys.data());
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const double yaw01 = (normalizeAngle(yaws[i]) + M_PI) / (2.0 * M_PI);
+    const uint64_t expected = BinTable::key(
+        binIndex(xs[i], 0.5), binIndex(ys[i], 0.5),
+        std::clamp<int64_t>(binIndex(yaw01, 1.0 / static_cast<double>(yaw_bins)), 0, 11));
+    EXPECT_EQ(expected, keys[i]) << "particle " << i << " at " << xs[i] << ", " << ys[i] << ", "
+                                 << yaws[i];
+  }
+  // And the keys unpack to the bins: (0.5, 0.25, pi) is in (1, 0) and the
+  // last heading bin; heading 0 in bin 6 of 12; x = 1e9 m clamps to 2^20 - 1.
+  const BinTable::Bin b = BinTable::unpack(keys[1]);
+  EXPECT_EQ(1, b.x);
+  EXPECT_EQ(0, b.y);
+  EXPECT_EQ(11, b.yaw);
+  EXPECT_EQ(6, BinTable::unpack(keys[0]).yaw);
+  EXPECT_EQ((int64_t{1} << 20) - 1, BinTable::unpack(keys[11]).x);
 }
 
 }  // namespace

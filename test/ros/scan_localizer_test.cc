@@ -68,7 +68,8 @@ sensor_msgs::LaserScan scanFromMoving(const nav_msgs::OccupancyGrid& map, const 
 
 sensor_msgs::LaserScan scanFrom(const nav_msgs::OccupancyGrid& map, const pf::Pose2& laser,
                                 const ros::Time& stamp) {
-  return scanFromMoving(map, [&](int) { return laser; }, stamp);
+  return scanFromMoving(
+      map, [&](int) { return laser; }, stamp);
 }
 
 geometry_msgs::TransformStamped transform(const std::string& parent, const std::string& child,
@@ -244,9 +245,9 @@ TEST_F(ScanLocalizerTest, OdometryMessageBecomesOdomToBaseTransform) {
 // from `from` to `to` s.
 void spinOnTf(tf2::BufferCore* tf, double rate, double from, double to) {
   for (double t = from; t <= to + 1e-9; t += 0.01) {
-    tf->setTransform(transform("odom", "base_link", {0.0, 0.0, pf::normalizeAngle(rate * t)},
-                               ros::Time(t)),
-                     "test");
+    tf->setTransform(
+        transform("odom", "base_link", {0.0, 0.0, pf::normalizeAngle(rate * t)}, ros::Time(t)),
+        "test");
   }
 }
 

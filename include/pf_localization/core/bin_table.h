@@ -19,6 +19,17 @@ class BinTable {
     return (field(x) << 42) | (field(y) << 21) | field(yaw);
   }
 
+  /// The three bin indices of a key, as clamped by key().
+  struct Bin {
+    int64_t x, y, yaw;
+  };
+  static Bin unpack(uint64_t key) {
+    constexpr uint64_t kField = (uint64_t{1} << 21) - 1;
+    return {static_cast<int64_t>((key >> 42) & kField) - kHalfRange,
+            static_cast<int64_t>((key >> 21) & kField) - kHalfRange,
+            static_cast<int64_t>(key & kField) - kHalfRange};
+  }
+
   /// Empties the table, with room for `expected` bins.
   void reset(std::size_t expected) {
     std::size_t capacity = 16;

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <vector>
 
 #include "pf_localization/core/particle_set.h"
@@ -41,6 +42,12 @@ struct PoseEstimate {
 
 /// Weighted mean and covariance of a set of particles (indices into `particles`).
 Cluster summarize(const ParticleSet& particles, const std::vector<std::size_t>& indices);
+
+/// The histogram bin of every particle that estimatePose clusters by, packed
+/// by BinTable::key: x and y in cells of `cell_xy`, the heading (wrapped into
+/// (-pi, pi]) in `yaw_bins` bins that wrap around. Four particles at a time
+/// where the processor has AVX2, with the same keys as one by one.
+void packClusterBins(const ParticleSet& particles, double cell_xy, int64_t yaw_bins, uint64_t* out);
 
 /// Clusters the cloud and summarises every cluster; the estimate is the heaviest.
 /// An empty set gives an estimate with no clusters.
