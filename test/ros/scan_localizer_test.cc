@@ -251,13 +251,19 @@ void spinOnTf(tf2::BufferCore* tf, double rate, double from, double to) {
   }
 }
 
-TEST(SweepMotion, FromOdometryOverTheSweepAndTheStampConvention) {
-  tf2::BufferCore tf;
-  spinOnTf(&tf, 1.0, 9.0, 11.0);
+// A 361-beam scan stamped 10.5 s whose sweep takes 0.2 s.
+sensor_msgs::LaserScan timedScan() {
   sensor_msgs::LaserScan scan;
   scan.header.stamp = ros::Time(10.5);
   scan.ranges.assign(361, 1.0f);
   scan.time_increment = 0.2f / 360.0f;
+  return scan;
+}
+
+TEST(SweepMotion, FromOdometryOverTheSweepAndTheStampConvention) {
+  tf2::BufferCore tf;
+  spinOnTf(&tf, 1.0, 9.0, 11.0);
+  sensor_msgs::LaserScan scan = timedScan();
   const double span = 360.0 * scan.time_increment;
   LocalizerConfig config;
   config.deskew_scans = true;
@@ -281,10 +287,7 @@ TEST(SweepMotion, FromOdometryOverTheSweepAndTheStampConvention) {
 TEST(SweepMotion, StillWhenOffUntimedImplausibleOrWithoutHistory) {
   tf2::BufferCore tf;
   spinOnTf(&tf, 1.0, 10.0, 11.0);
-  sensor_msgs::LaserScan scan;
-  scan.header.stamp = ros::Time(10.5);
-  scan.ranges.assign(361, 1.0f);
-  scan.time_increment = 0.2f / 360.0f;
+  sensor_msgs::LaserScan scan = timedScan();
   LocalizerConfig config;
   const pf::Pose2 odom{0.0, 0.0, 10.5};
   EXPECT_TRUE(sweepMotion(scan, tf, config, odom).isStill()) << "off by default";
