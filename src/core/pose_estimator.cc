@@ -41,7 +41,7 @@ void accumulateRuns(const std::vector<int>& group, double* rows, Term term) {
 }
 
 // The packed histogram bin (BinTable::key) of one particle; yaw bins wrap
-// around, [0, yaw_bins). The reference for packBinKeysAvx2.
+// around, [0, yaw_bins). The reference for packClusterBinsAvx2.
 uint64_t packedBinOf(double x, double y, double yaw, double cell_xy, int64_t yaw_bins,
                      double yaw_bin_size) {
   const double yaw01 = (normalizeAngle(yaw) + M_PI) / (2.0 * M_PI);
@@ -64,9 +64,10 @@ __attribute__((target("avx2"))) inline __m256i binField(__m256d v, __m256d cell,
 // each (division, floor, the same clamps), so the same keys. A block with a
 // heading that one step of 2 pi does not wrap (or NaN) is left to the scalar
 // code. Returns how many particles it packed (a multiple of four).
-__attribute__((target("avx2"))) std::size_t packBinKeysAvx2(const ParticleSet& particles,
-                                                            double cell_xy, int64_t yaw_bins,
-                                                            double yaw_bin_size, uint64_t* out) {
+__attribute__((target("avx2"))) std::size_t packClusterBinsAvx2(const ParticleSet& particles,
+                                                                double cell_xy, int64_t yaw_bins,
+                                                                double yaw_bin_size,
+                                                                uint64_t* out) {
   const std::size_t n = particles.size();
   const __m256d cell = _mm256_set1_pd(cell_xy), yaw_cell = _mm256_set1_pd(yaw_bin_size);
   const __m256d pi = _mm256_set1_pd(M_PI), minus_pi = _mm256_set1_pd(-M_PI);
@@ -110,7 +111,7 @@ void packClusterBins(const ParticleSet& particles, double cell_xy, int64_t yaw_b
   std::size_t i = 0;
 #if defined(__x86_64__)
   static const bool avx2 = __builtin_cpu_supports("avx2");
-  if (avx2) i = packBinKeysAvx2(particles, cell_xy, yaw_bins, yaw_bin_size, out);
+  if (avx2) i = packClusterBinsAvx2(particles, cell_xy, yaw_bins, yaw_bin_size, out);
 #endif
   for (; i < particles.size(); ++i) {
     out[i] = packedBinOf(particles.x[i], particles.y[i], particles.yaw[i], cell_xy, yaw_bins,
@@ -167,12 +168,13 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
   bin_of.reset(particles.size());
   keys.clear();
   particle_bin.resize(particles.size());
-  // Resampling leaves the copies of one particle side by side, so the bin of
-  // the particle before is the likeliest: it spares most hash look-ups.
   // The keys first, for the whole cloud (vectorised), then the look-ups.
+  // Bins beyond +-2^20 cells (524 km at 0.5 m) share the edge bin.
   std::vector<uint64_t>& packed = scratch.packed;
   packed.resize(particles.size());
   packClusterBins(particles, params.cell_xy, yaw_bins, packed.data());
+  // Resampling leaves the copies of one particle side by side, so the bin of
+  // the particle before is the likeliest: it spares most hash look-ups.
   uint64_t last_key = ~uint64_t{0};
   int last_id = -1;
   for (std::size_t i = 0; i < particles.size(); ++i) {
