@@ -27,7 +27,8 @@ struct LocalizerConfig {
   // De-skewing (core/scan_deskew.h): each beam is placed from where the laser
   // was when it took it, using the scan's time_increment and the odometry's
   // velocity. Scans with time_increment 0 are used as they are. Off by
-  // default: on the real bags at hand it changes little (config/pf.yaml).
+  // default: against the raw references at hand it does not help
+  // (README.md, "De-skewing").
   bool deskew_scans = false;
   // Which beam the scan's header stamp is the time of: "first_beam" (ROS's
   // convention, sensor_msgs/LaserScan) or "last_beam" (drivers that stamp a
