@@ -7,26 +7,25 @@
 namespace pf {
 namespace {
 
-// Stands in for "no source" inside the passes: large enough never to win
+// Stands in for "no source" inside the row pass: large enough never to win
 // against a real source, and finite so that no inf - inf turns into NaN.
 constexpr double kFar = 1e20;
 
-// One pass of Felzenszwalb-Huttenlocher over n samples of f (with a stride):
-// d[q] = min_p (q - p)^2 + f[p], the lower envelope of parabolas rooted at
-// every p. v holds the envelope's parabolas, z the boundaries between them.
-void transform1d(const double* f, int n, int stride, double* d, std::vector<int>& v,
-                 std::vector<double>& z) {
+// One pass of Felzenszwalb-Huttenlocher over n samples of f: d[q] = min_p
+// (q - p)^2 + f[p], the lower envelope of parabolas rooted at every p. v
+// holds the envelope's parabolas, z the boundaries between them.
+void transform1d(const double* f, int n, double* d, std::vector<int>& v, std::vector<double>& z) {
   int k = 0;
   v[0] = 0;
   z[0] = -std::numeric_limits<double>::infinity();
   z[1] = std::numeric_limits<double>::infinity();
   for (int q = 1; q < n; ++q) {
     // z[0] is -inf and s is finite (kFar is), so k never drops below 0.
-    const double fq = f[q * stride] + static_cast<double>(q) * q;
+    const double fq = f[q] + static_cast<double>(q) * q;
     double s;
     while (true) {
       const int p = v[k];
-      s = (fq - (f[p * stride] + static_cast<double>(p) * p)) / (2.0 * (q - p));
+      s = (fq - (f[p] + static_cast<double>(p) * p)) / (2.0 * (q - p));
       if (s > z[k]) break;
       --k;
     }
@@ -39,7 +38,7 @@ void transform1d(const double* f, int n, int stride, double* d, std::vector<int>
   for (int q = 0; q < n; ++q) {
     while (z[k + 1] < q) ++k;
     const double dq = q - v[k];
-    d[q * stride] = dq * dq + f[v[k] * stride];
+    d[q] = dq * dq + f[v[k]];
   }
 }
 
@@ -53,21 +52,32 @@ std::vector<float> squaredDistanceTransform(const std::vector<bool>& is_source, 
                                 " flags for a " + std::to_string(width) + " x " +
                                 std::to_string(height) + " grid");
   }
-  std::vector<double> f(n), g(n);
-  for (std::size_t i = 0; i < n; ++i) f[i] = is_source[i] ? 0.0 : kFar;
+  if (n == 0) return {};
+  const std::size_t w = static_cast<std::size_t>(width);
+  constexpr float kNone = std::numeric_limits<float>::infinity();
 
-  const int longest = std::max(width, height);
-  std::vector<int> v(longest);
-  std::vector<double> z(longest + 1);
-  for (int x = 0; x < width; ++x) transform1d(&f[x], height, width, &g[x], v, z);
-  for (int y = 0; y < height; ++y) {
-    transform1d(&g[static_cast<std::size_t>(y) * width], width, 1,
-                &f[static_cast<std::size_t>(y) * width], v, z);
-  }
-
+  // Down the columns, a row at a time so that memory is read in order: each
+  // cell's distance in cells to the nearest source in its own column (inf
+  // when the column has none; inf + 1 stays inf). Below, then above.
   std::vector<float> out(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    out[i] = f[i] >= kFar / 2 ? std::numeric_limits<float>::infinity() : static_cast<float>(f[i]);
+  for (std::size_t x = 0; x < w; ++x) out[x] = is_source[x] ? 0.0f : kNone;
+  for (std::size_t i = w; i < n; ++i) out[i] = is_source[i] ? 0.0f : out[i - w] + 1.0f;
+  for (std::size_t i = n - w; i-- > 0;) out[i] = std::min(out[i], out[i + w] + 1.0f);
+
+  // Along each row, the lower envelope of the columns' squared distances.
+  std::vector<double> f(w), d(w);
+  std::vector<int> v(w);
+  std::vector<double> z(w + 1);
+  for (std::size_t row = 0; row < n; row += w) {
+    float* cells = &out[row];
+    for (std::size_t x = 0; x < w; ++x) {
+      const double g = cells[x];
+      f[x] = cells[x] == kNone ? kFar : g * g;
+    }
+    transform1d(f.data(), width, d.data(), v, z);
+    for (std::size_t x = 0; x < w; ++x) {
+      cells[x] = d[x] >= kFar / 2 ? kNone : static_cast<float>(d[x]);
+    }
   }
   return out;
 }

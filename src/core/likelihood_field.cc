@@ -17,14 +17,11 @@ LikelihoodField::LikelihoodField(const OccupancyGrid& grid, double max_distance)
   for (std::size_t i = 0; i < occupied.size(); ++i) {
     occupied[i] = OccupancyGrid::classify(grid.data()[i]) == CellState::kOccupied;
   }
-  const std::vector<float> squared =
-      squaredDistanceTransform(occupied, grid.width(), grid.height());
-  distances_.resize(squared.size());
+  // Squared cells, turned into metres in place.
+  distances_ = squaredDistanceTransform(occupied, grid.width(), grid.height());
   const float cap = static_cast<float>(max_distance);
   const float res = static_cast<float>(grid.resolution());
-  for (std::size_t i = 0; i < squared.size(); ++i) {
-    distances_[i] = std::min(std::sqrt(squared[i]) * res, cap);  // sqrt(inf) = inf -> cap
-  }
+  for (float& d : distances_) d = std::min(std::sqrt(d) * res, cap);  // sqrt(inf) = inf -> cap
 }
 
 double LikelihoodField::distance(const CellIndex& c) const {
