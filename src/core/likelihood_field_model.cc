@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 #if defined(__x86_64__)
@@ -82,11 +84,25 @@ void LikelihoodFieldModel::buildTable(double range_max) const {
   const double k = params_.likelihood_exponent;
   const float outside = static_cast<float>(k * beamLogLikelihood(field_.maxDistance(), range_max));
   table_.assign(static_cast<std::size_t>(stride) * (grid.height() + 2), outside);
+  // The distances take few values (square roots of whole numbers of cells,
+  // and the cap), so each value's exp and log are computed once, not once per
+  // cell: a direct-mapped memo keyed by the float's bits (a distance is never
+  // NaN, so the all-ones key means empty).
+  struct Memo {
+    uint32_t bits = ~uint32_t{0};
+    float value = 0.0f;
+  };
+  constexpr int kMemoBits = 14;
+  std::vector<Memo> memo(std::size_t{1} << kMemoBits);
   const std::vector<float>& dist = field_.distances();
   for (int y = 0; y < grid.height(); ++y) {
     for (int x = 0; x < grid.width(); ++x) {
-      table_[static_cast<std::size_t>(y + 1) * stride + x + 1] = static_cast<float>(
-          k * beamLogLikelihood(dist[static_cast<std::size_t>(y) * grid.width() + x], range_max));
+      const float d = dist[static_cast<std::size_t>(y) * grid.width() + x];
+      uint32_t bits;
+      std::memcpy(&bits, &d, sizeof bits);
+      Memo& m = memo[(bits * 2654435761u) >> (32 - kMemoBits)];
+      if (m.bits != bits) m = {bits, static_cast<float>(k * beamLogLikelihood(d, range_max))};
+      table_[static_cast<std::size_t>(y + 1) * stride + x + 1] = m.value;
     }
   }
   table_range_max_ = range_max;
