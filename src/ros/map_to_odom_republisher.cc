@@ -6,6 +6,11 @@
 
 namespace pf_ros {
 
+bool RepublishSchedule::due(const ros::Time& now, const ros::Duration& period) {
+  if (next_.isZero() || now + period < next_) next_ = now;
+  return now >= next_;
+}
+
 MapToOdomRepublisher::MapToOdomRepublisher(const MapToOdomRepublisherOptions& options,
                                            TickHook hook)
     : options_(options), hook_(std::move(hook)) {}
@@ -33,7 +38,9 @@ bool MapToOdomRepublisher::set(const std::optional<geometry_msgs::TransformStamp
   // A correction must reach tf now even when the clock has not moved since
   // the last timed publication.
   if (!last_stamp_.isZero() && stamp <= last_stamp_) stamp = last_stamp_ + ros::Duration(1e-3);
-  return publishLocked(stamp);
+  if (!publishLocked(stamp)) return false;
+  if (!now.isZero()) schedule_.published(now, ros::Duration(1.0 / options_.rate));
+  return true;
 }
 
 void MapToOdomRepublisher::reset() {
@@ -41,6 +48,7 @@ void MapToOdomRepublisher::reset() {
   transform_.reset();
   scan_stamp_ = ros::Time();
   last_stamp_ = ros::Time();
+  schedule_.reset();
 }
 
 void MapToOdomRepublisher::setRate(double hz) {
@@ -63,29 +71,24 @@ std::size_t MapToOdomRepublisher::published() const {
 
 void MapToOdomRepublisher::run() {
   std::unique_lock<std::mutex> lock(mutex_);
-  ros::Time next_due;
   while (!stop_) {
     const ros::Duration period(1.0 / options_.rate);
     const ros::Time now = ros::Time::now();
-    if (!now.isZero()) {  // zero: simulated time has not started
-      // The first tick, or time went back (a bag restarted): start again now.
-      if (next_due.isZero() || now + period < next_due) next_due = now;
-      if (now >= next_due) {
-        next_due += period;
-        if (next_due <= now) next_due = now + period;  // late by more than a period
-        lock.unlock();
-        if (hook_) hook_(now);
-        lock.lock();
-        if (stop_) break;
-        const ros::Time stamp =
-            std::max(now, scan_stamp_) + ros::Duration(options_.transform_tolerance);
-        // Between updates, only a later stamp is news (and tf2 refuses a repeated one).
-        if (stamp > last_stamp_) publishLocked(stamp);
-      }
+    // Zero: simulated time has not started.
+    if (!now.isZero() && schedule_.due(now, period)) {
+      schedule_.published(now, period);
+      lock.unlock();
+      if (hook_) hook_(now);
+      lock.lock();
+      if (stop_) break;
+      const ros::Time stamp =
+          std::max(now, scan_stamp_) + ros::Duration(options_.transform_tolerance);
+      // Between updates, only a later stamp is news (and tf2 refuses a repeated one).
+      if (stamp > last_stamp_) publishLocked(stamp);
     }
     double wait = 0.001;
     if (!ros::Time::isSimTime() && !now.isZero()) {
-      wait = std::clamp((next_due - ros::Time::now()).toSec(), 0.0005, 0.1);
+      wait = std::clamp((schedule_.next() - ros::Time::now()).toSec(), 0.0005, 0.1);
     }
     wake_.wait_for(lock, std::chrono::duration<double>(wait));
   }

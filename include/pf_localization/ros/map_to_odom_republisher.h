@@ -1,7 +1,7 @@
 // map -> odom on /tf from a thread of its own: published after every filter
-// update and republished at tf_publish_rate in between. A filter update
-// (80 ms for 500 000 particles) or anything else on the node's spinner
-// therefore never delays it (issue 15: under load the ros::Timer used to wait
+// update, and again whenever 1 / tf_publish_rate s pass without one. A
+// filter update (80 ms for 500 000 particles) or anything else on the node's
+// spinner therefore never delays it (issue 15: under load the ros::Timer used to wait
 // behind the filter on the one spinner, and tf users downstream saw 8 s
 // gaps). It only ever touches the latest transform handed to it, under its
 // own mutex, never the filter. Its own loop rather than a ros::Timer on a
@@ -21,6 +21,26 @@
 #include <thread>
 
 namespace pf_ros {
+
+/// When map -> odom is due again: one period after the latest publication,
+/// timed or after an update, rather than on a fixed beat. Every message costs
+/// the node and each subscriber a few system calls, and tf users still get
+/// one at least once a period.
+class RepublishSchedule {
+ public:
+  /// Whether a timed publication is due at `now`. The first call is, and so
+  /// is any call after time went back (a bag restarted).
+  bool due(const ros::Time& now, const ros::Duration& period);
+  /// Something was published at `now`: the next is due one period later.
+  void published(const ros::Time& now, const ros::Duration& period) { next_ = now + period; }
+  /// Forget the past: due at once.
+  void reset() { next_ = ros::Time(); }
+  /// When the next is due (zero: at once).
+  const ros::Time& next() const { return next_; }
+
+ private:
+  ros::Time next_;
+};
 
 struct MapToOdomRepublisherOptions {
   double rate = 20.0;                // Hz of republishing (tf_publish_rate); > 0
@@ -47,7 +67,8 @@ class MapToOdomRepublisher {
   /// until the next set()), after the scan stamped `scan_stamp` (zero: none):
   /// published at once, stamped max(now, scan_stamp) + transform_tolerance,
   /// or just after the previous stamp when that is not later (tf2 refuses a
-  /// repeated stamp). Returns whether it was published.
+  /// repeated stamp); the next timed publication is then one period later.
+  /// Returns whether it was published.
   bool set(const std::optional<geometry_msgs::TransformStamped>& map_to_odom,
            const ros::Time& scan_stamp);
 
@@ -76,6 +97,7 @@ class MapToOdomRepublisher {
   bool stop_ = false;
   std::optional<geometry_msgs::TransformStamped> transform_;
   ros::Time scan_stamp_, last_stamp_;
+  RepublishSchedule schedule_;
   std::size_t published_ = 0;
   std::thread thread_;
 };
