@@ -312,8 +312,11 @@ class PfNode {
     errno = 0;
     const int nice = ::getpriority(PRIO_PROCESS, tid);
     if (errno == 0) ::setpriority(PRIO_PROCESS, tid, std::min(19, nice + kFilterNiceIncrement));
+    // The destructor's close() wakes the wait; its time-out only bounds how
+    // long a shutdown by another way goes unseen (a shorter one would wake
+    // an idle node ten times a second for nothing).
     while (ros::ok() && !slot_.closed()) {
-      if (auto pending = slot_.take(ros::WallDuration(0.1))) processScan(*pending);
+      if (auto pending = slot_.take(ros::WallDuration(1.0))) processScan(*pending);
     }
   }
 
