@@ -60,36 +60,87 @@ class YamlParamSource : public TypedParamSource<YamlParamSource> {
   std::string path_;
 };
 
+// A node's namespace, fetched from the master in one call when constructed:
+// NodeHandle::hasParam and getParam make a round trip to the master each,
+// and readConfig looks up about a hundred names and their amcl aliases, over
+// 200 round trips at start-up. Values convert as getParam converts them (an
+// int is a double too; a double rounds to the nearest int).
 class RosParamSource : public TypedParamSource<RosParamSource> {
  public:
-  explicit RosParamSource(const ros::NodeHandle& nh) : nh_(nh) {}
+  explicit RosParamSource(const ros::NodeHandle& nh) : nh_(nh) {
+    if (!nh_.getParam(nh_.getNamespace(), params_) ||
+        params_.getType() != XmlRpc::XmlRpcValue::TypeStruct) {
+      params_ = XmlRpc::XmlRpcValue();  // no parameters at all
+    }
+  }
 
   template <typename T>
   bool read(const std::string& key, T* value) const {
-    if (!nh_.hasParam(key)) return false;
-    if (!nh_.getParam(key, *value)) {
+    XmlRpc::XmlRpcValue* v = find(key);
+    if (v == nullptr) return false;
+    if (!convert(*v, value)) {
       throw std::invalid_argument("parameter " + nh_.resolveName(key) + " has the wrong type");
     }
     return true;
   }
 
   std::vector<std::string> keys() const override {
-    // The master lists every parameter by its full name; ours are the first
-    // name component under the node's namespace (a nested ~a/b counts as a).
-    std::vector<std::string> all, names;
-    if (!nh_.getParamNames(all)) return names;
-    const std::string prefix = nh_.getNamespace() + "/";
-    for (const std::string& full : all) {
-      if (full.compare(0, prefix.size(), prefix) != 0) continue;
-      const std::string name =
-          full.substr(prefix.size(), full.find('/', prefix.size()) - prefix.size());
-      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
-    }
+    std::vector<std::string> names;
+    if (params_.getType() != XmlRpc::XmlRpcValue::TypeStruct) return names;
+    for (const auto& entry : params_) names.push_back(entry.first);
     return names;
   }
 
  private:
+  // The value at `key` ("a/b" looks inside a), or nullptr.
+  XmlRpc::XmlRpcValue* find(const std::string& key) const {
+    XmlRpc::XmlRpcValue* v = &params_;
+    std::size_t start = 0;
+    while (true) {
+      const std::size_t slash = key.find('/', start);
+      const std::string name = key.substr(start, slash - start);
+      if (v->getType() != XmlRpc::XmlRpcValue::TypeStruct || !v->hasMember(name)) return nullptr;
+      v = &(*v)[name];
+      if (slash == std::string::npos) return v;
+      start = slash + 1;
+    }
+  }
+
+  static bool convert(XmlRpc::XmlRpcValue& v, double* out) {
+    if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) {
+      *out = static_cast<int>(v);
+    } else if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+      *out = static_cast<double>(v);
+    } else {
+      return false;
+    }
+    return true;
+  }
+  static bool convert(XmlRpc::XmlRpcValue& v, int* out) {
+    if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
+      const double d = v;
+      *out = static_cast<int>(std::fmod(d, 1.0) < 0.5 ? std::floor(d) : std::ceil(d));
+    } else if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) {
+      *out = static_cast<int>(v);
+    } else {
+      return false;
+    }
+    return true;
+  }
+  static bool convert(XmlRpc::XmlRpcValue& v, bool* out) {
+    if (v.getType() != XmlRpc::XmlRpcValue::TypeBoolean) return false;
+    *out = static_cast<bool>(v);
+    return true;
+  }
+  static bool convert(XmlRpc::XmlRpcValue& v, std::string* out) {
+    if (v.getType() != XmlRpc::XmlRpcValue::TypeString) return false;
+    *out = static_cast<std::string>(v);
+    return true;
+  }
+
   ros::NodeHandle nh_;
+  // Mutable: XmlRpcValue's accessors are not const.
+  mutable XmlRpc::XmlRpcValue params_;
 };
 
 void require(bool ok, const std::string& name, const std::string& range) {
