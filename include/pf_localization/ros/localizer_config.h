@@ -22,7 +22,7 @@ struct LocalizerConfig {
   std::string odom_frame = "odom";
   std::string base_frame = "base_link";
   double transform_tolerance = 0.1;  // s the published map->odom is post-dated by
-  double tf_publish_rate = 20.0;     // Hz map->odom is republished between updates
+  double tf_publish_rate = 20.0;     // Hz: map->odom republished when 1/rate s pass without one
   bool tf_broadcast = true;
   // De-skewing (core/scan_deskew.h): each beam is placed from where the laser
   // was when it took it, using the scan's time_increment and the odometry's
