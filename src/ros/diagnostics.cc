@@ -1,17 +1,19 @@
 #include "pf_localization/ros/diagnostics.h"
 
 #include <cmath>
-#include <sstream>
+#include <cstdio>
 
 namespace pf_ros {
 namespace {
 
+// As an ostream shows a double by default (%g, 6 digits), without building
+// one: some twenty values are formatted after every update.
 void add(diagnostic_msgs::DiagnosticStatus* status, const std::string& key, double value) {
-  std::ostringstream text;
-  text << value;
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", value);
   diagnostic_msgs::KeyValue kv;
   kv.key = key;
-  kv.value = text.str();
+  kv.value = text;
   status->values.push_back(kv);
 }
 

@@ -2,7 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -22,10 +22,9 @@ void addMs(diagnostic_msgs::DiagnosticStatus* status, const std::string& prefix,
   for (const auto& [suffix, value] : {std::pair<const char*, double>{"_p50_ms", r.percentile(0.5)},
                                       std::pair<const char*, double>{"_p95_ms", r.percentile(0.95)},
                                       std::pair<const char*, double>{"_max_ms", r.max()}}) {
-    std::ostringstream text;
-    text.precision(1);
-    text << std::fixed << value * 1e3;
-    add(status, prefix + suffix, text.str());
+    char text[64];  // a duration in ms: a handful of digits, truncated past 63
+    std::snprintf(text, sizeof text, "%.1f", value * 1e3);
+    add(status, prefix + suffix, text);
   }
 }
 
