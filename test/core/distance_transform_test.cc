@@ -92,6 +92,12 @@ TEST(SquaredDistanceTransform, SourceOnlyInOneColumnReachesTheWholeGrid) {
   EXPECT_EQ(expected, squaredDistanceTransform(sources(4, 3, {{3, 2}}), 4, 3));
 }
 
+TEST(SquaredDistanceTransform, EmptyGridsGiveNothing) {
+  EXPECT_TRUE(squaredDistanceTransform({}, 0, 0).empty());
+  EXPECT_TRUE(squaredDistanceTransform({}, 5, 0).empty());
+  EXPECT_TRUE(squaredDistanceTransform({}, 0, 5).empty());
+}
+
 TEST(SquaredDistanceTransform, MatchesBruteForceOnRandomGrids) {
   std::mt19937 rng(1234);
   const int width = 30, height = 20;

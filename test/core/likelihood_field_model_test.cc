@@ -184,6 +184,31 @@ TEST(LikelihoodFieldModel, RangeMaxChangesAreNotServedFromAStaleTable) {
   EXPECT_NEAR(kLogP0 + kLogP06, model.logLikelihood(short_scan, pose), kTol);
 }
 
+TEST(LikelihoodFieldModel, EveryCellScoresItsOwnDistanceOnALargeMap) {
+  // 200 x 200 cells of 0.1 m with one occupied cell in a corner and no cap
+  // inside the map: 13 648 distinct distances, so that the table's memo of
+  // exp and log (16 384 slots, direct-mapped) evicts and recomputes entries.
+  // A Gaussian without z_rand, so that near distances give distinct values.
+  std::vector<int8_t> data(200 * 200, 0);
+  data[0] = 100;
+  LikelihoodFieldModelParams p = params(100.0);
+  p.z_rand = 0.0;
+  p.sigma_hit = 5.0;
+  const LikelihoodFieldModel model(OccupancyGrid(200, 200, 0.1, {}, data), p);
+  const std::vector<float>& distance = model.field().distances();
+  // One beam of 1 m along +x, from 1 m left of each cell's centre.
+  const PreparedScan scan = model.prepare(quarterScan({1.0f}));
+  ASSERT_EQ(1u, scan.size());
+  for (int y = 0; y < 200; y += 3) {
+    for (int x = 0; x < 200; ++x) {
+      const float expected =
+          static_cast<float>(model.beamLogLikelihood(distance[y * 200 + x], scan.range_max));
+      const double got = model.logLikelihood(scan, {(x + 0.5) * 0.1 - 1.0, (y + 0.5) * 0.1, 0.0});
+      ASSERT_EQ(expected, static_cast<float>(got)) << "cell (" << x << ", " << y << ")";
+    }
+  }
+}
+
 TEST(LikelihoodFieldModel, RotatedMapOrigin) {
   // The same cells, but the map's x axis points along world +y and its
   // corner is at (2, 1): a pose p of the unrotated map is origin (+) p here.
