@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -63,8 +64,10 @@ class YamlParamSource : public TypedParamSource<YamlParamSource> {
 // A node's namespace, fetched from the master in one call when constructed:
 // NodeHandle::hasParam and getParam make a round trip to the master each,
 // and readConfig looks up about a hundred names and their amcl aliases, over
-// 200 round trips at start-up. Values convert as getParam converts them (an
-// int is a double too; a double rounds to the nearest int).
+// 200 round trips at start-up. Values convert as getParam converts them: an
+// int is a double too, and a double is rounded to an int by getParam's rule
+// (up from a fractional part of 0.5; beyond an int's range, clamped, so that
+// the range check names the value).
 class RosParamSource : public TypedParamSource<RosParamSource> {
  public:
   explicit RosParamSource(const ros::NodeHandle& nh) : nh_(nh) {
@@ -119,7 +122,10 @@ class RosParamSource : public TypedParamSource<RosParamSource> {
   static bool convert(XmlRpc::XmlRpcValue& v, int* out) {
     if (v.getType() == XmlRpc::XmlRpcValue::TypeDouble) {
       const double d = v;
-      *out = static_cast<int>(std::fmod(d, 1.0) < 0.5 ? std::floor(d) : std::ceil(d));
+      if (std::isnan(d)) return false;
+      const double rounded = std::fmod(d, 1.0) < 0.5 ? std::floor(d) : std::ceil(d);
+      *out = static_cast<int>(std::clamp<double>(rounded, std::numeric_limits<int>::min(),
+                                                 std::numeric_limits<int>::max()));
     } else if (v.getType() == XmlRpc::XmlRpcValue::TypeInt) {
       *out = static_cast<int>(v);
     } else {
