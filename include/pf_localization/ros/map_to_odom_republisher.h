@@ -1,10 +1,10 @@
 // map -> odom on /tf from a thread of its own: published after every filter
 // update, and again whenever 1 / tf_publish_rate s pass without one. A
-// filter update (80 ms for 500 000 particles) or anything else on the node's
-// spinner therefore never delays it (issue 15: under load the ros::Timer used to wait
-// behind the filter on the one spinner, and tf users downstream saw 8 s
-// gaps). It only ever touches the latest transform handed to it, under its
-// own mutex, never the filter. Its own loop rather than a ros::Timer on a
+// filter update (80 ms for 500 000 particles) or anything else on the
+// node's spinner therefore never delays it (issue 15: under load the
+// ros::Timer used to wait behind the filter on the one spinner, and tf users
+// downstream saw 8 s gaps). It only ever touches the latest transform handed
+// to it, under its own mutex, never the filter. Its own loop rather than a ros::Timer on a
 // callback queue of its own: that would take two thread hops (roscpp's timer
 // thread, then the queue's spinner) per tick, each a chance to be descheduled
 // on a loaded computer.
@@ -24,8 +24,8 @@ namespace pf_ros {
 
 /// When map -> odom is due again: one period after the latest publication,
 /// timed or after an update, rather than on a fixed beat. Every message costs
-/// the node and each subscriber a few system calls, and tf users still get
-/// one at least once a period.
+/// the node and each subscriber about ten system calls, and tf users still
+/// get one at least once a period.
 class RepublishSchedule {
  public:
   /// Whether a timed publication is due at `now`. The first call is, and so
