@@ -12,7 +12,7 @@
 # Builds in the benchmark workspace (scripts/benchmark.sh's). Not a test: the
 # figures depend on the machine and on what else runs on it.
 #
-#   scripts/live_cpu [ROUNDS]      (default 3; about 4 minutes a round)
+#   bash scripts/live_cpu.sh [ROUNDS]  (default 3; about 4 minutes a round)
 set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 rounds=${1:-3}
