@@ -21,8 +21,7 @@ int main(int argc, char** argv) {
   ros::init(argc, argv, "pf_node");
   ros::NodeHandle nh;
   pf_ros::InlineCallbackQueue inline_queue(ros::getGlobalCallbackQueue());
-  ros::NodeHandle inline_nh(nh);
-  inline_nh.setCallbackQueue(&inline_queue);
+  ros::NodeHandle inline_nh = pf_ros::withQueue(nh, &inline_queue);
   tf2_ros::Buffer buffer(ros::Duration(30.0));
   tf2_ros::TransformListener listener(buffer, inline_nh, false);
   tf2_ros::TransformBroadcaster broadcaster;

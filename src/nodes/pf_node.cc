@@ -64,12 +64,6 @@
 namespace pf_ros {
 namespace {
 
-// `nh` with its callbacks on `queue`.
-ros::NodeHandle withQueue(ros::NodeHandle nh, ros::CallbackQueueInterface* queue) {
-  nh.setCallbackQueue(queue);
-  return nh;
-}
-
 std::string failureText(tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
   switch (reason) {
     case tf2_ros::filter_failure_reasons::OutTheBack:

@@ -25,6 +25,7 @@
 #pragma once
 
 #include <ros/callback_queue_interface.h>
+#include <ros/node_handle.h>
 
 #include <cstdint>
 #include <functional>
@@ -50,6 +51,12 @@ class InlineCallbackQueue : public ros::CallbackQueueInterface {
   ros::CallbackQueueInterface* fallback_;
   std::shared_mutex running_;  // held shared by every callback running here
 };
+
+/// `nh` with its callbacks on `queue` (an InlineCallbackQueue, say).
+inline ros::NodeHandle withQueue(ros::NodeHandle nh, ros::CallbackQueueInterface* queue) {
+  nh.setCallbackQueue(queue);
+  return nh;
+}
 
 /// Leaves `fn` to `queue` (the main spinner's, say), under `owner_id` for
 /// removeByID: for work that must not run on the thread at hand.
