@@ -76,6 +76,9 @@ void MapToOdomRepublisher::run() {
     const ros::Time now = ros::Time::now();
     // Zero: simulated time has not started.
     if (!now.isZero() && schedule_.due(now, period)) {
+      // The tick counts as a publication even when it has nothing new to
+      // send (no map -> odom yet, or no later stamp): otherwise it would
+      // stay due and the loop would spin.
       schedule_.published(now, period);
       lock.unlock();
       if (hook_) hook_(now);
