@@ -4,29 +4,34 @@
 #include <stdexcept>
 #include <string>
 
-#include "pf_localization/core/parameter_check.h"
-
 namespace pf {
+
+const ParameterTable<BeamModelParams>& beamModelParameters() {
+  using P = BeamModelParams;
+  using I = ParamInfo;
+  static const ParameterTable<P> table = {
+      member(&P::z_short, I("laser_z_short", "", "beam model: weight of unexpected obstacles")
+                              .in(Range::atLeast(0))
+                              .amcl()
+                              .live(0, 1)),
+      member(&P::z_max, I("laser_z_max", "", "beam model: weight of max-range readings")
+                            .in(Range::atLeast(0))
+                            .amcl()
+                            .live(0, 1)),
+      member(&P::lambda_short,
+             I("laser_lambda_short", "1/m", "beam model: rate of the short readings")
+                 .in(Range::above(0))
+                 .amcl()
+                 .live(0.001, 10)),
+  };
+  return table;
+}
 
 BeamModel::BeamModel(const OccupancyGrid& grid, const LikelihoodFieldModelParams& shared,
                      const BeamModelParams& params)
     : shared_(shared), params_(params), field_(grid, shared.max_distance), caster_(grid) {
-  requireParameter(params.z_short >= 0.0 && std::isfinite(params.z_short), "laser_z_short", ">= 0",
-                   params.z_short);
-  requireParameter(params.z_max >= 0.0 && std::isfinite(params.z_max), "laser_z_max", ">= 0",
-                   params.z_max);
-  requireParameter(params.lambda_short > 0.0 && std::isfinite(params.lambda_short),
-                   "laser_lambda_short", "> 0", params.lambda_short);
-  requireParameter(shared.z_hit >= 0.0 && std::isfinite(shared.z_hit), "laser_z_hit", ">= 0",
-                   shared.z_hit);
-  requireParameter(shared.z_rand >= 0.0 && std::isfinite(shared.z_rand), "laser_z_rand", ">= 0",
-                   shared.z_rand);
-  requireParameter(shared.sigma_hit > 0.0 && std::isfinite(shared.sigma_hit), "laser_sigma_hit",
-                   "> 0", shared.sigma_hit);
-  requireParameter(shared.likelihood_exponent > 0.0 && shared.likelihood_exponent <= 1.0,
-                   "laser_likelihood_exponent", "in (0, 1]", shared.likelihood_exponent);
-  requireParameter(shared.max_beams >= 1, "laser_max_beams", ">= 1", shared.max_beams);
-  requireParameter(shared.threads >= 1, "sensor_threads", ">= 1", shared.threads);
+  checkRanges(beamModelParameters(), params);
+  validate(shared);
 }
 
 PreparedScan BeamModel::prepare(const LaserScan& scan, int max_beams) const {

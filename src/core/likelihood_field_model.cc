@@ -12,47 +12,97 @@
 
 #include "pf_localization/core/fast_math.h"
 #include "pf_localization/core/parameter_check.h"
+#include "pf_localization/core/parameter_table.h"
 #include "pf_localization/core/thread_scratch.h"
 
 namespace pf {
-namespace {
 
-void require(bool ok, const std::string& what) {
-  if (!ok) throw std::invalid_argument("likelihood field model: " + what);
+const ParameterTable<LikelihoodFieldModelParams>& likelihoodFieldParameters() {
+  using P = LikelihoodFieldModelParams;
+  using I = ParamInfo;
+  static const ParameterTable<P> table = {
+      member(&P::max_beams, I("laser_max_beams", "beams", "beams used per scan, evenly spaced")
+                                .in(Range::atLeast(1))
+                                .amcl()
+                                .live(0, 10000)),
+      member(&P::range_min, I("laser_min_range", "m", "ignore beams shorter than this")
+                                .in(Range::atLeast(0))
+                                .withNote("0 or less: the scan's range_min")
+                                .amcl()
+                                .live(-1, 100)),
+      member(&P::range_max, I("laser_max_range", "m", "ignore beams at or beyond this")
+                                .in(Range::atLeast(0))
+                                .withNote("0 or less: the scan's range_max")
+                                .amcl()
+                                .live(-1, 100)),
+      member(&P::z_hit, I("laser_z_hit", "", "weight of the Gaussian hit component")
+                            .in(Range::atLeast(0))
+                            .amcl()
+                            .live(0, 1)),
+      member(&P::z_rand, I("laser_z_rand", "", "weight of the uniform random component")
+                             .in(Range::atLeast(0))
+                             .amcl()
+                             .live(0, 1)),
+      member(&P::sigma_hit, I("laser_sigma_hit", "m", "std dev of the hit component")
+                                .in(Range::above(0))
+                                .amcl()
+                                .live(0, 10)),
+      member(&P::max_distance, I("laser_likelihood_max_dist", "m", "distance field cap")
+                                   .in(Range::above(0))
+                                   .amcl()
+                                   .live(0, 20)),
+      member(&P::likelihood_exponent,
+             I("laser_likelihood_exponent", "",
+               "power of the scan likelihood: a scan's beams are not independent, and their plain "
+               "product (1) is overconfident")
+                 .in(Range::openClosed(0, 1))
+                 .live(0, 1)),
+      member(&P::threads, I("sensor_threads", "threads",
+                            "threads scoring the particles; the same result for any")
+                              .in(Range::atLeast(1))),
+      member(&P::beam_skip,
+             I("do_beamskip", "", "likelihood_field_prob: skip beams most particles disagree with")
+                 .amcl()
+                 .live()),
+  };
+  return table;
 }
 
-}  // namespace
+const ParameterTable<LikelihoodFieldModelParams>& beamSkipParameters() {
+  using P = LikelihoodFieldModelParams;
+  using I = ParamInfo;
+  static const ParameterTable<P> table = {
+      member(&P::beam_skip_distance,
+             I("beam_skip_distance", "m", "an end point this close to an obstacle agrees")
+                 .in(Range::above(0))
+                 .amcl()
+                 .live(0.001, 5)),
+      member(&P::beam_skip_threshold,
+             I("beam_skip_threshold", "", "share of the particles that must agree on a beam")
+                 .in(Range::closed(0, 1))
+                 .amcl()
+                 .live(0, 1)),
+      // amcl reads only the misspelt name; configurations written for it exist.
+      member(&P::beam_skip_error_threshold,
+             I("beam_skip_error_threshold", "", "skip nothing when this share would be skipped")
+                 .in(Range::closed(0, 1))
+                 .amclAlias("beam_skip_error_threshold_")
+                 .live(0, 1)),
+  };
+  return table;
+}
 
-void validateBeamSkip(const LikelihoodFieldModelParams& params) {
-  if (!params.beam_skip) return;
-  requireParameter(params.beam_skip_distance > 0.0 && std::isfinite(params.beam_skip_distance),
-                   "beam_skip_distance", "> 0", params.beam_skip_distance);
-  requireParameter(params.beam_skip_threshold >= 0.0 && params.beam_skip_threshold <= 1.0,
-                   "beam_skip_threshold", "in [0, 1]", params.beam_skip_threshold);
-  requireParameter(
-      params.beam_skip_error_threshold >= 0.0 && params.beam_skip_error_threshold <= 1.0,
-      "beam_skip_error_threshold", "in [0, 1]", params.beam_skip_error_threshold);
+void validate(const LikelihoodFieldModelParams& params) {
+  checkRanges(likelihoodFieldParameters(), params);
+  // Unused, so unchecked, while skipping is off (as in amcl).
+  if (params.beam_skip) checkRanges(beamSkipParameters(), params);
+  requireParameter(params.z_hit + params.z_rand > 0.0, "laser_z_hit + laser_z_rand", "> 0",
+                   params.z_hit + params.z_rand);
 }
 
 LikelihoodFieldModel::LikelihoodFieldModel(const OccupancyGrid& grid,
                                            const LikelihoodFieldModelParams& params)
-    : params_(params), field_(grid, params.max_distance) {
-  require(params.z_hit >= 0.0 && std::isfinite(params.z_hit), "laser_z_hit must be >= 0");
-  require(params.z_rand >= 0.0 && std::isfinite(params.z_rand), "laser_z_rand must be >= 0");
-  require(params.z_hit + params.z_rand > 0.0, "laser_z_hit + laser_z_rand must be positive, got " +
-                                                  std::to_string(params.z_hit + params.z_rand));
-  require(params.sigma_hit > 0.0 && std::isfinite(params.sigma_hit),
-          "laser_sigma_hit must be positive, got " + std::to_string(params.sigma_hit));
-  require(params.likelihood_exponent > 0.0 && params.likelihood_exponent <= 1.0,
-          "laser_likelihood_exponent must be in (0, 1], got " +
-              std::to_string(params.likelihood_exponent));
-  require(params.threads >= 1,
-          "sensor_threads must be >= 1, got " + std::to_string(params.threads));
-  require(params.max_beams >= 1,
-          "laser_max_beams must be >= 1, got " + std::to_string(params.max_beams));
-  require(params.range_min >= 0.0 && params.range_max >= 0.0,
-          "laser_min_range and laser_max_range must be >= 0");
-  validateBeamSkip(params);
+    : params_((validate(params), params)), field_(grid, params.max_distance) {
   if (!params.beam_skip) return;
   const int stride = grid.width() + 2;
   near_.assign(static_cast<std::size_t>(stride) * (grid.height() + 2), 0);

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "pf_localization/core/fast_math.h"
+#include "pf_localization/core/parameter_check.h"
 #include "pf_localization/core/thread_scratch.h"
 
 namespace pf {
@@ -37,27 +38,55 @@ double sampleTranslation(double trans, double sigma, double fault_fraction, doub
   return trans - random->gaussian(sigma);
 }
 
-void checkAlpha(const char* name, double value) {
-  if (!(value >= 0.0) || !std::isfinite(value)) {
-    throw std::invalid_argument(std::string("motion model: ") + name +
-                                " must be a finite number >= 0, got " + std::to_string(value));
-  }
+std::string kindName(OdometryMotionParams::Kind kind) {
+  return kind == OdometryMotionParams::Kind::kOmni ? "omni" : "diff";
+}
+
+void setKind(OdometryMotionParams& p, const std::string& word, const ParamInfo& info) {
+  checkValue(info, word);
+  // amcl's "-corrected" variants fixed bugs of its own; the models here are the corrected ones.
+  p.kind = word.rfind("omni", 0) == 0 ? OdometryMotionParams::Kind::kOmni
+                                      : OdometryMotionParams::Kind::kDifferential;
 }
 
 }  // namespace
 
-OdometryMotionModel::OdometryMotionModel(const OdometryMotionParams& params) : params_(params) {
-  checkAlpha("odom_alpha1", params.alpha1);
-  checkAlpha("odom_alpha2", params.alpha2);
-  checkAlpha("odom_alpha3", params.alpha3);
-  checkAlpha("odom_alpha4", params.alpha4);
-  checkAlpha("odom_alpha5", params.alpha5);
-  if (!(params.fault_fraction >= 0.0 && params.fault_fraction < 1.0)) {
-    throw std::invalid_argument("motion model: odom_fault_fraction must be in [0, 1), got " +
-                                std::to_string(params.fault_fraction));
-  }
-  checkAlpha("odom_fault_margin", params.fault_margin);
+const ParameterTable<OdometryMotionParams>& odometryMotionParameters() {
+  using P = OdometryMotionParams;
+  using I = ParamInfo;
+  static const I kind = I("odom_model_type", "", "diff (differential drive) or omni (holonomic)")
+                            .oneOf({"diff", "diff-corrected", "omni", "omni-corrected"})
+                            .amcl();
+  const auto alpha = [](const char* name, const char* unit, const char* what) {
+    return I(name, unit, what).in(Range::atLeast(0)).amcl().live(0, 10);
+  };
+  static const ParameterTable<P> table = {
+      computed<P, std::string>([](const P& p) { return kindName(p.kind); },
+                               [](P& p, const std::string& w) { setKind(p, w, kind); }, kind),
+      member(&P::alpha1, alpha("odom_alpha1", "rad^2/rad^2", "rotation noise from rotation")),
+      member(&P::alpha2, alpha("odom_alpha2", "rad^2/m^2", "rotation noise from translation")),
+      member(&P::alpha3, alpha("odom_alpha3", "m^2/m^2", "translation noise from translation")),
+      member(&P::alpha4, alpha("odom_alpha4", "m^2/rad^2", "translation noise from rotation")),
+      member(&P::alpha5, alpha("odom_alpha5", "m^2/m^2", "strafe noise from translation (omni)")),
+  };
+  return table;
 }
+
+void validate(const OdometryMotionParams& p) {
+  checkRanges(odometryMotionParameters(), p);
+  requireParameter(p.fault_fraction >= 0.0 && p.fault_fraction < 1.0,
+                   "OdometryMotionParams::fault_fraction", "in [0, 1)", p.fault_fraction);
+  requireParameter(p.fault_fraction_max >= p.fault_fraction && p.fault_fraction_max < 1.0,
+                   "OdometryMotionParams::fault_fraction_max", "in [fault_fraction, 1)",
+                   p.fault_fraction_max);
+  requireParameter(p.fault_suspect_fraction > 0.0, "OdometryMotionParams::fault_suspect_fraction",
+                   "> 0", p.fault_suspect_fraction);
+  requireParameter(p.fault_margin >= 0.0 && std::isfinite(p.fault_margin),
+                   "OdometryMotionParams::fault_margin", ">= 0", p.fault_margin);
+}
+
+OdometryMotionModel::OdometryMotionModel(const OdometryMotionParams& params)
+    : params_((validate(params), params)) {}
 
 OdometryStep OdometryMotionModel::decompose(const Pose2& from, const Pose2& to) {
   const double dx = to.x - from.x;

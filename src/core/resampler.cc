@@ -10,6 +10,33 @@
 
 namespace pf {
 
+const ParameterTable<KldParams>& kldParameters() {
+  using P = KldParams;
+  using I = ParamInfo;
+  static const ParameterTable<P> table = {
+      member(&P::min_particles,
+             I("min_particles", "particles", "KLD-sampling never goes below this")
+                 .in(Range::atLeast(1))
+                 .amcl()
+                 .live(0, 1000000)),
+      member(&P::max_particles, I("max_particles", "particles",
+                                  "and never above this; global localization starts with this many")
+                                    .in(Range::atLeast(1))
+                                    .amcl()
+                                    .live(0, 1000000)),
+      member(&P::kld_err, I("kld_err", "", "KLD-sampling bound on the approximation error")
+                              .in(Range::above(0))
+                              .amcl()
+                              .live(0, 1)),
+      // amcl's kld_z is the normal quantile of this probability (readConfig converts it).
+      member(&P::confidence, I("kld_confidence", "", "probability that the KLD bound holds")
+                                 .in(Range::open(0, 1))
+                                 .amclAlias("kld_z")
+                                 .live(0, 1)),
+  };
+  return table;
+}
+
 double effectiveSampleSize(const std::vector<double>& weights) {
   double sum_sq = 0.0;
   for (double w : weights) sum_sq += w * w;

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "pf_localization/core/parameter_check.h"
+#include "pf_localization/core/parameter_table.h"
 #include "pf_localization/ros/amcl_params.h"
 
 namespace pf_ros {
@@ -32,6 +33,14 @@ class TypedParamSource : public ParamSource {
   const Derived& self() const { return static_cast<const Derived&>(*this); }
 };
 
+template <typename T>
+const char* expected() {
+  if constexpr (std::is_same_v<T, double>) return "a number";
+  if constexpr (std::is_same_v<T, int>) return "an integer";
+  if constexpr (std::is_same_v<T, bool>) return "true or false";
+  return "a string";
+}
+
 class YamlParamSource : public TypedParamSource<YamlParamSource> {
  public:
   YamlParamSource(YAML::Node root, std::string path)
@@ -44,7 +53,8 @@ class YamlParamSource : public TypedParamSource<YamlParamSource> {
     try {
       *value = node.as<T>();
     } catch (const YAML::Exception&) {
-      throw std::invalid_argument(path_ + ": parameter " + key + " has the wrong type");
+      throw std::invalid_argument(path_ + ": parameter " + key + " has the wrong type: expected " +
+                                  expected<T>() + ", got '" + YAML::Dump(node) + "'");
     }
     return true;
   }
@@ -82,7 +92,9 @@ class RosParamSource : public TypedParamSource<RosParamSource> {
     XmlRpc::XmlRpcValue* v = find(key);
     if (v == nullptr) return false;
     if (!convert(*v, value)) {
-      throw std::invalid_argument("parameter " + nh_.resolveName(key) + " has the wrong type");
+      throw std::invalid_argument("parameter " + nh_.resolveName(key) +
+                                  " has the wrong type: expected " + expected<T>() + ", got " +
+                                  typeName(*v));
     }
     return true;
   }
@@ -106,6 +118,21 @@ class RosParamSource : public TypedParamSource<RosParamSource> {
       v = &(*v)[name];
       if (slash == std::string::npos) return v;
       start = slash + 1;
+    }
+  }
+
+  static std::string typeName(XmlRpc::XmlRpcValue& v) {
+    switch (v.getType()) {
+      case XmlRpc::XmlRpcValue::TypeBoolean:
+        return std::string("the boolean ") + (static_cast<bool>(v) ? "true" : "false");
+      case XmlRpc::XmlRpcValue::TypeInt:
+        return "the integer " + std::to_string(static_cast<int>(v));
+      case XmlRpc::XmlRpcValue::TypeDouble:
+        return "the number " + pf::formatNumber(static_cast<double>(v));
+      case XmlRpc::XmlRpcValue::TypeString:
+        return "the string '" + static_cast<std::string>(v) + "'";
+      default:
+        return "a list, a dictionary or a date";
     }
   }
 
@@ -149,26 +176,225 @@ class RosParamSource : public TypedParamSource<RosParamSource> {
   mutable XmlRpc::XmlRpcValue params_;
 };
 
-void require(bool ok, const std::string& name, const std::string& range) {
-  if (!ok) throw std::invalid_argument("invalid parameter " + name + ": must be " + range);
-}
-
 template <typename T>
 std::string show(const T& value) {
-  std::ostringstream s;
-  s << std::boolalpha << value;
-  return s.str();
+  if constexpr (std::is_same_v<T, double>) {
+    return pf::formatNumber(value);
+  } else {
+    std::ostringstream s;
+    s << std::boolalpha << value;
+    return s.str();
+  }
 }
 
 // Whether our `name` set to `ours` and its amcl alias set to `amcls` mean the same.
 template <typename T>
-bool agree(const std::string&, const T& ours, const T& amcls) {
+bool agree(const std::string& name, const T& ours, const T& amcls) {
+  if constexpr (std::is_same_v<T, double>) {
+    if (name == "kld_confidence") return std::fabs(kldConfidenceFromZ(amcls) - ours) < 1e-9;
+  }
   return ours == amcls;
 }
 
-bool agree(const std::string& name, const double& ours, const double& amcls) {
-  if (name == "kld_confidence") return std::fabs(kldConfidenceFromZ(amcls) - ours) < 1e-9;
-  return ours == amcls;
+double nan() { return std::numeric_limits<double>::quiet_NaN(); }
+
+// initial_pose_x / _y / _a: the optional pose, one coordinate at a time.
+pf::Parameter<LocalizerConfig> initialPoseRow(double pf::Pose2::*coordinate, pf::ParamInfo info) {
+  return pf::computed<LocalizerConfig, double>(
+      [coordinate](const LocalizerConfig& c) {
+        return c.initial_pose ? (*c.initial_pose).*coordinate
+                              : (coordinate == &pf::Pose2::yaw ? 0.0 : nan());
+      },
+      [coordinate](LocalizerConfig& c, const double& v) {
+        if (!c.initial_pose) c.initial_pose = pf::Pose2{nan(), nan(), 0.0};
+        (*c.initial_pose).*coordinate = v;
+      },
+      std::move(info));
+}
+
+// initial_cov_xx / _yy / _aa: the diagonal of the initial covariance.
+pf::Parameter<LocalizerConfig> initialCovRow(int i, pf::ParamInfo info) {
+  return pf::computed<LocalizerConfig, double>(
+      [i](const LocalizerConfig& c) { return c.initial_cov(i, i); },
+      [i](LocalizerConfig& c, const double& v) { c.initial_cov(i, i) = v; }, std::move(info));
+}
+
+// The rows of LocalizerConfig's own members (the filter's are particleFilterParameters()).
+const pf::ParameterTable<LocalizerConfig>& ownParameters() {
+  using C = LocalizerConfig;
+  using I = pf::ParamInfo;
+  using pf::Range;
+  static const pf::ParameterTable<C> table = [] {
+    pf::ParameterTable<C> t;
+    pf::append(
+        &t,
+        {pf::member(&C::global_frame, I("global_frame", "",
+                                        "frame of the map and the "
+                                        "published estimates")
+                                          .amclAlias("global_frame_id")),
+         pf::member(&C::odom_frame,
+                    I("odom_frame", "", "frame of the wheel odometry").amclAlias("odom_frame_id")),
+         pf::member(&C::base_frame,
+                    I("base_frame", "", "the robot's body frame (odom -> it is odometry)")
+                        .amclAlias("base_frame_id"))},
+        "frames");
+    pf::append(
+        &t,
+        {pf::member(&C::tf_broadcast, I("tf_broadcast", "", "publish map -> odom on tf").amcl()),
+         pf::member(&C::transform_tolerance,
+                    I("transform_tolerance", "s",
+                      "map -> odom is stamped this far ahead, so tf users never extrapolate")
+                        .in(Range::atLeast(0))
+                        .amcl()
+                        .live(0, 10)),
+         pf::member(&C::gui_publish_rate,
+                    I("gui_publish_rate", "Hz", "particlecloud messages per second at most")
+                        .in(Range::any())
+                        .withNote("<= 0: one per update")
+                        .amcl()
+                        .live(-1, 100)),
+         pf::member(&C::save_pose_rate,
+                    I("save_pose_rate", "Hz",
+                      "the pose is saved to ~initial_pose_* this often, for a restarted node")
+                        .in(Range::any())
+                        .withNote("<= 0: never")
+                        .amcl()),
+         pf::member(&C::max_update_time,
+                    I("max_update_time", "s",
+                      "cap the particle count so that an update takes this long at p95")
+                        .in(Range{-Range::kInf, 10.0})
+                        .withNote("<= 0: no cap")
+                        .live(0, 10)),
+         pf::member(&C::first_map_only,
+                    I("first_map_only", "", "ignore maps after the first on the map topic").amcl()),
+         pf::computed<C, bool>(
+             [](const C&) { return true; }, [](C&, const bool&) {},
+             I("use_map_topic", "", "false: keep the first map, as amcl does without the topic")
+                 .amcl())},
+        "output");
+    pf::append(
+        &t,
+        {initialPoseRow(&pf::Pose2::x, I("initial_pose_x", "m", "initial x in global_frame")
+                                           .in(Range::any())
+                                           .unsetMeans("global localization")
+                                           .amcl()),
+         initialPoseRow(&pf::Pose2::y, I("initial_pose_y", "m", "initial y in global_frame")
+                                           .in(Range::any())
+                                           .unsetMeans("global localization")
+                                           .amcl()),
+         initialPoseRow(&pf::Pose2::yaw,
+                        I("initial_pose_a", "rad", "initial yaw").in(Range::any()).amcl()),
+         initialCovRow(
+             0,
+             I("initial_cov_xx", "m^2", "variance of the initial x").in(Range::atLeast(0)).amcl()),
+         initialCovRow(
+             1,
+             I("initial_cov_yy", "m^2", "variance of the initial y").in(Range::atLeast(0)).amcl()),
+         initialCovRow(2, I("initial_cov_aa", "rad^2", "variance of the initial yaw")
+                              .in(Range::atLeast(0))
+                              .amcl())},
+        "initial_pose");
+    pf::append(
+        &t,
+        {pf::member(&C::deskew_scans,
+                    I("deskew_scans", "",
+                      "place each beam from where the laser was when it took it (time_increment)")),
+         pf::member(&C::scan_stamp, I("scan_stamp", "",
+                                      "which beam a scan's stamp is the time of, for deskew_scans")
+                                        .oneOf({"first_beam", "last_beam"}))},
+        "scan");
+    return t;
+  }();
+  return table;
+}
+
+// What the sources' values mean once all are read: frames without tf's
+// leading slash, amcl's -1 for "the scan's own limit", an initial pose only
+// when both x and y are given.
+void finishReading(LocalizerConfig* c) {
+  // tf2 refuses frame ids with a leading slash, which tf (and so many amcl
+  // configurations) used; amcl strips it too.
+  for (std::string* frame : {&c->global_frame, &c->odom_frame, &c->base_frame}) {
+    if (!frame->empty() && frame->front() == '/') frame->erase(0, 1);
+  }
+  c->filter.sensor.range_min = std::max(c->filter.sensor.range_min, 0.0);
+  c->filter.sensor.range_max = std::max(c->filter.sensor.range_max, 0.0);
+  if (c->initial_pose &&
+      !(std::isfinite(c->initial_pose->x) && std::isfinite(c->initial_pose->y))) {
+    c->initial_pose.reset();
+  }
+}
+
+// Names that were parameters until they became named constants of the
+// filter's algorithms; a configuration that sets one is told so.
+bool isRetired(const std::string& name) {
+  static const std::set<std::string> names = {"kld_bin_xy",
+                                              "kld_bin_yaw",
+                                              "update_fit_drop",
+                                              "update_fit_distance",
+                                              "odom_jump_limit",
+                                              "resample_ess_fraction",
+                                              "tempering_ess_fraction",
+                                              "tempering_ess_fraction_uncertain",
+                                              "seed",
+                                              "cluster_xy",
+                                              "cluster_yaw",
+                                              "cluster_join_weight_ratio",
+                                              "recovery_trigger_ratio",
+                                              "recovery_patience",
+                                              "recovery_patience_localized",
+                                              "recovery_lost_share",
+                                              "recovery_kidnap_prior",
+                                              "recovery_expansion_ratio",
+                                              "recovery_expansion_std_xy",
+                                              "recovery_expansion_std_yaw",
+                                              "refine_max_beams",
+                                              "refine_max_iterations",
+                                              "refine_outlier_distance",
+                                              "refine_cauchy_scale",
+                                              "refine_wall_offset",
+                                              "refine_min_matched_fraction",
+                                              "refine_min_matched_beams",
+                                              "refine_max_translation",
+                                              "refine_max_rotation",
+                                              "refine_min_beam_std",
+                                              "refine_degeneracy_ratio",
+                                              "refine_beam_std",
+                                              "refine_convergence",
+                                              "confidence_hit_distance",
+                                              "confidence_lost_hit_fraction",
+                                              "confidence_localized_hit_fraction",
+                                              "confidence_localized_std_xy",
+                                              "confidence_localized_std_yaw",
+                                              "confidence_rival_weight_ratio",
+                                              "confidence_jump_distance",
+                                              "confidence_jump_yaw",
+                                              "confidence_settle_updates",
+                                              "odom_fault_fraction",
+                                              "odom_fault_fraction_max",
+                                              "odom_fault_suspect_fraction",
+                                              "odom_fault_margin",
+                                              "tf_publish_rate",
+                                              "cloud_max_poses"};
+  return names.count(name) > 0;
+}
+
+// A value found under amcl's name, in our units. amcl's kld_z is the normal
+// quantile of our kld_confidence (the one alias that is not a plain rename).
+template <typename T>
+T fromAlias(const pf::ParamInfo& info, const std::string& found, const T& value) {
+  if constexpr (std::is_same_v<T, double>) {
+    if (found == "kld_z" && found != info.name) {
+      const double p = kldConfidenceFromZ(value);
+      if (!(std::isfinite(value) && p > 0.0 && p < 1.0)) {
+        throw std::invalid_argument(pf::invalidParameterMessage(
+            "kld_z", pf::formatNumber(value),
+            "a finite normal quantile between -8 and 8 (amcl's default: 0.99)"));
+      }
+      return p;
+    }
+  }
+  return value;
 }
 
 // Looks each setting up under our name and amcl's, in the user's source
@@ -180,11 +406,26 @@ class ParamReader {
   ParamReader(const ParamSource& source, const ParamSource* defaults, ConfigNotes* notes)
       : source_(source), defaults_(defaults), notes_(notes) {}
 
+  /// Reads the row `p` into `config` when the sources have it. Returns the
+  /// name it was found under; empty when absent (`config` untouched).
+  std::string read(const pf::Parameter<LocalizerConfig>& p, LocalizerConfig* config) {
+    return std::visit(
+        [&](const auto& field) {
+          auto value = field.get(*config);
+          const std::string found = get(p.info, &value);
+          if (!found.empty()) field.set(*config, fromAlias(p.info, found, value));
+          return found;
+        },
+        p.field);
+  }
+
   /// The name the value was found under; empty when absent (value untouched).
   template <typename T>
-  std::string get(const std::string& name, T* value) {
+  std::string get(const pf::ParamInfo& info, T* value) {
+    const std::string& name = info.name;
     known_.insert(name);
-    const std::optional<std::string> alias = amclAliasOf(name);
+    std::optional<std::string> alias;
+    if (info.amcl_kind == pf::Amcl::kAlias) alias = info.amcl_name;
     if (alias) known_.insert(*alias);
     for (const ParamSource* layer : {&source_, defaults_}) {
       if (layer == nullptr) continue;
@@ -207,6 +448,10 @@ class ParamReader {
     return "";
   }
 
+  /// Marks `name` as known without reading it (state pf_node keeps on the
+  /// parameter server, not a setting).
+  void know(const std::string& name) { known_.insert(name); }
+
   /// Unknown names in the source, and the amcl parameters it sets that have no effect here.
   void reportLeftovers() {
     std::set<std::string> unused_amcl;
@@ -217,11 +462,17 @@ class ParamReader {
       }
       unused_amcl.insert(p.name);
     }
-    std::string unknown;
+    std::string unknown, retired;
     for (const std::string& key : source_.keys()) {
       // "defaults" is the namespace launch/amcl_compatible.launch loads config/pf.yaml into.
       if (known_.count(key) || unused_amcl.count(key) || key == "defaults") continue;
-      unknown += (unknown.empty() ? "" : ", ") + key;
+      std::string& list = isRetired(key) ? retired : unknown;
+      list += (list.empty() ? "" : ", ") + key;
+    }
+    if (!retired.empty()) {
+      notes_->infos.push_back(retired +
+                              ": no longer parameters (constants of the filter's algorithms "
+                              "since issue 26, docs/design.md): ignored");
     }
     if (!unknown.empty()) {
       notes_->warnings.push_back(
@@ -269,173 +520,40 @@ std::unique_ptr<ParamSource> rosParamSource(const ros::NodeHandle& nh) {
   return std::make_unique<RosParamSource>(nh);
 }
 
+const pf::ParameterTable<LocalizerConfig>& localizerParameters() {
+  static const pf::ParameterTable<LocalizerConfig> table = [] {
+    const pf::ParameterTable<LocalizerConfig>& own = ownParameters();
+    // The frames, the output and the initial pose, then the filter's, then the scan's.
+    const auto scan =
+        std::find_if(own.begin(), own.end(), [](const auto& p) { return p.info.group == "scan"; });
+    pf::ParameterTable<LocalizerConfig> t(own.begin(), scan);
+    for (const auto& p : pf::nested(&LocalizerConfig::filter, pf::particleFilterParameters())) {
+      t.push_back(p);
+    }
+    t.insert(t.end(), scan, own.end());
+    return t;
+  }();
+  return table;
+}
+
 LocalizerConfig readConfig(const ParamSource& source, const ParamSource* defaults,
                            ConfigNotes* notes) {
   ConfigNotes own_notes;
   ConfigNotes* out = notes != nullptr ? notes : &own_notes;
-  ParamReader p(source, defaults, out);
+  ParamReader reader(source, defaults, out);
   LocalizerConfig c;
-  p.get("global_frame", &c.global_frame);
-  p.get("odom_frame", &c.odom_frame);
-  p.get("base_frame", &c.base_frame);
-  // tf2 refuses frame ids with a leading slash, which tf (and so many amcl
-  // configurations) used; amcl strips it too.
-  for (std::string* frame : {&c.global_frame, &c.odom_frame, &c.base_frame}) {
-    if (!frame->empty() && frame->front() == '/') frame->erase(0, 1);
+  bool use_map_topic_false = false;
+  for (const pf::Parameter<LocalizerConfig>& p : localizerParameters()) {
+    if (p.info.name == "use_map_topic") {
+      bool use_map_topic = true;
+      use_map_topic_false = !reader.get(p.info, &use_map_topic).empty() && !use_map_topic;
+      continue;
+    }
+    reader.read(p, &c);
   }
-  p.get("tf_broadcast", &c.tf_broadcast);
-  p.get("transform_tolerance", &c.transform_tolerance);
-  p.get("tf_publish_rate", &c.tf_publish_rate);
-
-  p.get("deskew_scans", &c.deskew_scans);
-  p.get("scan_stamp", &c.scan_stamp);
-  require(c.scan_stamp == "first_beam" || c.scan_stamp == "last_beam", "scan_stamp",
-          "first_beam or last_beam (got '" + c.scan_stamp + "')");
-
-  pf::Pose2 initial{std::nan(""), std::nan(""), 0.0};
-  p.get("initial_pose_x", &initial.x);
-  p.get("initial_pose_y", &initial.y);
-  p.get("initial_pose_a", &initial.yaw);
-  if (std::isfinite(initial.x) && std::isfinite(initial.y)) {
-    require(std::isfinite(initial.yaw), "initial_pose_a", "a finite angle in rad");
-    c.initial_pose = initial;
-  }
-  double cov_xx = c.initial_cov(0, 0), cov_yy = c.initial_cov(1, 1), cov_aa = c.initial_cov(2, 2);
-  p.get("initial_cov_xx", &cov_xx);
-  p.get("initial_cov_yy", &cov_yy);
-  p.get("initial_cov_aa", &cov_aa);
-  require(cov_xx >= 0.0 && std::isfinite(cov_xx), "initial_cov_xx", ">= 0 (m^2)");
-  require(cov_yy >= 0.0 && std::isfinite(cov_yy), "initial_cov_yy", ">= 0 (m^2)");
-  require(cov_aa >= 0.0 && std::isfinite(cov_aa), "initial_cov_aa", ">= 0 (rad^2)");
-  c.initial_cov = Eigen::Vector3d(cov_xx, cov_yy, cov_aa).asDiagonal();
-
-  pf::ParticleFilterParams& f = c.filter;
-  p.get("min_particles", &f.kld.min_particles);
-  p.get("max_particles", &f.kld.max_particles);
-  p.get("kld_err", &f.kld.kld_err);
-  double kld = f.kld.confidence;
-  if (p.get("kld_confidence", &kld) == "kld_z") {
-    const double z = kld;
-    kld = kldConfidenceFromZ(z);
-    require(std::isfinite(z) && kld > 0.0 && kld < 1.0, "kld_z",
-            "a finite normal quantile between -8 and 8 (amcl's default: 0.99)");
-  }
-  f.kld.confidence = kld;
-  p.get("kld_bin_xy", &f.kld.bin_xy);
-  p.get("kld_bin_yaw", &f.kld.bin_yaw);
-  p.get("update_min_d", &f.update_min_d);
-  p.get("update_min_a", &f.update_min_a);
-  p.get("update_fit_drop", &f.update_fit_drop);
-  p.get("update_fit_distance", &f.update_fit_distance);
-  p.get("odom_jump_limit", &f.odom_jump_limit);
-  p.get("resample_ess_fraction", &f.resample_ess_fraction);
-  p.get("tempering_ess_fraction", &f.tempering_ess_fraction);
-  p.get("tempering_ess_fraction_uncertain", &f.tempering_ess_fraction_uncertain);
-  p.get("confidence_hit_distance", &f.confidence.hit_distance);
-  p.get("confidence_lost_hit_fraction", &f.confidence.lost_hit_fraction);
-  p.get("confidence_localized_hit_fraction", &f.confidence.localized_hit_fraction);
-  p.get("confidence_localized_std_xy", &f.confidence.localized_std_xy);
-  p.get("confidence_localized_std_yaw", &f.confidence.localized_std_yaw);
-  p.get("confidence_rival_weight_ratio", &f.confidence.rival_weight_ratio);
-  p.get("confidence_jump_distance", &f.confidence.jump_distance);
-  p.get("confidence_jump_yaw", &f.confidence.jump_yaw);
-  p.get("confidence_settle_updates", &f.confidence.settle_updates);
-  int seed = 0;
-  if (!p.get("seed", &seed).empty()) {
-    require(seed >= 0, "seed", ">= 0");
-    f.seed = static_cast<uint64_t>(seed);
-  }
-  p.get("cluster_xy", &f.clusters.cell_xy);
-  p.get("cluster_yaw", &f.clusters.cell_yaw);
-  p.get("cluster_join_weight_ratio", &f.clusters.join_weight_ratio);
-  p.get("recovery_alpha_slow", &f.recovery.alpha_slow);
-  p.get("recovery_alpha_fast", &f.recovery.alpha_fast);
-  p.get("recovery_trigger_ratio", &f.recovery.trigger_ratio);
-  p.get("recovery_kidnap_prior", &f.recovery.kidnap_prior);
-  p.get("recovery_patience", &f.recovery.patience);
-  p.get("recovery_patience_localized", &f.recovery.patience_localized);
-  p.get("recovery_lost_share", &f.recovery.lost_share);
-  p.get("recovery_expansion_ratio", &f.recovery.expansion_ratio);
-  p.get("recovery_expansion_std_xy", &f.recovery.expansion_std_xy);
-  p.get("recovery_expansion_std_yaw", &f.recovery.expansion_std_yaw);
-  p.get("refine_estimate", &f.refine_estimate);
-  p.get("refine_max_beams", &f.refiner.max_beams);
-  p.get("refine_max_iterations", &f.refiner.max_iterations);
-  p.get("refine_outlier_distance", &f.refiner.outlier_distance);
-  p.get("refine_cauchy_scale", &f.refiner.cauchy_scale);
-  p.get("refine_wall_offset", &f.refiner.wall_offset);
-  p.get("refine_min_matched_fraction", &f.refiner.min_matched_fraction);
-  p.get("refine_min_matched_beams", &f.refiner.min_matched_beams);
-  p.get("refine_max_translation", &f.refiner.max_translation);
-  p.get("refine_max_rotation", &f.refiner.max_rotation);
-  p.get("refine_min_beam_std", &f.refiner.min_beam_std);
-  p.get("refine_degeneracy_ratio", &f.refiner.degeneracy_ratio);
-  p.get("refine_beam_std", &f.refiner.beam_std);
-  p.get("refine_convergence", &f.refiner.convergence);
-
-  std::string odom_model = "diff";
-  p.get("odom_model_type", &odom_model);
-  // amcl's "-corrected" variants fixed bugs of its own; the models here are the corrected ones.
-  if (odom_model == "diff" || odom_model == "diff-corrected") {
-    f.motion.kind = pf::OdometryMotionParams::Kind::kDifferential;
-  } else if (odom_model == "omni" || odom_model == "omni-corrected") {
-    f.motion.kind = pf::OdometryMotionParams::Kind::kOmni;
-  } else {
-    require(false, "odom_model_type", "diff or omni, got '" + odom_model + "'");
-  }
-  p.get("odom_alpha1", &f.motion.alpha1);
-  p.get("odom_alpha2", &f.motion.alpha2);
-  p.get("odom_alpha3", &f.motion.alpha3);
-  p.get("odom_alpha4", &f.motion.alpha4);
-  p.get("odom_alpha5", &f.motion.alpha5);
-  p.get("odom_fault_fraction", &f.motion.fault_fraction);
-  p.get("odom_fault_fraction_max", &f.motion.fault_fraction_max);
-  p.get("odom_fault_suspect_fraction", &f.motion.fault_suspect_fraction);
-  p.get("odom_fault_margin", &f.motion.fault_margin);
-
-  p.get("laser_max_beams", &f.sensor.max_beams);
-  p.get("sensor_threads", &f.sensor.threads);
-  p.get("laser_z_hit", &f.sensor.z_hit);
-  p.get("laser_z_rand", &f.sensor.z_rand);
-  p.get("laser_sigma_hit", &f.sensor.sigma_hit);
-  p.get("laser_likelihood_max_dist", &f.sensor.max_distance);
-  p.get("laser_likelihood_exponent", &f.sensor.likelihood_exponent);
-  p.get("laser_min_range", &f.sensor.range_min);
-  p.get("laser_max_range", &f.sensor.range_max);
-  // amcl spells "use the scan's own limit" as -1; accept that spelling too.
-  f.sensor.range_min = std::max(f.sensor.range_min, 0.0);
-  f.sensor.range_max = std::max(f.sensor.range_max, 0.0);
-  std::string laser_model = "likelihood_field";
-  p.get("laser_model_type", &laser_model);
-  const std::string laser_model_error = laserModelTypeError(laser_model);
-  if (!laser_model_error.empty()) throw std::invalid_argument(laser_model_error);
-  f.laser_model_type = laser_model == "beam" ? pf::LaserModelType::kBeam
-                       : laser_model == "likelihood_field_prob"
-                           ? pf::LaserModelType::kLikelihoodFieldProb
-                           : pf::LaserModelType::kLikelihoodField;
-  p.get("laser_z_short", &f.beam.z_short);
-  p.get("laser_z_max", &f.beam.z_max);
-  p.get("laser_lambda_short", &f.beam.lambda_short);
-  // Beam skipping is part of likelihood_field_prob only, as in amcl; the
-  // filter ignores it under the other models. amcl reads its misspelt
-  // beam_skip_error_threshold_ (an alias here).
-  p.get("do_beamskip", &f.sensor.beam_skip);
-  p.get("beam_skip_distance", &f.sensor.beam_skip_distance);
-  p.get("beam_skip_threshold", &f.sensor.beam_skip_threshold);
-  p.get("beam_skip_error_threshold", &f.sensor.beam_skip_error_threshold);
-  if (f.sensor.beam_skip && f.laser_model_type != pf::LaserModelType::kLikelihoodFieldProb) {
-    out->infos.push_back("do_beamskip is true but laser_model_type is " + laser_model +
-                         ": beam skipping is part of likelihood_field_prob (as in amcl), so no "
-                         "beam is skipped");
-  }
-
-  p.get("gui_publish_rate", &c.gui_publish_rate);
-  p.get("cloud_max_poses", &c.cloud_max_poses);
-  p.get("max_update_time", &c.max_update_time);
-  p.get("save_pose_rate", &c.save_pose_rate);
-  p.get("first_map_only", &c.first_map_only);
-  bool use_map_topic = true;
-  if (!p.get("use_map_topic", &use_map_topic).empty() && !use_map_topic && !c.first_map_only) {
+  reader.know(kSavedPoseMapParam);
+  finishReading(&c);
+  if (use_map_topic_false && !c.first_map_only) {
     // amcl then asks map_server's static_map service once and never updates
     // its map. map_server publishes the same map latched on the map topic, so
     // taking the first map from there and keeping it behaves the same.
@@ -444,30 +562,21 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
         "use_map_topic is false: as amcl then does, the first map is kept (it is read from the "
         "map topic, which map_server and map_publisher latch, instead of the static_map service)");
   }
-  p.reportLeftovers();
+  if (c.filter.sensor.beam_skip &&
+      c.filter.laser_model_type != pf::LaserModelType::kLikelihoodFieldProb) {
+    out->infos.push_back(
+        "do_beamskip is true but laser_model_type is not likelihood_field_prob: "
+        "beam skipping is part of likelihood_field_prob (as in amcl), so no beam "
+        "is skipped");
+  }
+  reader.reportLeftovers();
   validate(c);
   if (notes == nullptr) logNotes(own_notes);
   return c;
 }
 
 void validate(const LocalizerConfig& c) {
-  require(!c.global_frame.empty(), "global_frame", "a frame name");
-  require(!c.odom_frame.empty(), "odom_frame", "a frame name");
-  require(!c.base_frame.empty(), "base_frame", "a frame name");
-  // Numbers as the core words them, value included.
-  pf::requireParameter(c.transform_tolerance >= 0.0 && std::isfinite(c.transform_tolerance),
-                       "transform_tolerance", ">= 0 (s)", c.transform_tolerance);
-  pf::requireParameter(c.tf_publish_rate > 0.0 && std::isfinite(c.tf_publish_rate),
-                       "tf_publish_rate", "> 0 (Hz)", c.tf_publish_rate);
-  pf::requireParameter(std::isfinite(c.gui_publish_rate), "gui_publish_rate",
-                       "finite (Hz; <= 0: no limit)", c.gui_publish_rate);
-  pf::requireParameter(c.cloud_max_poses >= 0, "cloud_max_poses", ">= 0 (poses; 0: every particle)",
-                       c.cloud_max_poses);
-  pf::requireParameter(std::isfinite(c.max_update_time) && c.max_update_time <= 10.0,
-                       "max_update_time", "finite and <= 10 (s; <= 0: no limit)",
-                       c.max_update_time);
-  pf::requireParameter(std::isfinite(c.save_pose_rate), "save_pose_rate",
-                       "finite (Hz; <= 0: never)", c.save_pose_rate);
+  checkRanges(ownParameters(), c);
   pf::validate(c.filter);
 }
 

@@ -348,7 +348,9 @@ TEST(BadInitialPose, NonFinitePoseOrBadCovarianceThrowsAndKeepsTheFilter) {
 // --- Parameters ---------------------------------------------------------------
 
 struct ParamCase {
-  const char* name;  // must appear in what()
+  // Must appear in what(): the parameter's name, or for the filter's own
+  // constants (not parameters) the option's struct and member.
+  const char* name;
   std::function<void(ParticleFilterParams*)> spoil;
 };
 
@@ -370,17 +372,21 @@ TEST(BadParams, EachInvalidParameterThrowsNamingIt) {
       {"kld_confidence", [](ParticleFilterParams* p) { p->kld.confidence = 1.5; }},
       {"kld_confidence", [](ParticleFilterParams* p) { p->kld.confidence = -0.2; }},
       {"kld_confidence", [](ParticleFilterParams* p) { p->kld.confidence = kNaN; }},
-      {"kld_bin_xy", [](ParticleFilterParams* p) { p->kld.bin_xy = 0.0; }},
-      {"kld_bin_yaw", [](ParticleFilterParams* p) { p->kld.bin_yaw = -0.1; }},
+      {"KldParams::bin_xy", [](ParticleFilterParams* p) { p->kld.bin_xy = 0.0; }},
+      {"KldParams::bin_yaw", [](ParticleFilterParams* p) { p->kld.bin_yaw = -0.1; }},
       {"update_min_d", [](ParticleFilterParams* p) { p->update_min_d = -0.1; }},
       {"update_min_a", [](ParticleFilterParams* p) { p->update_min_a = kNaN; }},
-      {"update_fit_drop", [](ParticleFilterParams* p) { p->update_fit_drop = 1.5; }},
-      {"recovery_lost_share", [](ParticleFilterParams* p) { p->recovery.lost_share = 1.0; }},
-      {"recovery_patience_localized",
+      {"ParticleFilterParams::update_fit_drop",
+       [](ParticleFilterParams* p) { p->update_fit_drop = 1.5; }},
+      {"RecoveryParams::lost_share", [](ParticleFilterParams* p) { p->recovery.lost_share = 1.0; }},
+      {"RecoveryParams::patience_localized",
        [](ParticleFilterParams* p) { p->recovery.patience_localized = p->recovery.patience - 1; }},
-      {"update_fit_distance", [](ParticleFilterParams* p) { p->update_fit_distance = 0.0; }},
-      {"resample_ess_fraction", [](ParticleFilterParams* p) { p->resample_ess_fraction = 0.0; }},
-      {"resample_ess_fraction", [](ParticleFilterParams* p) { p->resample_ess_fraction = 1.5; }},
+      {"ParticleFilterParams::update_fit_distance",
+       [](ParticleFilterParams* p) { p->update_fit_distance = 0.0; }},
+      {"ParticleFilterParams::resample_ess_fraction",
+       [](ParticleFilterParams* p) { p->resample_ess_fraction = 0.0; }},
+      {"ParticleFilterParams::resample_ess_fraction",
+       [](ParticleFilterParams* p) { p->resample_ess_fraction = 1.5; }},
       {"laser_sigma_hit", [](ParticleFilterParams* p) { p->sensor.sigma_hit = 0.0; }},
       {"laser_sigma_hit", [](ParticleFilterParams* p) { p->sensor.sigma_hit = -0.2; }},
       {"laser_sigma_hit", [](ParticleFilterParams* p) { p->sensor.sigma_hit = kNaN; }},
@@ -400,8 +406,8 @@ TEST(BadParams, EachInvalidParameterThrowsNamingIt) {
       {"odom_alpha3", [](ParticleFilterParams* p) { p->motion.alpha3 = -2.0; }},
       {"odom_alpha4", [](ParticleFilterParams* p) { p->motion.alpha4 = kNaN; }},
       {"odom_alpha5", [](ParticleFilterParams* p) { p->motion.alpha5 = -kInf; }},
-      {"cluster_xy", [](ParticleFilterParams* p) { p->clusters.cell_xy = 0.0; }},
-      {"cluster_yaw", [](ParticleFilterParams* p) { p->clusters.cell_yaw = kInf; }},
+      {"ClusterParams::cell_xy", [](ParticleFilterParams* p) { p->clusters.cell_xy = 0.0; }},
+      {"ClusterParams::cell_yaw", [](ParticleFilterParams* p) { p->clusters.cell_yaw = kInf; }},
       {"recovery_alpha_slow", [](ParticleFilterParams* p) { p->recovery.alpha_slow = 2.0; }},
       {"recovery_alpha_fast",
        [](ParticleFilterParams* p) {

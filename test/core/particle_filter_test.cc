@@ -147,12 +147,14 @@ TEST(ParticleFilterParams, InvalidValuesAreNamed) {
   expectInvalid([](P& p) { p.kld.confidence = 1.5; }, "kld_confidence");
   expectInvalid([](P& p) { p.kld.confidence = NAN; }, "kld_confidence");
   expectInvalid([](P& p) { p.kld.kld_err = 0.0; }, "kld_err");
-  expectInvalid([](P& p) { p.resample_ess_fraction = 0.0; }, "resample_ess_fraction");
-  expectInvalid([](P& p) { p.resample_ess_fraction = 1.5; }, "resample_ess_fraction");
+  expectInvalid([](P& p) { p.resample_ess_fraction = 0.0; },
+                "ParticleFilterParams::resample_ess_fraction");
+  expectInvalid([](P& p) { p.resample_ess_fraction = 1.5; },
+                "ParticleFilterParams::resample_ess_fraction");
   expectInvalid([](P& p) { p.update_min_d = -0.1; }, "update_min_d");
   expectInvalid([](P& p) { p.sensor.max_beams = 0; }, "laser_max_beams");
   expectInvalid([](P& p) { p.sensor.max_distance = 0.0; }, "laser_likelihood_max_dist");
-  expectInvalid([](P& p) { p.clusters.cell_xy = 0.0; }, "cluster_xy");
+  expectInvalid([](P& p) { p.clusters.cell_xy = 0.0; }, "ClusterParams::cell_xy");
   expectInvalid([](P& p) { p.recovery.alpha_slow = 0.1, p.recovery.alpha_fast = 0.05; },
                 "recovery_alpha_fast");
   // The message names the valid range too.

@@ -190,40 +190,33 @@ TEST(AmclParams, UnknownNamesAreListedInOneWarning) {
   EXPECT_EQ(notes.warnings[0].find("max_particles"), std::string::npos) << notes.warnings[0];
 }
 
-TEST(AmclParams, RefinementParametersAreReadAndValidated) {
-  const LocalizerConfig c = readConfig(
-      *yaml("refine_estimate: false\nrefine_max_beams: 90\nrefine_max_translation: 0.25\n"
-            "refine_max_rotation: 0.1\nrefine_outlier_distance: 0.4\nrefine_beam_std: 0.05\n"));
-  EXPECT_FALSE(c.filter.refine_estimate);
-  EXPECT_EQ(90, c.filter.refiner.max_beams);
-  EXPECT_EQ(0.25, c.filter.refiner.max_translation);
-  EXPECT_EQ(0.1, c.filter.refiner.max_rotation);
-  EXPECT_EQ(0.4, c.filter.refiner.outlier_distance);
-  EXPECT_EQ(0.05, c.filter.refiner.beam_std);
-  try {
-    readConfig(*yaml("refine_max_rotation: 4\n"));
-    ADD_FAILURE() << "refine_max_rotation 4 accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_EQ(std::string("invalid parameter refine_max_rotation = 4: must be in [0, pi]"),
-              e.what());
-  }
+// Settings that were parameters before they became constants of the filter
+// (issue 26): a configuration that still sets one is told so, not warned of a
+// misspelling, and the constant stands.
+TEST(AmclParams, RetiredParametersAreNamedAndLeftAlone) {
+  ConfigNotes notes;
+  const LocalizerConfig c =
+      readConfig(*yaml("refine_estimate: true\nrefine_max_beams: 90\nrecovery_patience: 3\n"),
+                 nullptr, &notes);
+  EXPECT_TRUE(c.filter.refine_estimate);
+  EXPECT_EQ(LocalizerConfig().filter.refiner.max_beams, c.filter.refiner.max_beams);
+  EXPECT_EQ(LocalizerConfig().filter.recovery.patience, c.filter.recovery.patience);
+  EXPECT_TRUE(notes.warnings.empty()) << notes.warnings[0];
+  EXPECT_TRUE(anyContains(notes.infos, "refine_max_beams, recovery_patience"));
+  EXPECT_TRUE(anyContains(notes.infos, "no longer parameters"));
 }
 
-// Issue 15's parameters: read, and refused with the start-up message.
-TEST(AmclParams, OverloadParametersAreReadAndValidated) {
+// Issue 15's parameter: read, and refused with the start-up message.
+TEST(AmclParams, MaxUpdateTimeIsReadAndValidated) {
   ConfigNotes notes;
-  LocalizerConfig c =
-      readConfig(*yaml("cloud_max_poses: 200\nmax_update_time: 0.02\n"), nullptr, &notes);
-  EXPECT_EQ(c.cloud_max_poses, 200);
+  LocalizerConfig c = readConfig(*yaml("max_update_time: 0.02\n"), nullptr, &notes);
   EXPECT_EQ(c.max_update_time, 0.02);
   EXPECT_TRUE(notes.warnings.empty());
   const std::pair<const char*, const char*> bad[] = {
-      {"cloud_max_poses: -1\n",
-       "invalid parameter cloud_max_poses = -1: must be >= 0 (poses; 0: every particle)"},
       {"max_update_time: .nan\n",
-       "invalid parameter max_update_time = nan: must be finite and <= 10 (s; <= 0: no limit)"},
+       "invalid parameter max_update_time = nan: must be <= 10 (s; <= 0: no cap)"},
       {"max_update_time: 60\n",
-       "invalid parameter max_update_time = 60: must be finite and <= 10 (s; <= 0: no limit)"}};
+       "invalid parameter max_update_time = 60: must be <= 10 (s; <= 0: no cap)"}};
   for (const auto& [text, message] : bad) {
     try {
       readConfig(*yaml(text), nullptr, &notes);

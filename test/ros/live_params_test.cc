@@ -99,7 +99,7 @@ TEST(LiveParams, AcceptedChangeListsWhatChanged) {
   EXPECT_EQ(change.config.filter.motion.alpha1, 0.5);
   EXPECT_EQ(change.config.filter.kld.max_particles, 60000);
   EXPECT_EQ(change.changed,
-            (std::vector<std::string>{"odom_alpha1 0.2 -> 0.5", "max_particles 50000 -> 60000"}));
+            (std::vector<std::string>{"max_particles 50000 -> 60000", "odom_alpha1 0.2 -> 0.5"}));
   // The whole message of the current values changes nothing.
   EXPECT_TRUE(applyLiveParams(current, liveParamsMessage(current)).changed.empty());
 }
@@ -107,11 +107,11 @@ TEST(LiveParams, AcceptedChangeListsWhatChanged) {
 TEST(LiveParams, InvalidValuesGetTheStartUpMessage) {
   const LocalizerConfig current;
   EXPECT_EQ(applyLiveParams(current, request("laser_sigma_hit", -1.0)).error,
-            "invalid parameter laser_sigma_hit = -1: must be > 0");
+            "invalid parameter laser_sigma_hit = -1: must be > 0 (m)");
   EXPECT_EQ(applyLiveParams(current, request("min_particles", 70000)).error,
             "invalid parameter max_particles = 50000: must be >= min_particles (70000)");
-  EXPECT_EQ(applyLiveParams(current, request("tf_publish_rate", 0.0)).error,
-            "invalid parameter tf_publish_rate = 0: must be > 0 (Hz)");
+  EXPECT_EQ(applyLiveParams(current, request("transform_tolerance", -0.5)).error,
+            "invalid parameter transform_tolerance = -0.5: must be >= 0 (s)");
 }
 
 TEST(LiveParams, AmclsKldZSetsKldConfidence) {

@@ -40,6 +40,10 @@ struct BeamModelParams {
   double lambda_short = 0.1;  // 1/m, rate of the exponential short component (> 0)
 };
 
+/// The beam model's own parameters (parameter_table.h); it shares the
+/// likelihood field's too.
+const ParameterTable<BeamModelParams>& beamModelParameters();
+
 class BeamModel : public SensorModel {
  public:
   /// Throws std::invalid_argument naming the parameter when one is out of range.

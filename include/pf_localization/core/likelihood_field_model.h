@@ -30,6 +30,7 @@
 
 #include "pf_localization/core/laser_scan.h"
 #include "pf_localization/core/likelihood_field.h"
+#include "pf_localization/core/parameter_table.h"
 #include "pf_localization/core/particle_set.h"
 #include "pf_localization/core/sensor_model.h"
 
@@ -60,10 +61,16 @@ struct LikelihoodFieldModelParams {
   double beam_skip_error_threshold = 0.9;  // skip nothing when this share would be skipped, [0, 1]
 };
 
-/// When params.beam_skip is set, throws std::invalid_argument naming the
-/// first beam_skip_* parameter out of range; the start-up check
-/// (pf::validate) and the model's constructor share it.
-void validateBeamSkip(const LikelihoodFieldModelParams& params);
+/// The parameters of LikelihoodFieldModelParams (parameter_table.h); the
+/// beam model shares them. beamSkipParameters() are the beam_skip_* ones,
+/// checked only while do_beamskip is set.
+const ParameterTable<LikelihoodFieldModelParams>& likelihoodFieldParameters();
+const ParameterTable<LikelihoodFieldModelParams>& beamSkipParameters();
+
+/// Throws std::invalid_argument naming the first parameter out of range
+/// (likelihoodFieldParameters() and z_hit + z_rand > 0); the start-up check
+/// (pf::validate) and the models' constructors share it.
+void validate(const LikelihoodFieldModelParams& params);
 
 class LikelihoodFieldModel : public SensorModel {
  public:

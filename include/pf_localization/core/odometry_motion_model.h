@@ -44,6 +44,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "pf_localization/core/parameter_table.h"
 #include "pf_localization/core/particle_set.h"
 #include "pf_localization/core/pose2.h"
 #include "pf_localization/core/random.h"
@@ -77,6 +78,12 @@ struct OdometryMotionParams {
   double fault_margin = 0.1;
 };
 
+/// The parameters of OdometryMotionParams (parameter_table.h).
+const ParameterTable<OdometryMotionParams>& odometryMotionParameters();
+
+/// Throws std::invalid_argument naming the first value out of range.
+void validate(const OdometryMotionParams& params);
+
 /// The odometry step split into rotation, translation, rotation.
 struct OdometryStep {
   double rot1;
@@ -86,7 +93,7 @@ struct OdometryStep {
 
 class OdometryMotionModel {
  public:
-  /// Throws std::invalid_argument when an alpha is negative or not finite.
+  /// Throws std::invalid_argument (see validate()).
   explicit OdometryMotionModel(const OdometryMotionParams& params);
 
   const OdometryMotionParams& params() const { return params_; }

@@ -1,22 +1,20 @@
-// The one way the core refuses a parameter: std::invalid_argument with the
-// message "invalid parameter NAME = VALUE: must be RANGE", which pf_node
-// prints as it is when it refuses to start, so every module's limits read alike.
+// A check that a parameter table's range cannot say alone (one value against
+// another, a sum), worded as the tables word theirs: std::invalid_argument
+// with "invalid parameter NAME = VALUE: must be RANGE" (parameter_table.h),
+// which pf_node prints as it is when it refuses to start.
 #pragma once
 
-#include <sstream>
 #include <stdexcept>
 #include <string>
+
+#include "pf_localization/core/parameter_table.h"
 
 namespace pf {
 
 /// Throws std::invalid_argument naming `name`, `value` and the valid `range` unless `ok`.
 inline void requireParameter(bool ok, const std::string& name, const std::string& range,
                              double value) {
-  if (!ok) {
-    std::ostringstream text;  // shortest form: 500, not 500.000000
-    text << "invalid parameter " << name << " = " << value << ": must be " << range;
-    throw std::invalid_argument(text.str());
-  }
+  if (!ok) throw std::invalid_argument(invalidParameterMessage(name, formatNumber(value), range));
 }
 
 }  // namespace pf

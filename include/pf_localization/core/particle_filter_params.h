@@ -11,6 +11,7 @@
 #include "pf_localization/core/likelihood_field_model.h"
 #include "pf_localization/core/occupancy_grid.h"
 #include "pf_localization/core/odometry_motion_model.h"
+#include "pf_localization/core/parameter_table.h"
 #include "pf_localization/core/pose_estimator.h"
 #include "pf_localization/core/resampler.h"
 #include "pf_localization/core/scan_refiner.h"
@@ -139,7 +140,18 @@ struct ParticleFilterParams {
   ScanRefinerParams refiner;
 };
 
-/// Throws std::invalid_argument naming the first parameter out of range and its valid range.
+/// The parameters of RecoveryParams (parameter_table.h): amcl's two averages.
+/// The rest of RecoveryParams are the filter's own constants.
+const ParameterTable<RecoveryParams>& recoveryParameters();
+/// Throws std::invalid_argument naming the first of those constants out of range.
+void validateInternals(const RecoveryParams& params);
+
+/// Every parameter of ParticleFilterParams, its parts' included, in the order
+/// config/pf.yaml lists them.
+const ParameterTable<ParticleFilterParams>& particleFilterParameters();
+
+/// Throws std::invalid_argument naming the first parameter out of range and
+/// its valid range ("invalid parameter NAME = VALUE: must be RANGE").
 void validate(const ParticleFilterParams& params);
 
 }  // namespace pf

@@ -18,6 +18,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "pf_localization/core/parameter_table.h"
 #include "pf_localization/core/particle_set.h"
 #include "pf_localization/core/random.h"
 
@@ -42,6 +43,11 @@ struct KldParams {
   double bin_xy = 0.5;       // histogram bin size (m)
   double bin_yaw = 0.1745;   // histogram bin size (rad), 10 degrees
 };
+
+/// The parameters of KldParams (parameter_table.h): the particle bounds and
+/// KLD-sampling's error bound and confidence. (The histogram's bins are ours
+/// to choose, not the user's.)
+const ParameterTable<KldParams>& kldParameters();
 
 /// The z with P(Z <= z) = p for a standard normal Z (p in (0, 1)): 2.326 for 0.99.
 double normalQuantile(double p);

@@ -1,8 +1,11 @@
-// Every tunable of the localizer, read from one place, with the same names in
-// config/pf.yaml, on the ROS parameter server and in pf_bag_runner's
-// --params file. Each parameter's meaning, unit and default is documented in
-// config/pf.yaml. amcl's names for the same settings are accepted too (see
-// amcl_params.h), so that an amcl configuration works unchanged.
+// Every parameter of the localizer, read from one place, with the same names
+// in config/pf.yaml, on the ROS parameter server and in pf_bag_runner's
+// --params file. localizerParameters() is the table (core/parameter_table.h)
+// that declares each one, its unit, range, description and amcl name, once:
+// reading, checking, live reconfiguration, `pf_node --help` and the generated
+// files (parameter_docs.h) all come from it. amcl's names for the same
+// settings are accepted too (amcl_params.h), so that an amcl configuration
+// works unchanged.
 #pragma once
 
 #include <ros/node_handle.h>
@@ -13,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "pf_localization/core/parameter_table.h"
 #include "pf_localization/core/particle_filter.h"
 
 namespace pf_ros {
@@ -22,7 +26,9 @@ struct LocalizerConfig {
   std::string odom_frame = "odom";
   std::string base_frame = "base_link";
   double transform_tolerance = 0.1;  // s the published map->odom is post-dated by
-  double tf_publish_rate = 20.0;     // Hz: map->odom republished when 1/rate s pass without one
+  // Hz: map -> odom is republished when 1 / rate s pass without one (amcl has
+  // no such setting; 20 Hz keeps tf users within 2 / rate = 0.1 s of a fresh one).
+  double tf_publish_rate = 20.0;
   bool tf_broadcast = true;
   // De-skewing (core/scan_deskew.h): each beam is placed from where the laser
   // was when it took it, using the scan's time_increment and the odometry's
@@ -41,8 +47,9 @@ struct LocalizerConfig {
   // pf_node only: pf_bag_runner has neither topics to throttle nor a
   // parameter server to save to.
   double gui_publish_rate = -1.0;  // Hz limit of particlecloud; <= 0: after every update
-  // Poses at most in a particlecloud message (0: every particle): a larger
-  // cloud is shown by a systematic resample to this many (toPoseArray).
+  // Poses at most in a particlecloud message: a larger cloud is shown by a
+  // systematic resample to this many (toPoseArray). 5000 poses are 280 kB, which
+  // rviz draws at its rate; 500 000 would be 28 MB a message.
   int cloud_max_poses = 5000;
   // s an update may take (wall, p95): when > 0 the particle count is capped
   // so that it does (UpdateTimeGovernor); <= 0: off, max_particles alone.
@@ -50,6 +57,14 @@ struct LocalizerConfig {
   double save_pose_rate = 0.5;  // Hz the estimate is saved to ~initial_pose_*; <= 0: never
   bool first_map_only = false;  // keep the first map; ignore later ones on the map topic
 };
+
+/// Every parameter of LocalizerConfig, the filter's included, in the order of
+/// config/pf.yaml: at most 50, amcl's and what a robot or a building needs.
+const pf::ParameterTable<LocalizerConfig>& localizerParameters();
+
+/// Where pf_node saves the signature of the map its saved pose is on (state
+/// on the parameter server beside ~initial_pose_*, not a setting).
+constexpr const char* kSavedPoseMapParam = "saved_pose_map";
 
 /// What readConfig has to tell besides errors: amcl parameters that are
 /// ignored and why, a setting given under both names, unknown names.
@@ -93,9 +108,10 @@ std::unique_ptr<ParamSource> rosParamSource(const ros::NodeHandle& nh);
 LocalizerConfig readConfig(const ParamSource& source, const ParamSource* defaults = nullptr,
                            ConfigNotes* notes = nullptr);
 
-/// The checks readConfig ends with, for a configuration changed while running
-/// (dynamic_reconfigure): throws std::invalid_argument with the same message
-/// ("invalid parameter NAME = V: must be RANGE") that refuses it at start-up.
+/// The checks readConfig ends with (the table's ranges, then pf::validate), for
+/// a configuration changed while running (dynamic_reconfigure): throws
+/// std::invalid_argument with the same message ("invalid parameter NAME = V:
+/// must be RANGE") that refuses it at start-up.
 void validate(const LocalizerConfig& config);
 
 }  // namespace pf_ros
