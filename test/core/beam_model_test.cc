@@ -11,6 +11,8 @@
 namespace pf {
 namespace {
 
+// The tests' wall: wallGrid(8), 10 x 5 cells of 0.1 m, column 8 (x in
+// [0.8, 0.9)) occupied.
 using test::wallGrid;
 
 // z_hit 0.8, z_short 0.1, z_max 0.05, z_rand 0.05, sigma_hit 0.2 m,
@@ -55,8 +57,6 @@ constexpr double kLogExact = 0.47515852093562067;
 constexpr double kLogLongBy1cm = 0.4739182423768205;
 constexpr double kLogShortOf4 = -2.85177270309359;
 constexpr double kLogShortOf075 = 0.06440608700875515;
-
-// The wall: wallGrid(8), 10 x 5 cells of 0.1 m, column 8 (x in [0.8, 0.9)) occupied.
 
 TEST(BeamModel, BeamProbabilityFormula) {
   const BeamModel model(wallGrid(8), shared(), beamTerms());

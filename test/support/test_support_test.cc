@@ -76,7 +76,6 @@ TEST(ScanSimulator, SeededNoiseOfTheGivenSpread) {
   spec.noise_sigma = 0.02;
   spec.seed = 5;
   const OccupancyGrid grid = room(4.0, 3.0, 0.05);
-  const LaserScan exact = simulateScan(grid, {2.0, 1.5, 0.0});  // default spec: no noise
   ScanSimulator noisy(grid, spec);
   const LaserScan a = noisy.scanFrom({2.0, 1.5, 0.0});
   const LaserScan b = noisy.scanFrom({2.0, 1.5, 0.0});
@@ -94,7 +93,6 @@ TEST(ScanSimulator, SeededNoiseOfTheGivenSpread) {
   const double n = static_cast<double>(a.ranges.size());
   EXPECT_NEAR(0.0, sum / n, 0.002);
   EXPECT_NEAR(0.02, std::sqrt(sum2 / n), 0.002);
-  EXPECT_EQ(180u, exact.ranges.size());
 }
 
 TEST(ScanSimulator, EachBeamIsCastFromWhereTheSweepHasCarriedTheLaser) {
