@@ -20,7 +20,7 @@ packages=(
   libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev libstd-srvs-dev libdiagnostic-msgs-dev
   librosbag-dev librosbag-storage-dev python3-rosbag
   # dynamic_reconfigure: the C++ server and its headers; the .cfg generator,
-  # the Python client (test/ros/reconfigure_checker) and dynparam
+  # the Python client (test/rostest/reconfigure_checker.py) and dynparam
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure
   # libraries of the core
   libeigen3-dev libyaml-cpp-dev

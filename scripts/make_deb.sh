@@ -89,7 +89,7 @@ multiarch=$(dpkg-architecture -qDEB_HOST_MULTIARCH 2>/dev/null)
 # libraries are compiled in and need nothing at run time.
 depends=(python3 python3-roslaunch python3-rosbag python3-numpy python3-yaml)
 recommends=(rosbash python3-matplotlib python3-pil python3-dynamic-reconfigure rviz)
-suggests=(python3-rostest python3-rostopic)
+suggests=(python3-rostopic)
 for d in "${rundeps[@]}"; do
   case $d in
     # linked C++ libraries: dpkg-shlibdeps
@@ -108,7 +108,7 @@ for d in "${rundeps[@]}"; do
 done
 # rosbag play (bag_demo.launch) and pf_evaluate's bag reader: python3-rosbag (above).
 # The generated dynamic_reconfigure client module: python3-dynamic-reconfigure.
-# The rostests' checker nodes installed beside the tools: python3-rostest.
+# (The rostests and their checker nodes stay in the source tree: no python3-rostest.)
 known=$(dpkg-query -W -f '${Package}\n' 2>/dev/null)
 for p in "${depends[@]}" "${recommends[@]}" "${suggests[@]}"; do
   grep -qx "$p" <<<"$known" || apt-cache show --no-all-versions "$p" >/dev/null 2>&1 ||

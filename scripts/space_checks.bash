@@ -9,7 +9,9 @@
 #   pf_check_rosrun SETUP           rosrun pf_localization pf_evaluate --help, no prompt, no loop
 #   pf_check_install_demo WS        roslaunch bag_demo.launch from WS/install: pf_node publishes pf_pose
 #   pf_check_demo SETUP SHARE       the same from any space; SHARE: where pf_localization must be found
-#   pf_check_deb DEB PACKAGE_XML    the .deb of scripts/make_deb.sh: fields, files under /usr, Depends
+#   pf_check_deb DEB PACKAGE_XML    the .deb of scripts/make_deb.sh: fields, files under /usr, Depends,
+#                                   no test node
+#   pf_check_no_test_nodes LIBEXEC  no rostest checker node (test/rostest/*.py) in LIBEXEC
 #   pf_check_deb_demo DEB           bag_demo.launch from DEB unpacked with dpkg -x into a temporary root
 
 pf_space_cmd() {  # sets PF_SPACE_CMD to the command line of pf_in_space SETUP CMD...
@@ -96,6 +98,20 @@ pf_check_demo() {
 # in Debian's ROS layout and no workspace file, no RPATH, and Depends that
 # cover what it runs: the package of every library a binary links (besides its
 # own), of roslaunch, and of every node bag_demo.launch starts.
+# The rostests' checker nodes (test/rostest/*.py) stay in the source tree:
+# roslaunch finds them there, and a robot has no use for them.
+pf_check_no_test_nodes() {
+  local libexec=$1 node bad=0
+  if [ ! -d "$libexec" ]; then echo "no $libexec"; return 1; fi
+  for node in "$(dirname "${BASH_SOURCE[0]}")"/../test/rostest/*.py; do
+    node=$(basename "$node" .py)
+    for f in "$libexec/$node" "$libexec/$node.py"; do
+      if [ -e "$f" ]; then echo "test node installed: $f (a leftover of an older install? remove it)"; bad=1; fi
+    done
+  done
+  return "$bad"
+}
+
 pf_check_deb() {
   local deb=$1 package_xml=$2 version arch multiarch root depends bad=0 f lib path owner p
   if [ ! -f "$deb" ]; then echo "no .deb: $deb"; return 1; fi
@@ -139,6 +155,9 @@ pf_check_deb() {
            usr/share/doc/ros-pf-localization/copyright; do
     grep -qx "$f" <<<"$listing" || { echo "missing /$f"; bad=1; }
   done
+  if grep -E '^usr/lib/pf_localization/[^/]*(_checker|cpu_hog)[^/]*$' <<<"$listing"; then
+    echo "rostest checker nodes in the package (above)"; bad=1
+  fi
 
   # Libraries and nodes: each one's Debian package must be in Depends.
   root=$(mktemp -d /tmp/pf_deb_check.XXXXXX)

@@ -58,6 +58,7 @@ check "catkin_lint -W1 clean" catkin_lint_clean
 check "rosrun pf_evaluate from the devel space: no prompt, no loop" pf_check_rosrun "$ws/devel/setup.bash"
 check "catkin_make install" install_space
 check "rosrun pf_evaluate from the install space: no prompt, no loop" pf_check_rosrun "$ws/install/setup.bash"
+check "no rostest checker node in the install space" pf_check_no_test_nodes "$ws/install/lib/pf_localization"
 check "bag_demo.launch from the install space alone: pf_node publishes pf_pose" pf_check_install_demo "$ws"
 
 # --- The Debian package (scripts/make_deb.sh) -------------------------------------

@@ -16,7 +16,8 @@
 //                       can check how a node copes with a map that arrives late
 //
 // A malformed map is fatal (exit code 1) with the loader's message, which
-// names the file and the field.
+// names the file and the field. -h / --help prints the usage (exit 0, no
+// master needed); a wrong call prints it on stderr (exit 2).
 #include <nav_msgs/GetMap.h>
 #include <nav_msgs/MapMetaData.h>
 #include <nav_msgs/OccupancyGrid.h>
@@ -24,6 +25,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <iostream>
 #include <string>
 
 #include "pf_localization/core/map_loader.h"
@@ -32,8 +35,19 @@
 namespace {
 
 constexpr char kUsage[] =
-    "usage: rosrun pf_localization map_publisher MAP.yaml  (or set the private parameter "
-    "~map_file)";
+    "usage: rosrun pf_localization map_publisher MAP.yaml\n"
+    "       rosrun pf_localization map_publisher _map_file:=MAP.yaml\n"
+    "Publishes the map latched on map and map_metadata, and serves static_map.\n"
+    "Private parameters: ~map_file, ~frame_id (default map), ~delay (s, default 0).\n";
+
+// -h or --help anywhere; checked before ros::init, so that the answer needs
+// no master and no ROS environment.
+bool asksForHelp(int argc, char** argv) {
+  for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "--help") == 0) return true;
+  }
+  return false;
+}
 
 // Sleeps in short steps so Ctrl-C during a long delay still ends the node.
 void waitWall(double seconds) {
@@ -47,20 +61,29 @@ void waitWall(double seconds) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  if (asksForHelp(argc, argv)) {
+    std::cout << kUsage;
+    return 0;
+  }
   // ros::init strips remapping arguments, so what is left in argv is ours.
   ros::init(argc, argv, "map_publisher");
+  // An option is a wrong call, not a map file that cannot be opened.
+  if (argc > 2 || (argc == 2 && argv[1][0] == '-')) {
+    std::cerr << "map_publisher: unexpected argument '" << argv[argc - 1] << "'\n" << kUsage;
+    return 2;
+  }
   ros::NodeHandle nh;
   ros::NodeHandle pnh("~");
 
   std::string yaml_path;
   if (argc == 2) {
     yaml_path = argv[1];
-  } else if (argc == 1) {
+  } else {
     pnh.getParam("map_file", yaml_path);
   }
-  if (argc > 2 || yaml_path.empty()) {
-    ROS_FATAL("map_publisher: %s", kUsage);
-    return 1;
+  if (yaml_path.empty()) {
+    std::cerr << "map_publisher: no map: give MAP.yaml or set ~map_file\n" << kUsage;
+    return 2;
   }
   const std::string frame_id = pnh.param<std::string>("frame_id", "map");
   double delay = pnh.param("delay", 0.0);

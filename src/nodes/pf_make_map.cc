@@ -12,14 +12,25 @@
 #include "pf_localization/core/map_loader.h"
 #include "pf_localization/sim/building_map.h"
 
+namespace {
+
+constexpr char kUsage[] =
+    "usage: pf_make_map [--out-dir DIR]   (default: maps)\n"
+    "writes DIR/building.yaml/.pgm and DIR/small.yaml/.pgm\n";
+
+}  // namespace
+
 int main(int argc, char** argv) {
   std::string out_dir = "maps";
   for (int i = 1; i < argc; ++i) {
+    if (std::strcmp(argv[i], "-h") == 0 || std::strcmp(argv[i], "--help") == 0) {
+      std::cout << kUsage;
+      return 0;
+    }
     if (std::strcmp(argv[i], "--out-dir") == 0 && i + 1 < argc) {
       out_dir = argv[++i];
     } else {
-      std::cerr << "usage: pf_make_map [--out-dir DIR]   (default: maps)\n"
-                   "writes DIR/building.yaml/.pgm and DIR/small.yaml/.pgm\n";
+      std::cerr << "pf_make_map: unexpected argument '" << argv[i] << "'\n" << kUsage;
       return 2;
     }
   }

@@ -6,7 +6,7 @@
 //                [--odom-error K] [--unsigned-odometry] [--no-people] [--scan-period S]
 //                [--start-time SECONDS]
 //
-// Topics, as on the real robot (see /work/shared/data/neato_ac109_1):
+// Topics, as on the real robot (the Neato's AC109 recording):
 //   /scan          sensor_msgs/LaserScan, base_laser_link, 5 Hz: 360 beams at
 //                  1 deg from angle 0, range 0.02-5 m, invalid beams 0.0
 //   /odom          nav_msgs/Odometry odom -> base_link, 20 Hz
@@ -68,15 +68,18 @@ struct Options {
   int scan_every = kScanEvery;
 };
 
+constexpr char kUsage[] =
+    "usage: pf_simulator --map MAP.yaml --path SCRIPT.path --out OUT.bag\n"
+    "                    [--seed N] [--compression bz2|lz4|none]\n"
+    "                    [--odom-error K]   scale the odometry errors (0: perfect)\n"
+    "                    [--unsigned-odometry]  log reversing as driving forwards\n"
+    "                    [--no-people]      ignore the script's 'person' lines\n"
+    "                    [--start-time S]   first stamp, s (default 1000)\n"
+    "                    [--scan-period S]  s between scans (default 0.2: 5 Hz)\n";
+
+// A wrong call: the problem and the usage on stderr, exit 2.
 [[noreturn]] void usage(const std::string& problem) {
-  if (!problem.empty()) std::cerr << "pf_simulator: " << problem << "\n";
-  std::cerr << "usage: pf_simulator --map MAP.yaml --path SCRIPT.path --out OUT.bag\n"
-               "                    [--seed N] [--compression bz2|lz4|none]\n"
-               "                    [--odom-error K]   scale the odometry errors (0: perfect)\n"
-               "                    [--unsigned-odometry]  log reversing as driving forwards\n"
-               "                    [--no-people]      ignore the script's 'person' lines\n"
-               "                    [--start-time S]   first stamp, s (default 1000)\n"
-               "                    [--scan-period S]  s between scans (default 0.2: 5 Hz)\n";
+  std::cerr << "pf_simulator: " << problem << "\n" << kUsage;
   std::exit(2);
 }
 
@@ -84,6 +87,10 @@ Options parseOptions(int argc, char** argv) {
   Options o;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
+    if (arg == "-h" || arg == "--help") {
+      std::cout << kUsage;
+      std::exit(0);
+    }
     const auto value = [&]() -> std::string {
       if (i + 1 >= argc) usage(arg + " needs a value");
       return argv[++i];
@@ -127,7 +134,7 @@ Options parseOptions(int argc, char** argv) {
       o.start_time = number();
       if (o.start_time <= 0.0) usage("--start-time must be positive");
     } else {
-      usage(arg == "--help" || arg == "-h" ? "" : "unknown option " + arg);
+      usage("unknown option " + arg);
     }
   }
   if (o.map.empty() || o.path.empty() || o.out.empty())

@@ -6,8 +6,14 @@
 #include <stdexcept>
 #include <vector>
 
+#include "support/rooms.h"
+
 namespace pf {
 namespace {
+
+// The tests' wall: wallGrid(8), 10 x 5 cells of 0.1 m, column 8 (x in
+// [0.8, 0.9)) occupied.
+using test::wallGrid;
 
 // z_hit 0.8, z_short 0.1, z_max 0.05, z_rand 0.05, sigma_hit 0.2 m,
 // lambda_short 0.5 /m, range_max 4 m, untempered.
@@ -26,13 +32,6 @@ BeamModelParams beamTerms() {
   p.z_max = 0.05;
   p.lambda_short = 0.5;
   return p;
-}
-
-// 10 x 5 cells of 0.1 m; column 8 (x in [0.8, 0.9)) occupied.
-OccupancyGrid wallGrid() {
-  std::vector<int8_t> data(50, 0);
-  for (int y = 0; y < 5; ++y) data[y * 10 + 8] = 100;
-  return OccupancyGrid(10, 5, 0.1, {}, data);
 }
 
 // Beams at 0 and pi/2 rad with the given ranges, range_max 4 m.
@@ -60,7 +59,7 @@ constexpr double kLogShortOf4 = -2.85177270309359;
 constexpr double kLogShortOf075 = 0.06440608700875515;
 
 TEST(BeamModel, BeamProbabilityFormula) {
-  const BeamModel model(wallGrid(), shared(), beamTerms());
+  const BeamModel model(wallGrid(8), shared(), beamTerms());
   EXPECT_NEAR(std::exp(kLogExact), model.beamProbability(0.55, 0.55, 4.0), 1e-12);
   EXPECT_NEAR(std::exp(kLogShortOf4), model.beamProbability(0.2, 4.0, 4.0), 1e-12);
   EXPECT_NEAR(std::exp(kLogLongBy1cm), model.beamProbability(0.56, 0.55, 4.0), 1e-12);
@@ -73,7 +72,7 @@ TEST(BeamModel, BeamProbabilityFormula) {
 }
 
 TEST(BeamModel, WeightOfAKnownScanOnALiteralWall) {
-  const BeamModel model(wallGrid(), shared(), beamTerms());
+  const BeamModel model(wallGrid(8), shared(), beamTerms());
   // 0.56 m, not 0.55: a reading exactly at the expected range is on the
   // edge of the short term (which applies below it), and float rounding
   // would decide the side.
@@ -99,7 +98,7 @@ TEST(BeamModel, WeightOfAKnownScanOnALiteralWall) {
 }
 
 TEST(BeamModel, TheSensorMountIsHonoured) {
-  const BeamModel model(wallGrid(), shared(), beamTerms());
+  const BeamModel model(wallGrid(8), shared(), beamTerms());
   LaserScan scan = twoBeams(0.56f, 0.2f);
   // The laser 0.2 m ahead of the base: the base at x = 0.05 sees what a
   // laser at x = 0.25 sees.
@@ -111,13 +110,13 @@ TEST(BeamModel, TheSensorMountIsHonoured) {
 TEST(BeamModel, RefusesBadTerms) {
   BeamModelParams p = beamTerms();
   p.lambda_short = 0.0;
-  EXPECT_THROW(BeamModel(wallGrid(), shared(), p), std::invalid_argument);
+  EXPECT_THROW(BeamModel(wallGrid(8), shared(), p), std::invalid_argument);
   p = beamTerms();
   p.z_short = -1.0;
-  EXPECT_THROW(BeamModel(wallGrid(), shared(), p), std::invalid_argument);
+  EXPECT_THROW(BeamModel(wallGrid(8), shared(), p), std::invalid_argument);
   p = beamTerms();
   p.z_max = NAN;
-  EXPECT_THROW(BeamModel(wallGrid(), shared(), p), std::invalid_argument);
+  EXPECT_THROW(BeamModel(wallGrid(8), shared(), p), std::invalid_argument);
 }
 
 }  // namespace

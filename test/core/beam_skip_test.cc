@@ -10,20 +10,13 @@
 #include "pf_localization/core/distance_field_ray_caster.h"
 #include "pf_localization/core/likelihood_field_model.h"
 #include "pf_localization/core/random.h"
+#include "support/rooms.h"
 
 namespace pf {
 namespace {
 
 // A 4 m x 4 m room of 0.1 m cells, walls on the border cells.
-OccupancyGrid room() {
-  std::vector<int8_t> data(40 * 40, 0);
-  for (int y = 0; y < 40; ++y) {
-    for (int x = 0; x < 40; ++x) {
-      if (x == 0 || y == 0 || x == 39 || y == 39) data[y * 40 + x] = 100;
-    }
-  }
-  return OccupancyGrid(40, 40, 0.1, {}, data);
-}
+OccupancyGrid room() { return test::room(4.0, 4.0, 0.1); }
 
 constexpr int kBeams = 30;
 

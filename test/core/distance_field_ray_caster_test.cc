@@ -6,29 +6,25 @@
 #include <vector>
 
 #include "pf_localization/core/random.h"
+#include "pf_localization/sim/ray_caster.h"
+#include "support/rooms.h"
 
 namespace pf {
 namespace {
 
-// 10 x 5 cells of 0.1 m; column 8 (x in [0.8, 0.9)) occupied.
-OccupancyGrid wallGrid() {
-  std::vector<int8_t> data(50, 0);
-  for (int y = 0; y < 5; ++y) data[y * 10 + 8] = 100;
-  return OccupancyGrid(10, 5, 0.1, {}, data);
-}
+using test::wallGrid;
 
-// The reference: march in steps of 0.1 mm and stop in the first occupied cell.
-double marched(const OccupancyGrid& grid, double x, double y, double angle, double max_range) {
-  for (double r = 0.0; r < max_range; r += 1e-4) {
-    const CellIndex c = grid.worldToCell(x + r * std::cos(angle), y + r * std::sin(angle));
-    if (!grid.contains(c)) return max_range;
-    if (grid.state(c) == CellState::kOccupied) return r;
-  }
-  return max_range;
+// The reference: the simulator's exact cell-by-cell traversal (Amanatides &
+// Woo), a different algorithm from sphere tracing; max_range when it finds
+// nothing.
+double exact(const sim::RayCaster& reference, double x, double y, double angle, double max_range) {
+  const double r = reference.cast(x, y, angle, max_range);
+  return std::isfinite(r) ? r : max_range;
 }
 
 TEST(DistanceFieldRayCaster, RangesOnALiteralWall) {
-  const DistanceFieldRayCaster caster(wallGrid());
+  // 10 x 5 cells of 0.1 m; column 8 (x in [0.8, 0.9)) occupied.
+  const DistanceFieldRayCaster caster(wallGrid(8));
   // Straight at the wall from x = 0.25: it is entered at x = 0.8.
   EXPECT_NEAR(0.55, caster.cast(0.25, 0.25, 0.0, 4.0), 1e-6);
   // At 30 deg from (0.35, 0.05): x = 0.8 after 0.45 / cos 30 = 0.519615 m,
@@ -52,7 +48,7 @@ TEST(DistanceFieldRayCaster, UnknownCellsAreTransparentAndAMapWithoutObstaclesIs
   EXPECT_EQ(3.0, empty.cast(0.25, 0.25, 0.3, 3.0));
 }
 
-TEST(DistanceFieldRayCaster, AgreesWithMarchingOnARotatedMapWithPillars) {
+TEST(DistanceFieldRayCaster, AgreesWithTheExactTraversalOnARotatedMapWithPillars) {
   // 60 x 50 cells of 0.05 m, border walls and 2 x 2 pillars every 10 cells,
   // origin rotated: sphere tracing must skip space without skipping a corner.
   std::vector<int8_t> data(60 * 50, 0);
@@ -64,6 +60,7 @@ TEST(DistanceFieldRayCaster, AgreesWithMarchingOnARotatedMapWithPillars) {
   }
   const OccupancyGrid grid(60, 50, 0.05, {-1.0, 0.5, 0.3}, data);
   const DistanceFieldRayCaster caster(grid);
+  const sim::RayCaster reference(grid);
   Random random(7);
   int compared = 0;
   for (int i = 0; i < 300; ++i) {
@@ -72,7 +69,7 @@ TEST(DistanceFieldRayCaster, AgreesWithMarchingOnARotatedMapWithPillars) {
         {2 + static_cast<int>(random.index(56)), 2 + static_cast<int>(random.index(46))}, &wx, &wy);
     if (grid.state(grid.worldToCell(wx, wy)) == CellState::kOccupied) continue;
     const double angle = random.uniform(-M_PI, M_PI);
-    EXPECT_NEAR(marched(grid, wx, wy, angle, 5.0), caster.cast(wx, wy, angle, 5.0), 2e-4)
+    EXPECT_NEAR(exact(reference, wx, wy, angle, 5.0), caster.cast(wx, wy, angle, 5.0), 2e-4)
         << "from " << wx << ", " << wy << " at " << angle;
     ++compared;
   }

@@ -10,9 +10,14 @@
 #include <vector>
 
 #include "pf_localization/core/random.h"
+#include "support/rooms.h"
 
 namespace pf {
 namespace {
+
+// wallGrid(column, origin): 10 x 5 cells of 0.1 m (1 m x 0.5 m); the cells of
+// column `column` are occupied, everything else free.
+using test::wallGrid;
 
 // Per-beam values are tabulated as float.
 constexpr double kTol = 1e-5;
@@ -42,14 +47,6 @@ LikelihoodFieldModelParams params(double max_distance = 2.0) {
   // Untempered, so that the expected values are the plain sums of log p.
   p.likelihood_exponent = 1.0;
   return p;
-}
-
-// 10 x 5 cells of 0.1 m (1 m x 0.5 m); the cells of column `wall_x` are
-// occupied, everything else free.
-OccupancyGrid wallGrid(int wall_x, const Pose2& origin = {}) {
-  std::vector<int8_t> data(50, 0);
-  for (int y = 0; y < 5; ++y) data[y * 10 + wall_x] = 100;
-  return OccupancyGrid(10, 5, 0.1, origin, data);
 }
 
 // Beams at 0, pi/2, pi, ... rad with the given ranges.

@@ -9,6 +9,8 @@
 #include "expect_pose.h"
 #include "pf_localization/core/laser_scan.h"
 #include "pf_localization/core/sensor_model.h"
+#include "support/rooms.h"
+#include "support/scan_simulator.h"
 
 namespace pf {
 namespace {
@@ -64,24 +66,20 @@ TEST(SensorPoseAtBeam, CarriesTheMountingAlongTheBaseMotion) {
   expectPoseNear({0.0, 0.1, -M_PI / 2}, sensorPoseAtBeam(mount, sweep, 4));
 }
 
-// A straight wall at x = 2 in the frame of the base at the stamp, scanned by
-// a laser mounted at `mount` while the base drives and turns: the ranges each
-// beam really measures.
+// A straight wall at x = 2 in the frame of the base at the stamp (the inner
+// face of a room's right wall, the room 12 m high so that every beam reaches
+// it), scanned by a laser mounted at `mount` while the base drives and turns:
+// the ranges each beam really measures.
 LaserScan wallScannedWhileMoving(const Pose2& mount, const SweepMotion& sweep) {
-  LaserScan scan;
-  scan.angle_min = -0.6;
-  scan.angle_increment = 0.1;
-  scan.range_min = 0.05;
-  scan.range_max = 20.0;
-  scan.sensor_pose = mount;
-  scan.sweep = sweep;
-  for (int i = 0; i <= 12; ++i) {
-    const Pose2 laser = compose(
-        motionOver(sweep.base_velocity, sweep.first_beam_time + i * sweep.time_increment), mount);
-    const double direction = laser.yaw + scan.angle_min + i * scan.angle_increment;
-    scan.ranges.push_back(static_cast<float>((2.0 - laser.x) / std::cos(direction)));
-  }
-  return scan;
+  test::ScanSpec spec;
+  spec.beams = 13;
+  spec.angle_min = -0.6;
+  spec.angle_increment = 0.1;
+  spec.range_min = 0.05;
+  spec.range_max = 20.0;
+  spec.sensor_pose = mount;
+  spec.sweep = sweep;
+  return test::simulateScan(test::room(3.1, 12.0, 0.1, {}, {-1.0, -6.0, 0.0}), {}, spec);
 }
 
 TEST(PrepareScan, DeskewedWallIsStraight) {

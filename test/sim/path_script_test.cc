@@ -4,6 +4,8 @@
 
 #include <sstream>
 
+#include "support/rooms.h"
+
 namespace pf::sim {
 namespace {
 
@@ -100,13 +102,7 @@ TEST(PathScriptTest, ErrorsNameFileAndLine) {
 }
 
 // A 10 x 6 room of 0.1 m cells (1 x 0.6 m) with a pillar in the middle.
-OccupancyGrid room() {
-  std::vector<int8_t> data(10 * 6, 0);
-  for (int x = 0; x < 10; ++x) data[x] = data[5 * 10 + x] = 100;
-  for (int y = 0; y < 6; ++y) data[y * 10] = data[y * 10 + 9] = 100;
-  data[2 * 10 + 5] = data[3 * 10 + 5] = 100;  // pillar at x 0.5-0.6, y 0.2-0.4
-  return OccupancyGrid(10, 6, 0.1, {}, data);
-}
+OccupancyGrid room() { return pf::test::room(1.0, 0.6, 0.1, {{0.5, 0.2, 0.6, 0.4}}); }
 
 TEST(CheckClearanceTest, AcceptsAPathInFreeSpace) {
   const PathScript s = parse("start 0.2 0.25 0\ngoto 0.2 0.35\nturn 3\nwait 1\n");

@@ -9,8 +9,8 @@
 // reflect), and a ray that leaves the map returns nothing.
 //
 // The Neato model (neatoReadings) turns those ideal ranges into readings,
-// after the real AC109 bag (/work/shared/data/neato_ac109_1), which loses
-// ~39 % of its beams:
+// after the real Neato recording in the AC109 arena, which loses ~39 % of
+// its beams:
 //   - nothing within range_max, or a dropout: 0.0, as the Neato reports it;
 //   - fixed blind sectors, where the robot's own mast and posts hide the
 //     laser: 16 % of the beams are never valid, and their neighbours are

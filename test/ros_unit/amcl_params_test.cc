@@ -229,8 +229,7 @@ TEST(AmclParams, MaxUpdateTimeIsReadAndValidated) {
 
 // config/pf.yaml, the defaults under every launch file: all of it known.
 TEST(AmclParams, PfYamlHasNoUnknownParameter) {
-  const std::string here = __FILE__;
-  const std::string pf_yaml = here.substr(0, here.rfind("/test/ros/")) + "/config/pf.yaml";
+  const std::string pf_yaml = PF_SOURCE_DIR "/config/pf.yaml";
   ConfigNotes notes;
   readConfig(*yamlParamSource(pf_yaml), nullptr, &notes);
   EXPECT_TRUE(notes.warnings.empty()) << notes.warnings[0];

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """rostest checker for pf_localization: compares the localizer with the truth.
 
-Run as a <test> node of a .test file (see test/ros/*.test); rostest reports
+Run as a <test> node of a .test file (see test/rostest/*.test); rostest reports
 the single test case `test_pose_checker` as passed or failed, with the summary
 in the failure message. The summary (and a timeline of the error in 5 s bins)
 is also printed in both cases: it is in the test's XML result (<system-out>,

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """rostest checker: pf_node's parameters change live (dynamic_reconfigure).
 
-While bags/tracking.bag plays (test/ros/reconfigure.test), through
+While bags/tracking.bag plays (test/rostest/reconfigure.test), through
 dynamic_reconfigure's Python client, as rqt_reconfigure and dynparam do:
 
 1. the server's description has config/pf.yaml's defaults, and its values

@@ -1,0 +1,27 @@
+// Test support: the walled rooms and the single wall the tests' worlds are
+// made of.
+#pragma once
+
+#include <vector>
+
+#include "pf_localization/core/occupancy_grid.h"
+
+namespace pf::test {
+
+/// An axis-aligned box in the grid's frame, metres: a cell is filled when
+/// its centre lies strictly inside.
+struct Box {
+  double x0, y0, x1, y1;
+};
+
+/// A room of width x height metres (rounded to whole cells) with one-cell
+/// walls on its border and the given boxes filled; everything else free.
+OccupancyGrid room(double width, double height, double resolution,
+                   const std::vector<Box>& boxes = {}, const Pose2& origin = {});
+
+/// 10 x 5 cells of 0.1 m (1 m x 0.5 m), free but for the cells of column
+/// `column`: a single wall, x in [column / 10, column / 10 + 0.1) in the
+/// grid's frame, whose ranges and distances are easy to work out by hand.
+OccupancyGrid wallGrid(int column, const Pose2& origin = {});
+
+}  // namespace pf::test
