@@ -46,7 +46,7 @@ std::string mapSignature(const nav_msgs::OccupancyGrid& map) {
   const auto& o = map.info.origin;
   char text[256];
   std::snprintf(text, sizeof text,
-                "%u x %u cells of %.9g m, origin (%.9g, %.9g, %.9g), cells %016" PRIx64,
+                "%u x %u cells of %.7g m, origin (%.9g, %.9g, %.9g), cells %016" PRIx64,
                 map.info.width, map.info.height, static_cast<double>(map.info.resolution),
                 o.position.x, o.position.y, yawOf(o.orientation), fnv1a(map.data));
   return text;
