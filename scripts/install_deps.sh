@@ -26,6 +26,8 @@ packages=(
   libeigen3-dev libyaml-cpp-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev librostest-dev python3-rostest python3-rosunit libbenchmark-dev
+  # test/rostest/odom_topic.test: relay and transform
+  topic-tools python3-topic-tools
   # fuzzing (scripts/fuzz.sh): clang with libFuzzer
   clang-14 libclang-rt-14-dev
   python3-std-srvs python3-geometry-msgs python3-nav-msgs python3-sensor-msgs python3-tf2-msgs
