@@ -322,8 +322,8 @@ class PfNode {
     const ros::WallTime start = ros::WallTime::now();
     const ScanResult result = localizer_.processScan(scan);
     const double update_s = (ros::WallTime::now() - start).toSec();
-    if (!result.error.empty()) {
-      warn(result.error.substr(0, 24), result.error);
+    if (result.error != pf_ros::ScanError::kNone) {
+      warn(pf_ros::toString(result.error), pf_ros::errorMessage(result));
       return;
     }
     if (!result.warning.empty()) warn("scan inconsistent", result.warning);
@@ -340,8 +340,8 @@ class PfNode {
       publishConfidence(scan.header.stamp, r);
       ROS_DEBUG("pf_node: update with %d beams, %zu particles, ESS %.0f%s in %.1f ms", r.beams_used,
                 r.particles, r.ess, r.resampled ? ", resampled" : "", update_s * 1e3);
-    } else if (r.skip_reason.rfind("not moved", 0) != 0) {
-      warn(r.skip_reason.substr(0, 16), "scan not used: " + r.skip_reason);
+    } else if (r.skip_reason != pf::SkipReason::kNotMoved) {
+      warn(pf::toString(r.skip_reason), "scan not used: " + pf::skipMessage(r));
     }
   }
 
