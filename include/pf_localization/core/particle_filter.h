@@ -132,7 +132,9 @@ class ParticleFilter {
   const Confidence& confidence() const { return confidence_.confidence(); }
 
   /// map -> odom: the estimate composed with the inverse of the odometry pose
-  /// it was computed at. Empty until the first update after an initialisation.
+  /// it was computed at, or the latest accepted scan fit since that update
+  /// (EstimateRefinement). Empty until the first update after an
+  /// initialisation.
   std::optional<Pose2> mapToOdom() const;
 
  private:
