@@ -168,7 +168,7 @@ void BM_ScanRefinement(benchmark::State& state) {
   int iterations = 0;
   for (auto _ : state) {
     const pf::ScanRefinement r = refiner.refine(scan, start, cloud);
-    if (!r.accepted) state.SkipWithError(r.rejection.c_str());
+    if (!r.accepted) state.SkipWithError(r.rejection_detail.c_str());
     iterations = r.iterations;
     benchmark::DoNotOptimize(r.pose);
   }

@@ -27,6 +27,26 @@ std::string text(double v) {
 
 }  // namespace
 
+const char* toString(ScanRejection rejection) {
+  switch (rejection) {
+    case ScanRejection::kNone:
+      return "none";
+    case ScanRejection::kRefinementOff:
+      return "refine_estimate is off";
+    case ScanRejection::kFilterLost:
+      return "the filter is lost";
+    case ScanRejection::kNotMovedSinceFit:
+      return "not moved since the last fit, which stands";
+    case ScanRejection::kTooFewMatchedBeams:
+      return "too few matched beams";
+    case ScanRejection::kDegenerate:
+      return "the scan constrains no direction of the pose";
+    case ScanRejection::kMovedTooFar:
+      return "the fit moved too far";
+  }
+  return "unknown rejection";
+}
+
 void validate(const ScanRefinerParams& p) {
   requireParameter(p.max_iterations >= 1, "refine_max_iterations", ">= 1", p.max_iterations);
   requireParameter(p.outlier_distance > 0.0 && finite(p.outlier_distance),
@@ -139,7 +159,8 @@ ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start,
   Evaluation e = evaluate(scan, pose, true);
   if (e.matched < needed) {
     out.matched_beams = e.matched;
-    out.rejection = too_few(e.matched);
+    out.rejection = ScanRejection::kTooFewMatchedBeams;
+    out.rejection_detail = too_few(e.matched);
     return out;
   }
   double cost = total(e, pose);
@@ -189,18 +210,21 @@ ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start,
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(e.hessian);
   const Eigen::Vector3d lambda = eig.eigenvalues();
   if (!(lambda(2) > 0.0)) {
-    out.rejection = "the scan constrains no direction of the pose";
+    out.rejection = ScanRejection::kDegenerate;
+    out.rejection_detail = "the scan constrains no direction of the pose";
     return out;
   }
   if (e.matched < needed) {
-    out.rejection = too_few(e.matched);
+    out.rejection = ScanRejection::kTooFewMatchedBeams;
+    out.rejection_detail = too_few(e.matched);
     return out;
   }
   if (out.translation > params_.max_translation || std::fabs(out.rotation) > params_.max_rotation) {
-    out.rejection = "the fit moved " + text(out.translation) + " m and " +
-                    text(std::fabs(out.rotation)) + " rad (bounds " +
-                    text(params_.max_translation) + " m, " + text(params_.max_rotation) +
-                    " rad): the scan fits another place better, which is for the filter to decide";
+    out.rejection = ScanRejection::kMovedTooFar;
+    out.rejection_detail =
+        "the fit moved " + text(out.translation) + " m and " + text(std::fabs(out.rotation)) +
+        " rad (bounds " + text(params_.max_translation) + " m, " + text(params_.max_rotation) +
+        " rad): the scan fits another place better, which is for the filter to decide";
     return out;
   }
   // The fit's covariance: the residual variance per unit weight (with the

@@ -244,9 +244,9 @@ int main(int argc, char** argv) {
     cpu_total += cpu;
     const double t = scan.header.stamp.toSec();
     if (first_stamp < 0) first_stamp = t;
-    if (!r.error.empty()) {
-      if (errors[r.error.substr(0, 40)]++ == 0)
-        std::cerr << "\npf_bag_runner: warning: " << r.error << "\n";
+    if (r.error != pf_ros::ScanError::kNone) {
+      if (errors[pf_ros::toString(r.error)]++ == 0)
+        std::cerr << "\npf_bag_runner: warning: " << pf_ros::errorMessage(r) << "\n";
       return;
     }
     if (r.report.updated) {
@@ -325,7 +325,7 @@ int main(int argc, char** argv) {
               << 1e3 * update_cpu.max() << " ms\n";
   }
   for (const auto& e : errors) {
-    std::cerr << "pf_bag_runner: " << e.second << " scans not used: " << e.first << "...\n";
+    std::cerr << "pf_bag_runner: " << e.second << " scans not used: " << e.first << "\n";
   }
   if (scans == 0) fail(opt.bag + ": no scans on " + opt.scan_topic);
   if (written == 0) fail("no pose could be estimated (see the warnings above)", 3);

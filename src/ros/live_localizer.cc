@@ -130,8 +130,8 @@ void LiveLocalizer::processScan(const PendingScan& pending, const LatestScanSlot
   const ros::WallTime start = ros::WallTime::now();
   const ScanResult result = localizer_.processScan(scan);
   const double update_s = (ros::WallTime::now() - start).toSec();
-  if (!result.error.empty()) {
-    warn_->warn(result.error.substr(0, 24), result.error);
+  if (result.error != ScanError::kNone) {
+    warn_->warn(toString(result.error), errorMessage(result));
     return;
   }
   if (!result.warning.empty()) warn_->warn("scan inconsistent", result.warning);
@@ -149,8 +149,8 @@ void LiveLocalizer::processScan(const PendingScan& pending, const LatestScanSlot
                               slot.dropped(), governor_.cap());
     ROS_DEBUG("pf_node: update with %d beams, %zu particles, ESS %.0f%s in %.1f ms", r.beams_used,
               r.particles, r.ess, r.resampled ? ", resampled" : "", update_s * 1e3);
-  } else if (r.skip_reason.rfind("not moved", 0) != 0) {
-    warn_->warn(r.skip_reason.substr(0, 16), "scan not used: " + r.skip_reason);
+  } else if (r.skip_reason != pf::SkipReason::kNotMoved) {
+    warn_->warn(pf::toString(r.skip_reason), "scan not used: " + pf::skipMessage(r));
   }
 }
 

@@ -21,6 +21,28 @@ std::string describe(const ros::Time& t) {
 
 }  // namespace
 
+const char* toString(ScanError error) {
+  switch (error) {
+    case ScanError::kNone:
+      return "none";
+    case ScanError::kNoMap:
+      return "no map received yet";
+    case ScanError::kEmptyLaserFrame:
+      return "the scan has an empty frame_id";
+    case ScanError::kNoLaserMounting:
+      return "cannot place the laser on the robot";
+    case ScanError::kNoOdometry:
+      return "no odometry at the scan's stamp";
+  }
+  return "unknown scan error";
+}
+
+std::string errorMessage(const ScanResult& result) {
+  std::string message = toString(result.error);
+  if (!result.error_detail.empty()) message += ": " + result.error_detail;
+  return message;
+}
+
 ScanLocalizer::ScanLocalizer(const LocalizerConfig& config, const tf2::BufferCore* tf)
     : config_(config),
       configured_pose_(config.initial_pose),
@@ -110,11 +132,13 @@ std::string ScanLocalizer::restart() {
 ScanResult ScanLocalizer::processScan(const sensor_msgs::LaserScan& scan) {
   ScanResult result;
   if (!filter_.hasMap()) {
-    result.error = "no map received yet: waiting for one on the map topic";
+    result.error = ScanError::kNoMap;
+    result.error_detail = "waiting for one on the map topic";
     return result;
   }
   if (scan.header.frame_id.empty()) {
-    result.error = "the scan has an empty frame_id: cannot place the laser on the robot";
+    result.error = ScanError::kEmptyLaserFrame;
+    result.error_detail = "cannot place the laser on the robot";
     return result;
   }
   geometry_msgs::TransformStamped laser, odom;
@@ -123,16 +147,20 @@ ScanResult ScanLocalizer::processScan(const sensor_msgs::LaserScan& scan) {
     // stamp, and does not fail on a mount published at a low rate.
     laser = tf_->lookupTransform(config_.base_frame, scan.header.frame_id, ros::Time(0));
   } catch (const tf2::TransformException& e) {
-    result.error = "cannot place the laser on the robot: tf lookup " + config_.base_frame + " -> " +
-                   scan.header.frame_id + " failed: " + e.what();
+    result.error = ScanError::kNoLaserMounting;
+    result.error_detail =
+        "no transform " + config_.base_frame + " -> " + scan.header.frame_id +
+        " (the laser's mounting; the odometry was not looked up yet): " + e.what();
     return result;
   }
   try {
     odom = tf_->lookupTransform(config_.odom_frame, config_.base_frame, scan.header.stamp);
   } catch (const tf2::TransformException& e) {
-    result.error = "no odometry at the scan's stamp " + describe(scan.header.stamp) +
-                   ": tf lookup " + config_.odom_frame + " -> " + config_.base_frame +
-                   " failed: " + e.what();
+    result.error = ScanError::kNoOdometry;
+    result.error_detail = "no transform " + config_.odom_frame + " -> " + config_.base_frame +
+                          " at t=" + describe(scan.header.stamp) + " (the laser's mounting " +
+                          config_.base_frame + " -> " + scan.header.frame_id +
+                          " was found): " + e.what();
     return result;
   }
   result.warning = scanInconsistency(scan);

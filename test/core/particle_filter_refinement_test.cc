@@ -88,8 +88,8 @@ TEST(ParticleFilterRefinement, TheFittedPoseIsPublishedThroughMapToOdom) {
   filter.initializeGaussian({kTruth.x + 0.04, kTruth.y - 0.03, kTruth.yaw + 0.02}, kStartCov);
   const Pose2 odom = odomOf(kTruth);
   const UpdateReport r = filter.update(odom, castScan(grid, kTruth));
-  ASSERT_TRUE(r.updated) << r.skip_reason;
-  ASSERT_TRUE(r.refinement.accepted) << r.refinement.rejection;
+  ASSERT_TRUE(r.updated) << skipMessage(r);
+  ASSERT_TRUE(r.refinement.accepted) << r.refinement.rejection_detail;
   EXPECT_EQ(180, r.refinement.matched_beams);
   const PoseEstimate& e = filter.estimate();
   expectPoseNear(r.refinement.pose, e.pose, 0.0);
@@ -120,8 +120,8 @@ TEST(ParticleFilterRefinement, ScansBetweenUpdatesAreFittedAndStandingStillIsNot
   const Pose2 odom = odomOf(compose(kTruth, {0.06, 0.0, 0.0}));
   UpdateReport r = filter.update(odom, castScan(grid, truth));
   EXPECT_FALSE(r.updated);
-  EXPECT_EQ("not moved enough since the last update", r.skip_reason);
-  ASSERT_TRUE(r.refinement.accepted) << r.refinement.rejection;
+  EXPECT_EQ(SkipReason::kNotMoved, r.skip_reason) << skipMessage(r);
+  ASSERT_TRUE(r.refinement.accepted) << r.refinement.rejection_detail;
   const Pose2 placed = compose(*filter.mapToOdom(), odom);
   EXPECT_LT(distance(truth, placed), 0.01);
   expectPoseNear(r.refinement.pose, placed, 1e-9);
@@ -130,7 +130,7 @@ TEST(ParticleFilterRefinement, ScansBetweenUpdatesAreFittedAndStandingStillIsNot
   const Pose2 map_to_odom = *filter.mapToOdom();
   r = filter.update(odom, castScan(grid, compose(truth, {0.002, 0.0, 0.0})));
   EXPECT_FALSE(r.refinement.accepted);
-  EXPECT_EQ("not moved since the last fit, which stands", r.refinement.rejection);
+  EXPECT_EQ(ScanRejection::kNotMovedSinceFit, r.refinement.rejection);
   expectPoseNear(map_to_odom, *filter.mapToOdom(), 0.0);
 }
 
@@ -144,7 +144,7 @@ TEST(ParticleFilterRefinement, AnOdometryFaultMakesTheFitStale) {
   // the new odometry with the estimate where it was, as without refinement.
   const Pose2 jumped = compose(odomOf(kTruth), {10.0, 0.0, 0.0});
   const UpdateReport r = filter.update(jumped, castScan(grid, kTruth));
-  EXPECT_NE(std::string::npos, r.skip_reason.find("odometry jumped")) << r.skip_reason;
+  EXPECT_EQ(SkipReason::kOdometryJumped, r.skip_reason) << skipMessage(r);
   expectPoseNear(compose(filter.estimate().pose, inverse(jumped)), *filter.mapToOdom(), 1e-12);
 }
 
@@ -158,7 +158,7 @@ TEST(ParticleFilterRefinement, OffPublishesTheCloudsMean) {
   const UpdateReport r = filter.update(odomOf(kTruth), castScan(grid, kTruth));
   ASSERT_TRUE(r.updated);
   EXPECT_FALSE(r.refinement.accepted);
-  EXPECT_EQ("refine_estimate is off", r.refinement.rejection);
+  EXPECT_EQ(ScanRejection::kRefinementOff, r.refinement.rejection);
   expectPoseNear(filter.estimate().clusters[0].mean, filter.estimate().pose, 0.0);
   EXPECT_EQ(filter.estimate().clusters[0].covariance, filter.estimate().covariance);
 }
@@ -175,7 +175,7 @@ TEST(ParticleFilterRefinement, ALostFilterIsNotRefined) {
   ASSERT_TRUE(r.updated);
   ASSERT_EQ(LocalizationState::kLost, filter.confidence().state);
   EXPECT_FALSE(r.refinement.accepted);
-  EXPECT_EQ("the filter is lost", r.refinement.rejection);
+  EXPECT_EQ(ScanRejection::kFilterLost, r.refinement.rejection);
   expectPoseNear(filter.estimate().clusters[0].mean, filter.estimate().pose, 0.0);
 }
 

@@ -236,7 +236,8 @@ void checkFilter(const pf::ParticleFilter& filter, const pf::UpdateReport& repor
   PF_FUZZ_CHECK(
       s.x.size() == s.y.size() && s.x.size() == s.yaw.size() && s.x.size() == s.weight.size(),
       "particle arrays of different sizes");
-  PF_FUZZ_CHECK(report.updated || !report.skip_reason.empty(), "skipped without a reason");
+  PF_FUZZ_CHECK(report.updated != (report.skip_reason != pf::SkipReason::kNone),
+                "skipped without a reason, or updated with one");
   if (!filter.isInitialized()) return;
   PF_FUZZ_CHECK(s.size() >= static_cast<std::size_t>(p.kld.min_particles) &&
                     s.size() <= static_cast<std::size_t>(p.kld.max_particles),
@@ -283,7 +284,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
   // Before a map: updates are skipped, global localization refuses.
   {
     const pf::UpdateReport r = filter->update({}, pf::LaserScan{});
-    PF_FUZZ_CHECK(!r.updated && !r.skip_reason.empty(), "update without a map");
+    PF_FUZZ_CHECK(!r.updated && r.skip_reason == pf::SkipReason::kNoMap, "update without a map");
     bool threw = false;
     try {
       filter->initializeUniform();
@@ -401,7 +402,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
 
     const pf::UpdateReport report = filter->update(odom, scan);
     PF_FUZZ_LOG("  update: %s (%d beams, %zu particles)",
-                report.updated ? "updated" : report.skip_reason.c_str(), report.beams_used,
+                report.updated ? "updated" : pf::skipMessage(report).c_str(), report.beams_used,
                 report.particles);
     if (!odom.isFinite()) {
       PF_FUZZ_CHECK(!report.updated, "updated with non-finite odometry");

@@ -112,26 +112,40 @@ class ScanLocalizerTest : public ::testing::Test {
 TEST_F(ScanLocalizerTest, ScanBeforeMapIsRejectedWithAClearReason) {
   ScanLocalizer localizer(config_, &tf_);
   const ScanResult r = localizer.processScan(observe({1, 1, 0}, {0, 0, 0}, 10.0));
-  EXPECT_NE(r.error.find("no map"), std::string::npos) << r.error;
+  EXPECT_EQ(r.error, ScanError::kNoMap) << errorMessage(r);
   EXPECT_FALSE(localizer.mapToOdom(ros::Time(10)).has_value());
 }
 
-TEST_F(ScanLocalizerTest, MissingLaserFrameNamesTheFrame) {
+TEST_F(ScanLocalizerTest, MissingLaserMountingSaysWhichTransformIsMissing) {
   ScanLocalizer localizer(config_, &tf_);
   ASSERT_EQ(localizer.setMap(map_), "");
   sensor_msgs::LaserScan scan = observe({1, 1, 0}, {0, 0, 0}, 10.0);
   scan.header.frame_id = "tilted_laser";
   const ScanResult r = localizer.processScan(scan);
-  EXPECT_NE(r.error.find("tilted_laser"), std::string::npos) << r.error;
-  EXPECT_NE(r.error.find("base_link"), std::string::npos) << r.error;
+  EXPECT_EQ(r.error, ScanError::kNoLaserMounting) << errorMessage(r);
+  // The message leads with the one transform that is missing.
+  EXPECT_EQ(r.error_detail.rfind("no transform base_link -> tilted_laser ", 0), 0u)
+      << r.error_detail;
+  EXPECT_FALSE(r.report.updated);
 }
 
-TEST_F(ScanLocalizerTest, MissingOdometryIsReported) {
+TEST_F(ScanLocalizerTest, MissingOdometrySaysWhichTransformIsMissing) {
   ScanLocalizer localizer(config_, &tf_);
   ASSERT_EQ(localizer.setMap(map_), "");
   const sensor_msgs::LaserScan scan = scanFrom(map_, {1, 1, 0}, ros::Time(10));
   const ScanResult r = localizer.processScan(scan);
-  EXPECT_NE(r.error.find("no odometry"), std::string::npos) << r.error;
+  EXPECT_EQ(r.error, ScanError::kNoOdometry) << errorMessage(r);
+  EXPECT_EQ(r.error_detail.rfind("no transform odom -> base_link at t=10.000 ", 0), 0u)
+      << r.error_detail;
+  EXPECT_FALSE(r.report.updated);
+}
+
+TEST_F(ScanLocalizerTest, AScanWithoutFrameIsRejected) {
+  ScanLocalizer localizer(config_, &tf_);
+  ASSERT_EQ(localizer.setMap(map_), "");
+  sensor_msgs::LaserScan scan = observe({1, 1, 0}, {0, 0, 0}, 10.0);
+  scan.header.frame_id.clear();
+  EXPECT_EQ(localizer.processScan(scan).error, ScanError::kEmptyLaserFrame);
 }
 
 TEST_F(ScanLocalizerTest, TracksFromTheConfiguredInitialPose) {
@@ -144,8 +158,8 @@ TEST_F(ScanLocalizerTest, TracksFromTheConfiguredInitialPose) {
     const pf::Pose2 motion{0.1 * k, 0.0, 0.05 * k};
     const ScanResult r =
         localizer.processScan(observe(pf::compose(start, motion), motion, 10.0 + k));
-    ASSERT_EQ(r.error, "");
-    ASSERT_TRUE(r.report.updated) << r.report.skip_reason;
+    ASSERT_EQ(r.error, ScanError::kNone) << errorMessage(r);
+    ASSERT_TRUE(r.report.updated) << pf::skipMessage(r.report);
   }
   const auto m2o = localizer.mapToOdom(ros::Time(20));
   ASSERT_TRUE(m2o.has_value());
@@ -327,7 +341,7 @@ TEST_F(ScanLocalizerTest, DeskewingRemovesTheSpinsYawBias) {
       sensor_msgs::LaserScan scan = scanFromMoving(map_, laser_at, ros::Time(stamp));
       scan.time_increment = static_cast<float>(kSweep / 359.0);
       const ScanResult r = localizer.processScan(scan);
-      EXPECT_EQ(r.error, "");
+      EXPECT_EQ(r.error, ScanError::kNone) << errorMessage(r);
       const pf::Pose2 truth = pf::compose(start, {0.0, 0.0, kRate * stamp});
       const auto est = localizer.estimate(ros::Time(stamp));
       error = pf::angleDiff(toPose2(est->pose.pose).yaw, truth.yaw);

@@ -8,12 +8,12 @@
 // average of the measurement likelihood falls below the long-term one), and
 // KLD-sampling (Fox 2003) to adapt the particle count.
 //
-// The filter runs an update only after the robot has moved update_min_d or
-// turned update_min_a since the last one, and on the first scan after an
-// initialisation: a robot standing still would otherwise keep multiplying
-// the same evidence into its weights and grow falsely confident. It updates
-// sooner when a scan no longer fits where the odometry says the robot is
-// (update_fit_drop): that is when waiting for more odometry costs most.
+// One update is a pipeline of named parts: UpdateGate (whether and why),
+// MotionUpdate (the odometry, with OdometryFaultTracker's share of faults),
+// SensorUpdate (the weights, tempered by temperingEssFraction), the estimate
+// and ConfidenceTracker (the verdict), EstimateRefinement (the scan fit, and
+// map -> odom), and Recovery (the resampling, with its strategies). The
+// design decisions behind them, with their evidence: docs/design.md.
 //
 // Deterministic: the same parameters (seed included) and the same calls give
 // the same particles, bit for bit.
@@ -28,18 +28,23 @@
 
 #include "pf_localization/core/beam_model.h"
 #include "pf_localization/core/confidence.h"
+#include "pf_localization/core/confidence_tracker.h"
+#include "pf_localization/core/estimate_refinement.h"
 #include "pf_localization/core/laser_scan.h"
 #include "pf_localization/core/likelihood_field_model.h"
+#include "pf_localization/core/motion_update.h"
 #include "pf_localization/core/occupancy_grid.h"
-#include "pf_localization/core/odometry_motion_model.h"
 #include "pf_localization/core/particle_filter_params.h"
 #include "pf_localization/core/particle_set.h"
 #include "pf_localization/core/pose_estimator.h"
 #include "pf_localization/core/random.h"
+#include "pf_localization/core/recovery.h"
 #include "pf_localization/core/resampler.h"
 #include "pf_localization/core/scan_refiner.h"
 #include "pf_localization/core/sensor_model.h"
-#include "pf_localization/core/weighting.h"
+#include "pf_localization/core/sensor_update.h"
+#include "pf_localization/core/skip_reason.h"
+#include "pf_localization/core/update_gate.h"
 
 namespace pf {
 
@@ -50,8 +55,9 @@ std::unique_ptr<SensorModel> makeSensorModel(const OccupancyGrid& grid,
 
 /// What one call to ParticleFilter::update did.
 struct UpdateReport {
-  bool updated = false;     // motion and sensor update ran
-  std::string skip_reason;  // why not, when !updated
+  bool updated = false;                        // motion and sensor update ran
+  SkipReason skip_reason = SkipReason::kNone;  // why not, when !updated
+  std::string skip_detail;                     // the specifics, for the log (may be empty)
   int beams_used = 0;
   int beams_dropped = 0;
   int beams_skipped = 0;  // of beams_used, left out by beam skipping
@@ -70,6 +76,9 @@ struct UpdateReport {
   // the reason it was not, as in refinement.rejection.
   ScanRefinement refinement;
 };
+
+/// What a skipped update says in a log line: the reason and its detail.
+std::string skipMessage(const UpdateReport& report);
 
 class ParticleFilter {
  public:
@@ -92,8 +101,10 @@ class ParticleFilter {
   /// otherwise the filter becomes uninitialised. Returns whether they were kept.
   /// Throws std::invalid_argument for an empty map.
   bool setMap(const OccupancyGrid& grid);
-  bool hasMap() const { return static_cast<bool>(model_); }
-  const OccupancyGrid* map() const { return model_ ? &model_->field().grid() : nullptr; }
+  bool hasMap() const { return sensor_.hasModel(); }
+  const OccupancyGrid* map() const {
+    return sensor_.hasModel() ? &sensor_.model().field().grid() : nullptr;
+  }
 
   /// Particles drawn around `mean` from a Gaussian with covariance `cov`
   /// (x, y, yaw). Throws std::invalid_argument for a non-finite pose or a
@@ -111,68 +122,40 @@ class ParticleFilter {
   UpdateReport update(const Pose2& odom, const LaserScan& scan);
 
   /// The next update() runs even without motion.
-  void requestNoMotionUpdate() { force_update_ = true; }
+  void requestNoMotionUpdate() { gate_.requestUpdate(); }
 
   const ParticleSet& particles() const { return particles_; }
   /// The estimate: its pose and covariance are the refined ones when the
   /// last update's scan fit was accepted; clusters[0].mean stays the cloud's.
   const PoseEstimate& estimate() const { return estimate_; }
   /// How far to trust the estimate, as of the last update.
-  const Confidence& confidence() const { return confidence_; }
+  const Confidence& confidence() const { return confidence_.confidence(); }
 
   /// map -> odom: the estimate composed with the inverse of the odometry pose
-  /// it was computed at. Empty until the first update after an initialisation.
+  /// it was computed at, or the latest accepted scan fit since that update
+  /// (EstimateRefinement). Empty until the first update after an
+  /// initialisation.
   std::optional<Pose2> mapToOdom() const;
 
  private:
   void weigh(const PreparedScan& scan, UpdateReport* report);
+  // The estimate of the weighted cloud and the verdict on it; `predicted`:
+  // the last estimate moved by the odometry since (none on a first update).
+  void estimateAndJudge(const PreparedScan& scan, const std::optional<Pose2>& predicted);
   void resample(UpdateReport* report);
-  void adaptFaultFraction();
-  // The scan, prepared, when it fits the pose the odometry predicts
-  // `since_update` after the last update's estimate clearly worse than that
-  // update's scan fitted its estimate (update_fit_drop); nothing otherwise.
-  std::optional<PreparedScan> fitDropped(const LaserScan& scan, const Pose2& since_update) const;
-  void refineEstimate(const LaserScan& scan, UpdateReport* report);
-  void refineBetweenUpdates(const Pose2& odom, const LaserScan& scan, UpdateReport* report);
-  bool refinedIsCurrent() const;
-  Pose2 randomFreePose();
   void restartAfterInitialization();
   void reserveStorage(std::size_t max_particles);
 
   ParticleFilterParams params_;
   Random random_;
-  OdometryMotionModel motion_model_;
-  std::unique_ptr<SensorModel> model_;
+  SensorUpdate sensor_;  // the sensor model (none without a map) and its scratch
+  MotionUpdate motion_;  // the motion model and the odometry fault share
   ParticleSet particles_;
-  ParticleSet spare_;  // the resampler's output, swapped with particles_
   PoseEstimate estimate_;
-  Confidence confidence_;
-  std::optional<Pose2> odom_at_update_;
-  // map -> odom of the latest accepted scan fit, which may be newer than the
-  // last update, and odom_at_update_ at that update. An update clears it
-  // before fitting; a rejected fit between updates leaves the last one.
-  struct RefinedMapToOdom {
-    Pose2 map_to_odom;
-    Pose2 odom_at_update;
-    Pose2 odom_at_fit;  // the odometry at the scan that was fitted
-  };
-  std::optional<RefinedMapToOdom> refined_;
-  bool force_update_ = false;
-  // The share of the last update's beams that ended within
-  // update_fit_distance of an obstacle at its estimate (see update_fit_drop).
-  double fit_at_update_ = 0.0;
-  bool restart_ = false;  // the next update follows an initialisation
-  bool has_estimate_ = false;
-  double w_slow_ = 0.0;
-  double w_fast_ = 0.0;
-  int low_fit_updates_ = 0;  // consecutive updates with w_fast below the trigger
-  LocalizationState fit_state_ = LocalizationState::kLost;  // the verdict before holdAfterJump
-  double fault_fraction_ = 0.0;  // of the next motion update (adaptFaultFraction)
-  std::vector<uint8_t> faulty_;  // which particles took an odometry fault in this update
-  int settle_left_ = 0;          // updates until a jumped estimate may be localized (holdAfterJump)
-  bool expand_ = false;          // this scan's fit collapsed: spread the survivors
-  WeightingScratch weighting_;
-  std::vector<double> log_likelihood_;
+  UpdateGate gate_;  // holds the odometry of the last update
+  ConfidenceTracker confidence_;
+  EstimateRefinement refinement_;
+  Recovery recovery_;
 };
 
 }  // namespace pf

@@ -77,10 +77,25 @@ struct ScanRefinerParams {
 /// its refine_ parameter name) and its valid range.
 void validate(const ScanRefinerParams& params);
 
+/// Why a scan fit was not used (the estimate of the cloud stands).
+enum class ScanRejection {
+  kNone,                // accepted, or no fit was tried
+  kRefinementOff,       // refine_estimate is off
+  kFilterLost,          // the filter is lost: its estimate is no start for a fit
+  kNotMovedSinceFit,    // standing still since the last accepted fit, which stands
+  kTooFewMatchedBeams,  // too few beams end near a mapped obstacle
+  kDegenerate,          // the scan constrains no direction of the pose
+  kMovedTooFar,         // beyond max_translation / max_rotation: another place fits better
+};
+
+/// A few words for `rejection`, e.g. "too few matched beams".
+const char* toString(ScanRejection rejection);
+
 struct ScanRefinement {
   bool accepted = false;
-  std::string rejection;  // why not, when !accepted
-  Pose2 pose;             // the refined pose when accepted, else the start
+  ScanRejection rejection = ScanRejection::kNone;  // why not, when !accepted
+  std::string rejection_detail;                    // the figures behind it, for the log
+  Pose2 pose;                                      // the refined pose when accepted, else the start
   // The fit's covariance (x, y, yaw): the residual variance times the
   // inverse Hessian, zero in the directions the scan does not constrain.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();

@@ -23,8 +23,8 @@
 
 namespace pf_ros {
 
-/// The parameter that holds the saved pose's map (and the pose).
-constexpr const char* kSavedPoseMapParam = "saved_pose_map";
+// kSavedPoseMapParam (localizer_config.h) names the parameter that holds the
+// saved pose's map (and the pose).
 
 /// A map's identity, as text: "W x H cells of R m, origin (x, y, yaw), cells
 /// <64-bit FNV-1a hash of the cells, hex>". Equal for the same map sent again.

@@ -21,11 +21,24 @@
 
 namespace pf_ros {
 
+/// Why a scan did not reach the filter.
+enum class ScanError {
+  kNone,             // it did (report says what the filter made of it)
+  kNoMap,            // no map has arrived yet
+  kEmptyLaserFrame,  // the scan's frame_id is empty: nothing to place the laser by
+  kNoLaserMounting,  // tf has no base -> laser transform (the laser's mounting)
+  kNoOdometry,       // tf has no odom -> base transform at the scan's stamp
+};
+
+/// A few words for `error`, e.g. "no odometry at the scan's stamp".
+const char* toString(ScanError error);
+
 /// What processing one scan produced.
 struct ScanResult {
-  pf::UpdateReport report;  // report.updated: the filter ran
-  std::string error;        // non-empty: the scan was not used, and why (for the log)
-  std::string warning;      // non-empty: the scan was used, but something in it is off
+  pf::UpdateReport report;             // report.updated: the filter ran
+  ScanError error = ScanError::kNone;  // not kNone: the scan was not used, and why
+  std::string error_detail;            // the specifics, for the log: which transform is missing
+  std::string warning;                 // non-empty: the scan was used, but something in it is off
   // The odometry pose (odom -> base) at the scan's stamp, when it was found.
   std::optional<pf::Pose2> odom;
 };
@@ -85,6 +98,9 @@ class ScanLocalizer {
   pf::ParticleFilter filter_;
   bool had_map_ = false;
 };
+
+/// The log line for a scan that was not used: the error and its detail.
+std::string errorMessage(const ScanResult& result);
 
 /// What is inconsistent in a scan message without making it unusable:
 /// intensities of another length than the ranges (they are not used), or an

@@ -1,0 +1,51 @@
+// The filter's verdict over time: the confidence of each update
+// (assessConfidence), held back after a jump of the estimate until it is
+// confirmed (holdAfterJump), and demoted from "localized" while the scans
+// have fitted worse than usual for longer than recovery's patience: a cloud
+// settled on a wrong place that fits most beams looks just like a right one,
+// and says so while recovery waits. See docs/design.md, "Recovery waits while
+// localized".
+#pragma once
+
+#include <Eigen/Core>
+#include <optional>
+
+#include "pf_localization/core/confidence.h"
+#include "pf_localization/core/particle_set.h"
+#include "pf_localization/core/pose2.h"
+#include "pf_localization/core/pose_estimator.h"
+
+namespace pf {
+
+class ConfidenceTracker {
+ public:
+  /// After an initialisation: "uncertain" with `covariance` (the new
+  /// cloud's), no jump pending.
+  void restart(const Eigen::Matrix3d& covariance);
+
+  /// The verdict on this update's weighted cloud, `hit_fraction` of the
+  /// scan's beams hitting an obstacle from `estimate`.
+  void assess(const ParticleSet& particles, const PoseEstimate& estimate, double hit_fraction,
+              const ConfidenceParams& params);
+  /// The history check (holdAfterJump) against `predicted`, the previous
+  /// estimate moved by the odometry since; nothing without one.
+  void holdAfterJump(const std::optional<Pose2>& predicted, const Pose2& estimate,
+                     const ConfidenceParams& params);
+  /// Widens the published covariance to cover `covariance` too (a scan fit's).
+  void cover(const Eigen::Matrix3d& covariance);
+  /// "localized" becomes "uncertain" after more than `patience` consecutive
+  /// updates with a fit below recovery's trigger.
+  void demoteAfterLowFit(int low_fit_updates, int patience);
+
+  const Confidence& confidence() const { return confidence_; }
+  /// This update's verdict from its scan alone, before holdAfterJump and the
+  /// low-fit demotion: what tempering and recovery follow.
+  LocalizationState fitState() const { return fit_state_; }
+
+ private:
+  Confidence confidence_;
+  LocalizationState fit_state_ = LocalizationState::kLost;
+  int settle_left_ = 0;  // updates until a jumped estimate may be localized
+};
+
+}  // namespace pf

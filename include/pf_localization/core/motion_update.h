@@ -1,0 +1,41 @@
+// The motion step of the filter update: the odometry motion model
+// (odometry_motion_model.h: Thrun et al., "Probabilistic Robotics", table
+// 5.6, with odometry faults), run with the fault share that
+// OdometryFaultTracker adapts from scan to scan.
+#pragma once
+
+#include "pf_localization/core/odometry_fault_tracker.h"
+#include "pf_localization/core/odometry_motion_model.h"
+#include "pf_localization/core/particle_set.h"
+#include "pf_localization/core/random.h"
+
+namespace pf {
+
+class MotionUpdate {
+ public:
+  /// Throws std::invalid_argument as OdometryMotionModel does.
+  explicit MotionUpdate(const OdometryMotionParams& params) : model_(params) {}
+
+  /// Replaces the model (new parameters); the fault share is kept within
+  /// the new bounds.
+  void setModel(const OdometryMotionModel& model) {
+    model_ = model;
+    faults_.clampTo(model_.params());
+  }
+
+  /// Moves every particle by the noisy odometry motion from `from` to `to`,
+  /// the tracker's share of them assuming a fault (and flagged so).
+  void apply(const Pose2& from, const Pose2& to, ParticleSet* particles, Random* random) {
+    model_.apply(from, to, faults_.fraction(), particles, random, faults_.flags());
+  }
+
+  const OdometryMotionParams& params() const { return model_.params(); }
+  OdometryFaultTracker& faults() { return faults_; }
+  const OdometryFaultTracker& faults() const { return faults_; }
+
+ private:
+  OdometryMotionModel model_;
+  OdometryFaultTracker faults_;
+};
+
+}  // namespace pf

@@ -1,0 +1,62 @@
+// The share of particles that assume an odometry fault in the next motion
+// update (OdometryMotionParams::fault_fraction: a reversal or a stall instead
+// of the odometry's step), adapted to the evidence: the share of the
+// posterior weight the faulty particles won on the last scan, clamped to
+// [fault_fraction, fault_fraction_max].
+//
+// Odometry faults come in runs (a robot reverses for a while, wheels spin on
+// a threshold for a while), so the weight the faulty particles just won is
+// the best guess of how many the next step needs: it rises while a fault
+// lasts and falls back to the floor as soon as the odometry is right again.
+// A mixture proposal in the sense of Thrun, Fox, Burgard & Dellaert, "Robust
+// Monte Carlo localization for mobile robots" (AIJ 128, 2001). See
+// docs/design.md, "Odometry faults are observed, not assumed".
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "pf_localization/core/odometry_motion_model.h"
+
+namespace pf {
+
+class OdometryFaultTracker {
+ public:
+  /// Back to the floor, fault_fraction (after an initialisation).
+  void restart(const OdometryMotionParams& params) { fraction_ = params.fault_fraction; }
+  /// Keeps the share within new bounds (the parameters changed).
+  void clampTo(const OdometryMotionParams& params);
+
+  /// The share for the next motion update.
+  double fraction() const { return fraction_; }
+  /// Whether the faulty particles win (fault_suspect_fraction): the odometry
+  /// itself is then in doubt.
+  bool suspect(const OdometryMotionParams& params) const {
+    return fraction_ >= params.fault_suspect_fraction;
+  }
+  /// Whether a step of `step` m lets a scan tell faulty particles from the
+  /// others. A fault changes the translation by twice its length (reversed)
+  /// or by it (stalled): on a step shorter than half fault_margin even a
+  /// reversal stays within the stalled particles' own spread, and what
+  /// weight the faulty ones win by chance must not grow their share.
+  static bool observable(double step, const OdometryMotionParams& params) {
+    return 2.0 * step >= params.fault_margin;
+  }
+
+  /// Which particles took a fault in the last motion update (1) and which
+  /// the odometry's step (0), written by OdometryMotionModel::apply.
+  std::vector<uint8_t>* flags() { return &faulty_; }
+  /// The new share: the posterior weight of the flagged particles
+  /// (`weights` normalised, in the order of the flags), clamped.
+  void adapt(const std::vector<double>& weights, const OdometryMotionParams& params);
+
+  /// Prefaults room for `n` particles' flags.
+  void reserve(std::size_t n);
+
+ private:
+  double fraction_ = 0.0;
+  std::vector<uint8_t> faulty_;
+};
+
+}  // namespace pf

@@ -1,0 +1,133 @@
+// Recovery from a lost or wrong track: after each scan, how many random
+// particles the resampling injects and whether it spreads the survivors,
+// from the fit of the scans and the confidence state. Each scheme is a
+// RecoveryStrategy; Recovery combines them (the largest injection wins) and
+// resamples by the plan.
+//
+// - AugmentedMclInjection: Thrun, Burgard & Fox, "Probabilistic Robotics"
+//   (2005), table 8.3: a short-term average of the mean beam likelihood below
+//   trigger_ratio times the long-term one injects that dip's share; unless
+//   lost, only after the fit stayed low for more than `patience` updates
+//   (patience_localized while localized).
+// - LostShareInjection: a compact cloud that is lost searches at once with
+//   lost_share of max_particles.
+// - ExpansionResetting: Ueda et al., "Expansion resetting for recovery from
+//   fatal error in Monte Carlo localization" (IROS 2004): a single scan
+//   fitting below expansion_ratio times the long-term average spreads the
+//   survivors of the resampling.
+// Injected particles weigh kidnap_prior together (a mixture proposal: Thrun,
+// Fox, Burgard & Dellaert, AIJ 128, 2001). See docs/design.md, "Recovery
+// waits while localized".
+#pragma once
+
+#include <cstddef>
+
+#include "pf_localization/core/confidence.h"
+#include "pf_localization/core/occupancy_grid.h"
+#include "pf_localization/core/particle_filter_params.h"
+#include "pf_localization/core/particle_set.h"
+#include "pf_localization/core/random.h"
+
+namespace pf {
+
+/// What the strategies see after a scan was weighed and judged.
+struct RecoveryContext {
+  double mean_beam_likelihood = 0.0;                   // this scan's (SensorUpdate::weigh)
+  double slow_before = 0.0;                            // the long-term average before this scan
+  double slow = 0.0;                                   // the long-term average, this scan included
+  double fast = 0.0;                                   // the short-term average, this scan included
+  LocalizationState state = LocalizationState::kLost;  // this scan's verdict
+  std::size_t particles = 0;                           // in the cloud now
+  std::size_t max_particles = 0;                       // the budget (kld.max_particles)
+  bool has_free_space = false;  // the map has free cells to draw random particles from
+};
+
+/// What the resampling is to do.
+struct RecoveryPlan {
+  double inject_probability = 0.0;  // share of max_particles drawn at random
+  bool spread = false;              // spread the survivors (expansion resetting)
+};
+
+class RecoveryStrategy {
+ public:
+  virtual ~RecoveryStrategy() = default;
+  /// Adds this scheme's say to `plan` (raising inject_probability, setting
+  /// spread). Called once per update.
+  virtual void contribute(const RecoveryContext& context, const RecoveryParams& params,
+                          RecoveryPlan* plan) = 0;
+  /// Forgets the history (after an initialisation).
+  virtual void restart() {}
+};
+
+class AugmentedMclInjection final : public RecoveryStrategy {
+ public:
+  void contribute(const RecoveryContext& context, const RecoveryParams& params,
+                  RecoveryPlan* plan) override;
+  void restart() override { low_fit_updates_ = 0; }
+  /// Consecutive updates so far with the short-term average below the trigger.
+  int lowFitUpdates() const { return low_fit_updates_; }
+
+ private:
+  int low_fit_updates_ = 0;
+};
+
+class LostShareInjection final : public RecoveryStrategy {
+ public:
+  void contribute(const RecoveryContext& context, const RecoveryParams& params,
+                  RecoveryPlan* plan) override;
+};
+
+class ExpansionResetting final : public RecoveryStrategy {
+ public:
+  void contribute(const RecoveryContext& context, const RecoveryParams& params,
+                  RecoveryPlan* plan) override;
+  /// Spreads the first `n` particles by expansion_std_xy / expansion_std_yaw
+  /// (x, y, yaw from `random`, particle by particle).
+  static void spread(const RecoveryParams& params, std::size_t n, Random* random,
+                     ParticleSet* particles);
+};
+
+/// What Recovery::resample did.
+struct ResampleOutcome {
+  bool resampled = false;
+  std::size_t injected = 0;  // random particles added
+  bool expanded = false;     // the survivors were spread
+};
+
+class Recovery {
+ public:
+  /// Forgets the averages and the strategies' history (after an initialisation).
+  void restart();
+
+  /// Takes this scan's mean beam likelihood into the averages (alpha_slow,
+  /// alpha_fast; alpha_slow 0 keeps them at 0, which disables recovery).
+  void observe(double mean_beam_likelihood, const RecoveryParams& params);
+  /// The plan for this update, from the last observe() and this scan's
+  /// verdict `state`, for a cloud of `particles` with the budget
+  /// `max_particles`.
+  RecoveryPlan plan(LocalizationState state, std::size_t particles, std::size_t max_particles,
+                    bool has_free_space, const RecoveryParams& params);
+  /// Consecutive updates with a fit below the trigger (AugmentedMclInjection).
+  int lowFitUpdates() const { return injection_.lowFitUpdates(); }
+
+  /// Resamples `particles` by `plan` when their effective sample size `ess`
+  /// is below resample_ess_fraction of their count or the plan asks for
+  /// anything: KLD-sampling (Fox 2003) picks the count, systematic
+  /// resampling the survivors, and the injected share comes from
+  /// randomFreePose on `grid`. Draws from `random`: the injected count, the
+  /// resampling, the spread, the injected poses.
+  ResampleOutcome resample(const RecoveryPlan& plan, double ess, const ParticleFilterParams& params,
+                           const OccupancyGrid& grid, Random* random, ParticleSet* particles);
+
+  /// Prefaults the resampler's output for `n` particles.
+  void reserve(std::size_t n);
+
+ private:
+  RecoveryContext context_;  // of the last observe()
+  AugmentedMclInjection injection_;
+  LostShareInjection lost_share_;
+  ExpansionResetting expansion_;
+  ParticleSet spare_;  // the resampler's output, swapped with the cloud
+};
+
+}  // namespace pf

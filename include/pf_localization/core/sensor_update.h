@@ -1,0 +1,52 @@
+// The sensor step of the filter update: the sensor model on the map
+// (sensor_model.h) and the weighing of the particles by a scan, MCL's
+// importance weights (Thrun et al., "Probabilistic Robotics", table 8.2),
+// tempered by applyLikelihood (weighting.h). Keeps the scratch storage, so
+// that an update allocates nothing.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include "pf_localization/core/particle_set.h"
+#include "pf_localization/core/sensor_model.h"
+#include "pf_localization/core/weighting.h"
+
+namespace pf {
+
+/// What weighing one scan gave.
+struct Weighing {
+  double tempering = 1.0;  // the exponent applied to the scan's likelihood (1: none)
+  int beams_skipped = 0;   // of the scan's beams, left out by beam skipping
+  // How well the cloud explains the scan: the per-beam geometric mean
+  // likelihood, averaged with the posterior weights.
+  double mean_beam_likelihood = 0.0;
+};
+
+class SensorUpdate {
+ public:
+  void setModel(std::unique_ptr<SensorModel> model) { model_ = std::move(model); }
+  bool hasModel() const { return static_cast<bool>(model_); }
+  /// Null without a model.
+  const SensorModel* get() const { return model_.get(); }
+  /// Precondition: hasModel().
+  const SensorModel& model() const { return *model_; }
+
+  /// Multiplies the weights of `particles` by the likelihood of `scan`,
+  /// tempered so that at least `min_ess_fraction` of the effective sample
+  /// size is left, and normalises them. `likelihood_exponent` is the sensor
+  /// model's: the mean beam likelihood undoes it. Precondition: hasModel().
+  Weighing weigh(const PreparedScan& scan, double min_ess_fraction, double likelihood_exponent,
+                 ParticleSet* particles);
+
+  /// Prefaults the scratch for `n` particles.
+  void reserve(std::size_t n);
+
+ private:
+  std::unique_ptr<SensorModel> model_;
+  std::vector<double> log_likelihood_;
+  WeightingScratch scratch_;
+};
+
+}  // namespace pf

@@ -1,0 +1,41 @@
+#include "pf_localization/core/confidence_tracker.h"
+
+#include <string>
+
+#include "pf_localization/core/scan_refiner.h"
+
+namespace pf {
+
+void ConfidenceTracker::restart(const Eigen::Matrix3d& covariance) {
+  confidence_ = Confidence();
+  confidence_.state = LocalizationState::kUncertain;
+  fit_state_ = confidence_.state;
+  confidence_.reason = "no scan since the initialisation";
+  confidence_.covariance = covariance;
+  settle_left_ = 0;
+}
+
+void ConfidenceTracker::assess(const ParticleSet& particles, const PoseEstimate& estimate,
+                               double hit_fraction, const ConfidenceParams& params) {
+  confidence_ = assessConfidence(particles, estimate, hit_fraction, params);
+  fit_state_ = confidence_.state;
+}
+
+void ConfidenceTracker::holdAfterJump(const std::optional<Pose2>& predicted, const Pose2& estimate,
+                                      const ConfidenceParams& params) {
+  if (predicted) pf::holdAfterJump(*predicted, estimate, params, &settle_left_, &confidence_);
+}
+
+void ConfidenceTracker::cover(const Eigen::Matrix3d& covariance) {
+  confidence_.covariance = coveringCovariance(covariance, confidence_.covariance);
+}
+
+void ConfidenceTracker::demoteAfterLowFit(int low_fit_updates, int patience) {
+  if (confidence_.state == LocalizationState::kLocalized && low_fit_updates > patience) {
+    confidence_.state = LocalizationState::kUncertain;
+    confidence_.reason = "the scans have fitted worse than usual for " +
+                         std::to_string(low_fit_updates) + " updates";
+  }
+}
+
+}  // namespace pf

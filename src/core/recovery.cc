@@ -1,0 +1,147 @@
+#include "pf_localization/core/recovery.h"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "pf_localization/core/prefault.h"
+#include "pf_localization/core/random_free_pose.h"
+#include "pf_localization/core/resampler.h"
+
+namespace pf {
+
+void AugmentedMclInjection::contribute(const RecoveryContext& context, const RecoveryParams& params,
+                                       RecoveryPlan* plan) {
+  // Dips of a few tenths come and go in normal tracking (a person in front
+  // of the laser, a doorway); only a fit below trigger_ratio times the usual
+  // one injects anything.
+  const double usual = params.trigger_ratio * context.slow;
+  const double dip = usual > 0.0 ? std::max(0.0, 1.0 - context.fast / usual) : 0.0;
+  low_fit_updates_ = dip > 0.0 ? low_fit_updates_ + 1 : 0;
+  // The fit sags for a few scans wherever the map is poor, and random
+  // guesses then only add rivals; a robot really lost is soon "lost", or
+  // stays badly fitted for longer.
+  const int patience =
+      context.state == LocalizationState::kLocalized ? params.patience_localized : params.patience;
+  const bool patient = context.state != LocalizationState::kLost && low_fit_updates_ <= patience;
+  if (context.has_free_space && !patient) {
+    plan->inject_probability = std::max(plan->inject_probability, dip);
+  }
+}
+
+void LostShareInjection::contribute(const RecoveryContext& context, const RecoveryParams& params,
+                                    RecoveryPlan* plan) {
+  // Not while the cloud already holds more than (1 - lost_share) of the
+  // budget: it is searching (a global localization), and halving it would
+  // only thin the search.
+  const bool compact_and_lost =
+      context.state == LocalizationState::kLost &&
+      static_cast<double>(context.particles) <=
+          (1.0 - params.lost_share) * static_cast<double>(context.max_particles);
+  if (context.has_free_space && compact_and_lost) {
+    plan->inject_probability = std::max(plan->inject_probability, params.lost_share);
+  }
+}
+
+void ExpansionResetting::contribute(const RecoveryContext& context, const RecoveryParams& params,
+                                    RecoveryPlan* plan) {
+  // One scan fitting far worse than usual: the robot has probably slipped or
+  // been pushed a little, and spreading the survivors finds it nearby long
+  // before random particles would.
+  if (params.expansion_ratio > 0.0 && context.slow_before > 0.0 &&
+      context.mean_beam_likelihood < params.expansion_ratio * context.slow_before) {
+    plan->spread = true;
+  }
+}
+
+void ExpansionResetting::spread(const RecoveryParams& params, std::size_t n, Random* random,
+                                ParticleSet* particles) {
+  for (std::size_t i = 0; i < n; ++i) {
+    particles->x[i] += random->gaussian(params.expansion_std_xy);
+    particles->y[i] += random->gaussian(params.expansion_std_xy);
+    particles->yaw[i] =
+        normalizeAngle(particles->yaw[i] + random->gaussian(params.expansion_std_yaw));
+  }
+}
+
+void Recovery::restart() {
+  context_.slow = context_.fast = 0.0;
+  injection_.restart();
+  lost_share_.restart();
+  expansion_.restart();
+}
+
+void Recovery::observe(double mean_beam_likelihood, const RecoveryParams& params) {
+  context_.mean_beam_likelihood = mean_beam_likelihood;
+  context_.slow_before = context_.slow;
+  if (params.alpha_slow > 0.0) {
+    if (context_.slow == 0.0) {
+      context_.slow = context_.fast = mean_beam_likelihood;
+    } else {
+      context_.slow += params.alpha_slow * (mean_beam_likelihood - context_.slow);
+      context_.fast += params.alpha_fast * (mean_beam_likelihood - context_.fast);
+    }
+  }
+}
+
+RecoveryPlan Recovery::plan(LocalizationState state, std::size_t particles,
+                            std::size_t max_particles, bool has_free_space,
+                            const RecoveryParams& params) {
+  context_.state = state;
+  context_.particles = particles;
+  context_.max_particles = max_particles;
+  context_.has_free_space = has_free_space;
+  RecoveryPlan plan;
+  for (RecoveryStrategy* strategy :
+       {static_cast<RecoveryStrategy*>(&injection_), static_cast<RecoveryStrategy*>(&lost_share_),
+        static_cast<RecoveryStrategy*>(&expansion_)}) {
+    strategy->contribute(context_, params, &plan);
+  }
+  return plan;
+}
+
+ResampleOutcome Recovery::resample(const RecoveryPlan& plan, double ess,
+                                   const ParticleFilterParams& params, const OccupancyGrid& grid,
+                                   Random* random, ParticleSet* particles) {
+  ResampleOutcome out;
+  const std::size_t n = particles->size();
+  const double p = plan.inject_probability;
+  if (ess >= params.resample_ess_fraction * n && p < 0.01 && !plan.spread) return out;
+
+  const std::size_t target = kldParticleCount(*particles, params.kld);
+  // Random particles are spread over the whole map, so they are counted
+  // against the largest cloud, not the converged one: a lost filter must
+  // search with as many particles as a global localization.
+  const std::size_t max = static_cast<std::size_t>(params.kld.max_particles);
+  const auto injected =
+      std::min(max, static_cast<std::size_t>(std::floor(p * max + random->uniform())));
+  const std::size_t kept =
+      std::min(max - injected, static_cast<std::size_t>(std::ceil((1.0 - p) * target)));
+  systematicResample(*particles, kept, random, &spare_);
+  std::swap(*particles, spare_);
+  if (plan.spread) ExpansionResetting::spread(params.recovery, kept, random, particles);
+  particles->resize(kept + injected);
+  for (std::size_t i = kept; i < kept + injected; ++i) {
+    particles->setPose(i, randomFreePose(grid, random));
+  }
+  particles->setUniformWeights();
+  if (injected > 0 && kept > 0) {
+    const double prior = params.recovery.kidnap_prior;
+    const double w_kept = (1.0 - prior) / static_cast<double>(kept);
+    const double w_injected = prior / static_cast<double>(injected);
+    std::fill(particles->weight.begin(), particles->weight.begin() + kept, w_kept);
+    std::fill(particles->weight.begin() + kept, particles->weight.end(), w_injected);
+  }
+  out.resampled = true;
+  out.injected = injected;
+  out.expanded = plan.spread;
+  return out;
+}
+
+void Recovery::reserve(std::size_t n) {
+  for (std::vector<double>* v : {&spare_.x, &spare_.y, &spare_.yaw, &spare_.weight}) {
+    prefault(v, n);
+  }
+}
+
+}  // namespace pf

@@ -1,0 +1,32 @@
+#include "pf_localization/core/sensor_update.h"
+
+#include <algorithm>
+
+#include "pf_localization/core/prefault.h"
+
+namespace pf {
+
+Weighing SensorUpdate::weigh(const PreparedScan& scan, double min_ess_fraction,
+                             double likelihood_exponent, ParticleSet* particles) {
+  Weighing w;
+  const std::size_t beams_counted = model_->logLikelihoods(scan, *particles, &log_likelihood_);
+  w.tempering = applyLikelihood(log_likelihood_, min_ess_fraction, &particles->weight, &scratch_);
+  w.beams_skipped = static_cast<int>(scan.size() - beams_counted);
+  // The per-beam geometric mean is independent of the beam count, so
+  // comparable across scans and robots. Weighted with the posterior, not the
+  // prior, so that a few particles that found the robot count for what they
+  // are worth, and a cloud salted with random particles is not judged by
+  // them. Over the beams the model counted: beam skipping may leave some out.
+  const double beams =
+      static_cast<double>(std::max<std::size_t>(beams_counted, 1)) * likelihood_exponent;
+  w.mean_beam_likelihood = meanBeamLikelihood(particles->weight, log_likelihood_, beams);
+  return w;
+}
+
+void SensorUpdate::reserve(std::size_t n) {
+  for (std::vector<double>* v : {&scratch_.log_prior, &scratch_.log_posterior, &log_likelihood_}) {
+    prefault(v, n);
+  }
+}
+
+}  // namespace pf

@@ -1,0 +1,90 @@
+#include "pf_localization/core/update_gate.h"
+
+#include <cmath>
+#include <utility>
+
+namespace pf {
+namespace {
+
+GateDecision skipped(SkipReason reason, std::string detail = "") {
+  GateDecision d;
+  d.skip = reason;
+  d.detail = std::move(detail);
+  return d;
+}
+
+}  // namespace
+
+GateDecision UpdateGate::decide(const Pose2& odom, const LaserScan& scan, const SensorModel* model,
+                                bool initialized, const Pose2& estimate, bool odometry_suspect,
+                                const ParticleFilterParams& params) {
+  if (!model) return skipped(SkipReason::kNoMap);
+  if (!initialized) return skipped(SkipReason::kNotInitialized);
+  if (!odom.isFinite()) return skipped(SkipReason::kOdometryNotFinite);
+  if (auto error = validateScan(scan)) return skipped(SkipReason::kBadScan, std::move(*error));
+
+  GateDecision d;
+  const bool first = first_pending_ || !odom_at_update_;
+  if (!first) {
+    const Pose2 delta = between(*odom_at_update_, odom);
+    d.step = std::hypot(delta.x, delta.y);
+    if (!(d.step <= params.odom_jump_limit)) {
+      // Wheels do not carry a robot this far between two scans: moving the
+      // particles by it would throw them away.
+      odom_at_update_ = odom;
+      const double step = d.step;
+      d = skipped(SkipReason::kOdometryJumped,
+                  std::to_string(d.step) + " m since the last update (odom_jump_limit " +
+                      std::to_string(params.odom_jump_limit) +
+                      " m): treated as an odometry fault, particles not moved");
+      d.step = step;
+      return d;
+    }
+    // While the odometry is suspect, the odometry between updates is what is
+    // wrong: every scan updates the filter then, instead of the published
+    // pose following the wrong odometry until the robot has "moved"
+    // update_min_d.
+    if (!force_ && !odometry_suspect && d.step < params.update_min_d &&
+        std::fabs(delta.yaw) < params.update_min_a) {
+      d.scan = fitDropped(*model, scan, estimate, delta, params);
+      if (!d.scan) return skipped(SkipReason::kNotMoved);
+      d.fit_dropped = true;
+    }
+  }
+  if (!d.scan) d.scan = model->prepare(scan);
+  if (d.scan->size() == 0) {
+    // Without evidence the cloud would only be moved; the odometry reference
+    // stays, so the motion is applied once a usable scan comes.
+    d.skip = SkipReason::kNoValidBeam;
+    d.detail = std::to_string(d.scan->dropped) + " of " + std::to_string(scan.ranges.size()) +
+               " beams invalid";
+    d.fit_dropped = false;
+    return d;
+  }
+  if (!first) d.from = odom_at_update_;
+  odom_at_update_ = odom;
+  first_pending_ = false;
+  force_ = false;
+  return d;
+}
+
+void UpdateGate::recordFit(const SensorModel& model, const PreparedScan& scan,
+                           const Pose2& estimate, const ParticleFilterParams& params) {
+  fit_at_update_ = params.update_fit_drop > 0.0
+                       ? model.hitFraction(scan, estimate, params.update_fit_distance)
+                       : 0.0;
+}
+
+std::optional<PreparedScan> UpdateGate::fitDropped(const SensorModel& model, const LaserScan& scan,
+                                                   const Pose2& estimate, const Pose2& since_update,
+                                                   const ParticleFilterParams& params) const {
+  if (!(params.update_fit_drop > 0.0)) return std::nullopt;
+  PreparedScan prepared = model.prepare(scan);
+  if (prepared.size() == 0) return std::nullopt;
+  const Pose2 predicted = compose(estimate, since_update);
+  const double fit = model.hitFraction(prepared, predicted, params.update_fit_distance);
+  if (fit >= fit_at_update_ - params.update_fit_drop) return std::nullopt;
+  return prepared;
+}
+
+}  // namespace pf

@@ -1,0 +1,72 @@
+// ConfidenceTracker: the verdict after an initialisation, held after a jump,
+// and demoted while the scans fit worse than usual for too long.
+#include "pf_localization/core/confidence_tracker.h"
+
+#include <gtest/gtest.h>
+
+namespace pf {
+namespace {
+
+// A tight cloud of 200 particles around `at`: one cluster, a few cm wide.
+ParticleSet tightCloud(const Pose2& at) {
+  ParticleSet s;
+  s.resize(200);
+  for (std::size_t i = 0; i < s.size(); ++i) {
+    const double d = 0.01 * (static_cast<double>(i % 5) - 2.0);
+    s.setPose(i, {at.x + d, at.y - d, at.yaw + d});
+  }
+  s.setUniformWeights();
+  return s;
+}
+
+class ConfidenceTrackerTest : public ::testing::Test {
+ protected:
+  void assessLocalized() {
+    const ParticleSet cloud = tightCloud(at_);
+    tracker_.assess(cloud, estimatePose(cloud, ClusterParams()), 0.95, params_);
+    ASSERT_EQ(LocalizationState::kLocalized, tracker_.confidence().state)
+        << tracker_.confidence().reason;
+  }
+
+  const Pose2 at_{2.0, 1.0, 0.3};
+  ConfidenceParams params_;
+  ConfidenceTracker tracker_;
+};
+
+TEST_F(ConfidenceTrackerTest, AfterAnInitialisationItIsUncertain) {
+  const Eigen::Matrix3d cov = Eigen::Vector3d(0.1, 0.2, 0.05).asDiagonal();
+  tracker_.restart(cov);
+  EXPECT_EQ(LocalizationState::kUncertain, tracker_.confidence().state);
+  EXPECT_EQ(LocalizationState::kUncertain, tracker_.fitState());
+  EXPECT_EQ(cov, tracker_.confidence().covariance);
+}
+
+TEST_F(ConfidenceTrackerTest, AJumpHoldsThePublishedVerdictButNotTheFitState) {
+  assessLocalized();
+  tracker_.holdAfterJump(std::nullopt, at_, params_);  // no previous estimate
+  EXPECT_EQ(LocalizationState::kLocalized, tracker_.confidence().state);
+  tracker_.holdAfterJump(compose(at_, {2.0, 0.0, 0.0}), at_, params_);
+  EXPECT_EQ(LocalizationState::kUncertain, tracker_.confidence().state);
+  EXPECT_EQ(LocalizationState::kLocalized, tracker_.fitState());
+}
+
+TEST_F(ConfidenceTrackerTest, AFitBelowTheTriggerForLongerThanPatienceDemotes) {
+  assessLocalized();
+  tracker_.demoteAfterLowFit(5, 5);
+  EXPECT_EQ(LocalizationState::kLocalized, tracker_.confidence().state);
+  tracker_.demoteAfterLowFit(6, 5);
+  EXPECT_EQ(LocalizationState::kUncertain, tracker_.confidence().state);
+  EXPECT_NE(std::string::npos, tracker_.confidence().reason.find("6 updates"));
+}
+
+TEST_F(ConfidenceTrackerTest, CoverWidensThePublishedCovariance) {
+  assessLocalized();
+  const Eigen::Matrix3d wide = Eigen::Vector3d(1.0, 1.0, 1.0).asDiagonal();
+  tracker_.cover(wide);
+  const Eigen::Matrix3d c = tracker_.confidence().covariance;
+  EXPECT_GE(c(0, 0), 1.0 - 1e-9);
+  EXPECT_GE(c(2, 2), 1.0 - 1e-9);
+}
+
+}  // namespace
+}  // namespace pf

@@ -1,0 +1,99 @@
+// EstimateRefinement: the scan fit of the estimate at an update and between
+// updates, and the map -> odom it gives.
+#include "pf_localization/core/estimate_refinement.h"
+
+#include <gtest/gtest.h>
+
+#include "expect_pose.h"
+#include "pf_localization/core/likelihood_field_model.h"
+#include "small_world.h"
+
+namespace pf {
+namespace {
+
+using small_world::castScan;
+using small_world::kTruth;
+
+class EstimateRefinementTest : public ::testing::Test {
+ protected:
+  EstimateRefinementTest()
+      : grid_(small_world::room()), model_(grid_, LikelihoodFieldModelParams()) {
+    params_.refine_estimate = true;
+    estimate_.pose = {kTruth.x + 0.04, kTruth.y - 0.03, kTruth.yaw + 0.02};
+    estimate_.covariance = Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, 0.03 * 0.03).asDiagonal();
+  }
+
+  OccupancyGrid grid_;
+  LikelihoodFieldModel model_;
+  ParticleFilterParams params_;
+  PoseEstimate estimate_;
+  EstimateRefinement refinement_;
+  const Pose2 odom_{3.0, -1.0, 0.5};
+};
+
+TEST_F(EstimateRefinementTest, AtAnUpdateTheFitMovesTheEstimateOntoTheScan) {
+  const PoseEstimate cloud = estimate_;
+  const ScanRefinement r = refinement_.atUpdate(model_, castScan(grid_, kTruth), odom_,
+                                                LocalizationState::kLocalized, params_, &estimate_);
+  ASSERT_TRUE(r.accepted) << r.rejection_detail;
+  EXPECT_LT(std::hypot(estimate_.pose.x - kTruth.x, estimate_.pose.y - kTruth.y), 0.01);
+  EXPECT_GE(estimate_.covariance(0, 0), r.covariance(0, 0) - 1e-12);
+  EXPECT_GE(estimate_.covariance(0, 0), cloud.covariance(0, 0) - 1e-12);
+  expectPoseNear(compose(r.pose, inverse(odom_)), refinement_.mapToOdom(cloud.pose, odom_), 1e-12);
+}
+
+TEST_F(EstimateRefinementTest, OffOrLostKeepsTheCloudsEstimate) {
+  const Pose2 before = estimate_.pose;
+  params_.refine_estimate = false;
+  ScanRefinement r = refinement_.atUpdate(model_, castScan(grid_, kTruth), odom_,
+                                          LocalizationState::kLocalized, params_, &estimate_);
+  EXPECT_EQ(ScanRejection::kRefinementOff, r.rejection);
+  params_.refine_estimate = true;
+  r = refinement_.atUpdate(model_, castScan(grid_, kTruth), odom_, LocalizationState::kLost,
+                           params_, &estimate_);
+  EXPECT_EQ(ScanRejection::kFilterLost, r.rejection);
+  expectPoseNear(before, estimate_.pose, 0.0);
+  expectPoseNear(before, r.pose, 0.0);
+  expectPoseNear(compose(before, inverse(odom_)), refinement_.mapToOdom(before, odom_), 1e-12);
+}
+
+TEST_F(EstimateRefinementTest, BetweenUpdatesAFitFollowsTheMapAndStandingStillKeepsIt) {
+  ASSERT_TRUE(refinement_
+                  .atUpdate(model_, castScan(grid_, kTruth), odom_, LocalizationState::kLocalized,
+                            params_, &estimate_)
+                  .accepted);
+  // The robot went 5 cm, the odometry says 6 cm.
+  const Pose2 truth = compose(kTruth, {0.05, 0.0, 0.0});
+  const Pose2 odom = compose(odom_, {0.06, 0.0, 0.0});
+  ScanRefinement r = refinement_.betweenUpdates(model_, castScan(grid_, truth), odom, odom_,
+                                                estimate_, LocalizationState::kLocalized, params_);
+  ASSERT_TRUE(r.accepted) << r.rejection_detail;
+  const Pose2 placed = compose(refinement_.mapToOdom(estimate_.pose, odom_), odom);
+  EXPECT_LT(std::hypot(placed.x - truth.x, placed.y - truth.y), 0.01);
+  // Standing still: the last fit stands.
+  r = refinement_.betweenUpdates(model_, castScan(grid_, truth), odom, odom_, estimate_,
+                                 LocalizationState::kLocalized, params_);
+  EXPECT_EQ(ScanRejection::kNotMovedSinceFit, r.rejection);
+  expectPoseNear(placed, r.pose, 1e-12);
+  // A lost filter is not fitted between updates either.
+  EXPECT_EQ(ScanRejection::kNone, refinement_
+                                      .betweenUpdates(model_, castScan(grid_, truth), odom, odom_,
+                                                      estimate_, LocalizationState::kLost, params_)
+                                      .rejection);
+}
+
+TEST_F(EstimateRefinementTest, AFitOfAnotherUpdateIsStale) {
+  ASSERT_TRUE(refinement_
+                  .atUpdate(model_, castScan(grid_, kTruth), odom_, LocalizationState::kLocalized,
+                            params_, &estimate_)
+                  .accepted);
+  const Pose2 other = compose(odom_, {10.0, 0.0, 0.0});  // an odometry jump
+  expectPoseNear(compose(estimate_.pose, inverse(other)),
+                 refinement_.mapToOdom(estimate_.pose, other), 1e-12);
+  refinement_.reset();
+  expectPoseNear(compose(estimate_.pose, inverse(odom_)),
+                 refinement_.mapToOdom(estimate_.pose, odom_), 1e-12);
+}
+
+}  // namespace
+}  // namespace pf

@@ -1,0 +1,162 @@
+// UpdateGate: which scans run a filter update, and the reason of each skip.
+#include "pf_localization/core/update_gate.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "pf_localization/core/likelihood_field_model.h"
+#include "small_world.h"
+
+namespace pf {
+namespace {
+
+using small_world::castScan;
+using small_world::kTruth;
+
+class UpdateGateTest : public ::testing::Test {
+ protected:
+  UpdateGateTest() : grid_(small_world::room()), model_(grid_, LikelihoodFieldModelParams()) {
+    params_.update_fit_drop = 0.0;  // the thresholds alone, unless a test says otherwise
+  }
+
+  GateDecision decide(const Pose2& odom, const Pose2& robot, bool suspect = false) {
+    return gate_.decide(odom, castScan(grid_, robot), &model_, true, robot, suspect, params_);
+  }
+
+  OccupancyGrid grid_;
+  LikelihoodFieldModel model_;
+  ParticleFilterParams params_;  // update_min_d 0.2 m, update_min_a pi/6, odom_jump_limit 5 m
+  UpdateGate gate_;
+};
+
+TEST_F(UpdateGateTest, InputChecksComeFirstAndSayWhich) {
+  const LaserScan scan = castScan(grid_, kTruth);
+  EXPECT_EQ(SkipReason::kNoMap,
+            gate_.decide(kTruth, scan, nullptr, true, kTruth, false, params_).skip);
+  EXPECT_EQ(SkipReason::kNotInitialized,
+            gate_.decide(kTruth, scan, &model_, false, kTruth, false, params_).skip);
+  const Pose2 nan{std::nan(""), 0.0, 0.0};
+  EXPECT_EQ(SkipReason::kOdometryNotFinite,
+            gate_.decide(nan, scan, &model_, true, kTruth, false, params_).skip);
+  LaserScan bad = scan;
+  bad.angle_increment = 0.0;
+  const GateDecision d = gate_.decide(kTruth, bad, &model_, true, kTruth, false, params_);
+  EXPECT_EQ(SkipReason::kBadScan, d.skip);
+  EXPECT_EQ(*validateScan(bad), d.detail);
+  // None of them counted as an update.
+  EXPECT_FALSE(gate_.hasUpdated());
+  EXPECT_FALSE(gate_.odomAtUpdate().has_value());
+}
+
+TEST_F(UpdateGateTest, TheFirstScanRunsWithoutMotionThenOnlyAfterMotion) {
+  const Pose2 odom0{5.0, 5.0, 2.0};
+  GateDecision d = decide(odom0, kTruth);
+  ASSERT_TRUE(d.runs()) << toString(d.skip);
+  EXPECT_FALSE(d.from.has_value());
+  ASSERT_TRUE(d.scan.has_value());
+  EXPECT_GT(d.scan->size(), 0u);
+  EXPECT_TRUE(gate_.hasUpdated());
+
+  EXPECT_EQ(SkipReason::kNotMoved, decide(odom0, kTruth).skip);
+  EXPECT_EQ(SkipReason::kNotMoved, decide(compose(odom0, {0.19, 0.0, 0.0}), kTruth).skip);
+  EXPECT_EQ(SkipReason::kNotMoved, decide(compose(odom0, {0.0, 0.0, 0.5}), kTruth).skip);
+
+  const Pose2 odom1 = compose(odom0, {0.0, -0.21, 0.0});
+  d = decide(odom1, kTruth);
+  ASSERT_TRUE(d.runs()) << toString(d.skip);
+  ASSERT_TRUE(d.from.has_value());
+  EXPECT_EQ(odom0.x, d.from->x);
+  EXPECT_NEAR(0.21, d.step, 1e-9);
+  EXPECT_FALSE(d.fit_dropped);
+  // The reference is now odom1: turning 0.55 rad from there is enough.
+  EXPECT_TRUE(decide(compose(odom1, {0.0, 0.0, 0.55}), kTruth).runs());
+}
+
+TEST_F(UpdateGateTest, ARequestedUpdateOrSuspectOdometryRunsWithoutMotion) {
+  const Pose2 odom{1.0, 2.0, 0.0};
+  ASSERT_TRUE(decide(odom, kTruth).runs());
+  gate_.requestUpdate();
+  EXPECT_TRUE(decide(odom, kTruth).runs());
+  EXPECT_EQ(SkipReason::kNotMoved, decide(odom, kTruth).skip);  // once
+  EXPECT_TRUE(decide(odom, kTruth, /*suspect=*/true).runs());
+}
+
+TEST_F(UpdateGateTest, AnOdometryJumpIsSkippedAndTrackingResumesFromIt) {
+  const Pose2 odom{1.0, 2.0, 0.0};
+  ASSERT_TRUE(decide(odom, kTruth).runs());
+  const Pose2 jumped = compose(odom, {10.0, 0.0, 0.0});
+  const GateDecision d = decide(jumped, kTruth);
+  EXPECT_EQ(SkipReason::kOdometryJumped, d.skip);
+  EXPECT_NEAR(10.0, d.step, 1e-9);
+  EXPECT_EQ(jumped.x, gate_.odomAtUpdate()->x);
+  // Measured from the new odometry, the robot has not moved.
+  EXPECT_EQ(SkipReason::kNotMoved, decide(jumped, kTruth).skip);
+}
+
+TEST_F(UpdateGateTest, AScanWithoutValidBeamKeepsTheReference) {
+  const Pose2 odom{1.0, 2.0, 0.0};
+  ASSERT_TRUE(decide(odom, kTruth).runs());
+  LaserScan blind = castScan(grid_, kTruth);
+  blind.ranges.assign(blind.ranges.size(), std::numeric_limits<float>::quiet_NaN());
+  const Pose2 moved = compose(odom, {0.5, 0.0, 0.0});
+  const GateDecision d = gate_.decide(moved, blind, &model_, true, kTruth, false, params_);
+  EXPECT_EQ(SkipReason::kNoValidBeam, d.skip);
+  ASSERT_TRUE(d.scan.has_value());
+  EXPECT_EQ(180, d.scan->dropped);
+  EXPECT_EQ(odom.x, gate_.odomAtUpdate()->x);
+  // The motion is applied with the next usable scan, from the old reference.
+  const GateDecision next = decide(moved, kTruth);
+  ASSERT_TRUE(next.runs());
+  EXPECT_EQ(odom.x, next.from->x);
+}
+
+TEST_F(UpdateGateTest, AScanThatStopsFittingRunsBeforeTheThresholds) {
+  params_.update_fit_drop = 0.2;
+  const Pose2 odom{1.0, 2.0, 0.0};
+  ASSERT_TRUE(decide(odom, kTruth).runs());
+  const LaserScan at_truth = castScan(grid_, kTruth);
+  gate_.recordFit(model_, model_.prepare(at_truth), kTruth, params_);
+  // 5 cm of odometry, and the scan still fits the predicted pose: waits.
+  const Pose2 step{0.05, 0.0, 0.0};
+  EXPECT_EQ(SkipReason::kNotMoved,
+            gate_
+                .decide(compose(odom, step), castScan(grid_, compose(kTruth, step)), &model_, true,
+                        kTruth, false, params_)
+                .skip);
+  // The robot was pushed 0.4 m while the odometry says 5 cm: runs now.
+  const GateDecision d =
+      gate_.decide(compose(odom, step), castScan(grid_, compose(kTruth, {0.45, 0.3, 0.0})), &model_,
+                   true, kTruth, false, params_);
+  EXPECT_TRUE(d.runs()) << toString(d.skip);
+  EXPECT_TRUE(d.fit_dropped);
+}
+
+TEST_F(UpdateGateTest, RestartMakesTheNextUpdateTheFirst) {
+  const Pose2 odom{1.0, 2.0, 0.0};
+  ASSERT_TRUE(decide(odom, kTruth).runs());
+  gate_.restart();
+  EXPECT_FALSE(gate_.hasUpdated());
+  const GateDecision d = decide(odom, kTruth);
+  EXPECT_TRUE(d.runs());
+  EXPECT_FALSE(d.from.has_value());
+}
+
+TEST(SkipReason, EveryReasonHasItsOwnName) {
+  const SkipReason all[] = {SkipReason::kNone,           SkipReason::kNoMap,
+                            SkipReason::kNotInitialized, SkipReason::kOdometryNotFinite,
+                            SkipReason::kBadScan,        SkipReason::kOdometryJumped,
+                            SkipReason::kNotMoved,       SkipReason::kNoValidBeam};
+  for (const SkipReason a : all) {
+    for (const SkipReason b : all) {
+      if (a != b) {
+        EXPECT_STRNE(toString(a), toString(b));
+      }
+    }
+  }
+}
+
+}  // namespace
+}  // namespace pf
