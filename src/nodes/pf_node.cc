@@ -1,14 +1,12 @@
 // pf_node: the live ROS front door of the particle filter.
 //
 // Subscribes scan, odom, map (latched) and initialpose; publishes map -> odom
-// on tf, the particles on particlecloud and the estimate on pf_pose and, for
-// amcl's users, amcl_pose. The localization itself happens in
-// pf_ros::ScanLocalizer and the core, and what goes with the filter (time
-// jumping back, the saved pose, the output topics) in pf_ros::LiveLocalizer;
-// this file wires them to roscpp, waits for tf and tells the user what is
-// wrong. It speaks amcl's interface too (topics, services, parameter names,
-// the pose saved to the parameter server, dynamic_reconfigure through
-// pf_ros::ReconfigureServer), so that it can replace amcl in a bringup.
+// on tf, the particles on particlecloud and the estimate on pf_pose and
+// amcl_pose. The localization happens in pf_ros::ScanLocalizer and the core,
+// what goes with the filter (time jumping back, the saved pose, the output)
+// in pf_ros::LiveLocalizer; this file wires them to roscpp. It speaks amcl's
+// interface too (topics, services, parameter names, the saved pose,
+// dynamic_reconfigure), so that it can replace amcl in a bringup.
 //
 // Threads (README.md, "Under overload"): tf and the scans are taken on
 // roscpp's own poll thread as they arrive (InlineCallbackQueue: no hand-off
@@ -46,6 +44,7 @@
 #include "pf_localization/ros/live_localizer.h"
 #include "pf_localization/ros/map_to_odom_republisher.h"
 #include "pf_localization/ros/odometry_source.h"
+#include "pf_localization/ros/parameter_docs.h"
 #include "pf_localization/ros/pose_transform.h"
 #include "pf_localization/ros/reconfigure_server.h"
 #include "pf_localization/ros/scan_drop.h"
@@ -332,6 +331,7 @@ class PfNode {
 }  // namespace pf_ros
 
 int main(int argc, char** argv) {
+  if (pf_ros::printHelpIfAsked(argc, argv, "pf_node")) return 0;
   // roscpp's own SIGINT handler would shut down before the pose is saved.
   ros::init(argc, argv, "pf_node", ros::init_options::NoSigintHandler);
   std::signal(SIGINT, [](int) {

@@ -1,6 +1,7 @@
 #include "pf_localization/ros/parameter_docs.h"
 
 #include <cmath>
+#include <iostream>
 #include <sstream>
 #include <variant>
 #include <vector>
@@ -203,6 +204,17 @@ std::string parameterHelp(const std::string& program) {
         << "      " << p.info.description << "\n";
   }
   return out.str();
+}
+
+bool printHelpIfAsked(int argc, char** argv, const std::string& program) {
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "-h" || a == "--help") {
+      std::cout << parameterHelp(program);
+      return true;
+    }
+  }
+  return false;
 }
 
 }  // namespace pf_ros

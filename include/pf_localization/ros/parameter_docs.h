@@ -24,4 +24,8 @@ std::string parameterMarkdown();
 /// `pf_node --help`: usage, then one line per parameter.
 std::string parameterHelp(const std::string& program);
 
+/// When the command line asks for -h or --help (before any ROS remapping is
+/// read, so no master is needed): prints parameterHelp on stdout and returns true.
+bool printHelpIfAsked(int argc, char** argv, const std::string& program);
+
 }  // namespace pf_ros
