@@ -105,8 +105,9 @@ def package_dir(command=None):
 
 
 def shared_data(package):
-    """The real recordings' default folder, beside a source checkout (../shared/data), or None
-    for an install space's share folder."""
+    """The real recordings' default folder, beside a source checkout (../shared/data, from where
+    the checkout really is: a workspace's src/ may hold a link to it), or None for an install
+    space's share folder."""
     if package is None or not os.path.isfile(os.path.join(package, 'CMakeLists.txt')):
         return None
-    return os.path.normpath(os.path.join(package, '..', 'shared', 'data'))
+    return os.path.join(os.path.dirname(os.path.realpath(package)), 'shared', 'data')
