@@ -139,6 +139,8 @@ def run_evaluation(argv):
     with contextlib.redirect_stdout(out), contextlib.redirect_stderr(out):
         try:
             status = evaluate.main(argv)
+        except SystemExit as e:  # argparse's
+            status = e.code
         except Exception as e:  # a bug or an unreadable input: this run's failure, not the table's
             print('pf_evaluate: %s: %s' % (type(e).__name__, e))
             status = 1
