@@ -19,7 +19,10 @@
 #               benchmark_datasets (the bundled bags) and pf_evaluate must find
 #               that workspace's pf_bag_runner and finish.
 #
-#   bash scripts/readme_walkthrough.sh [--keep]
+#   bash scripts/readme_walkthrough.sh [--keep] [CHECK ...]
+#
+# CHECK: demo, bag_demo, help, user_ws (default: all, in that order; bag_demo
+# and help use the workspace demo builds, user_ws needs nothing before it).
 #
 # Prints one "[check] NAME: ok/FAILED" line per check, then "N passed, N
 # failed"; exits 1 if any check failed. Everything it makes (the two
@@ -29,14 +32,16 @@
 # minutes on two cores.
 set -uo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
-keep=0
+keep=0 only=()
 while [ $# -gt 0 ]; do
   case $1 in
     --keep) keep=1; shift ;;
     -h | --help) sed -n '2,/^set -uo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
+    demo | bag_demo | help | user_ws) only+=("$1"); shift ;;
     *) echo "readme_walkthrough: unknown argument '$1' (see --help)" >&2; exit 2 ;;
   esac
 done
+wanted() { [ ${#only[@]} -eq 0 ] || [[ " ${only[*]} " == *" $1 "* ]]; }
 export PATH=/usr/bin:$PATH
 # shellcheck source=scripts/workspace.bash
 source "$repo/scripts/workspace.bash"
@@ -122,6 +127,10 @@ bag_demo() {
     roslaunch -p "$port" pf_localization bag_demo.launch rviz:=false
   "${PF_SPACE_CMD[@]}" >"$log" 2>&1 &
   pid=$!
+  for _ in $(seq 30); do  # roslaunch starts its roscore first
+    ROS_MASTER_URI=http://localhost:$port pf_in_space "$setup" rostopic list >/dev/null 2>&1 && break
+    sleep 1
+  done
   ROS_MASTER_URI=http://localhost:$port pf_in_space "$setup" timeout 150 \
     /usr/bin/python3 "$tmp/live_listener.py" 120 >"$tmp/live_listener.out" 2>&1
   rc=$?
@@ -174,13 +183,17 @@ user_ws() {
     --map "$share/maps/building.yaml" --out "$tmp/eval" 2>&1) || { sed 's/^/    /' <<<"$out"; return 1; }
 }
 
-check "demo: bash scripts/demo.sh builds every node and writes the report" demo
-check "bag_demo: roslaunch bag_demo.launch rviz:=false: map -> odom on /tf, pf_status localized" bag_demo
-for tool in pf_evaluate pf_tune benchmark_datasets compare_scans.py \
-            pf_bag_runner map_publisher pf_simulator pf_make_map pf_node; do
-  check "help $tool: rosrun pf_localization $tool --help, no ROS master" tool_help "$tool"
-done
-check "user_ws: pf_tune, benchmark_datasets, pf_evaluate from a user's catkin_make workspace" user_ws
+wanted demo && check "demo: bash scripts/demo.sh builds every node and writes the report" demo
+wanted bag_demo &&
+  check "bag_demo: roslaunch bag_demo.launch rviz:=false: map -> odom on /tf, pf_status localized" bag_demo
+if wanted help; then
+  for tool in pf_evaluate pf_tune benchmark_datasets compare_scans.py \
+              pf_bag_runner map_publisher pf_simulator pf_make_map pf_node; do
+    check "help $tool: rosrun pf_localization $tool --help, no ROS master" tool_help "$tool"
+  done
+fi
+wanted user_ws &&
+  check "user_ws: pf_tune, benchmark_datasets, pf_evaluate from a user's catkin_make workspace" user_ws
 
 echo "$passed passed, $failed failed ($(($(date +%s) - t_start)) s)"
 if [ "$failed" -eq 0 ] && [ "$keep" -eq 0 ]; then rm -rf "$tmp"; else echo "files in $tmp"; fi
