@@ -28,9 +28,9 @@
 # failed"; exits 1 if any check failed. Everything it makes (the two
 # workspaces, logs, outputs) is in one temporary folder, removed at the end
 # unless --keep (or a failure) says otherwise; demo.sh writes its report to
-# reports/tracking/ as it does for a user. Two builds from scratch: about 6
-# minutes on an idle two-core machine (user_ws alone: 5 minutes on a busy
-# one), plus 30 s for each node whose --help waits for a ROS master.
+# reports/tracking/ as it does for a user. Two builds from scratch: 9.5
+# minutes on a shared two-core machine (load 4), 30 s of it for each node
+# whose --help waited for a ROS master.
 set -uo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 keep=0 only=()
