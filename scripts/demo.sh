@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The main job: installs the dependencies, builds the package, localizes the
+# The main job: installs the dependencies, builds the package (every node), localizes the
 # robot of a bag with pf_bag_runner (as fast as the CPU allows) and writes an
 # evaluation report with pf_evaluate.
 #
@@ -37,7 +37,9 @@ bag=$(realpath "$bag"); map=$(realpath "$map")
 report=${report:-$repo/reports/$(basename "$bag" .bag)}
 
 bash "$repo/scripts/install_deps.sh"
-bash "$repo/scripts/build.sh" pf_bag_runner >/dev/null
+# Every node, not just the runner: the README's next step is bag_demo.launch
+# (pf_node, map_publisher), and rosrun reaches pf_simulator and pf_make_map.
+bash "$repo/scripts/build.sh" >/dev/null
 mkdir -p "$report"
 
 echo "demo: localizing $bag on $map"

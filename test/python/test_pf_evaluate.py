@@ -1,11 +1,10 @@
 #!/usr/bin/python3
-"""Unit tests of scripts/pf_evaluate's association and metrics on tiny literal trajectories.
+"""Unit tests of pf_evaluate (pf_localization.evaluate): association and metrics on tiny literal
+trajectories, and the CPU plot's axis.
 
 Run from the repository root:  /usr/bin/python3 -m unittest discover -s test/python -v
 Needs numpy only (no ROS, no matplotlib).
 """
-import importlib.machinery
-import importlib.util
 import math
 import os
 import sys
@@ -14,12 +13,9 @@ import unittest
 
 import numpy as np
 
-_PATH = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'scripts', 'pf_evaluate')
-_loader = importlib.machinery.SourceFileLoader('pf_evaluate', _PATH)
-_spec = importlib.util.spec_from_loader('pf_evaluate', _loader)
-pfe = importlib.util.module_from_spec(_spec)
-sys.dont_write_bytecode = True  # no __pycache__ next to scripts/pf_evaluate
-_loader.exec_module(pfe)
+# This checkout's package, built or not (before any installed pf_localization).
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'src'))
+from pf_localization import evaluate as pfe  # noqa: E402
 
 
 def traj(rows):
@@ -125,6 +121,14 @@ class MetricsTest(unittest.TestCase):
         finally:
             os.unlink(f.name)
         np.testing.assert_allclose(a, [[1, 0, 0, 0], [2, 1, 2, -3.0]], atol=1e-9)
+
+    def test_cpu_axis_is_clipped_only_when_a_few_updates_squash_the_rest(self):
+        bulk = np.r_[9.4, np.linspace(0.08, 0.12, 499)]   # one slow first update, then ~0.1 ms
+        top = pfe.cpu_axis_top(bulk)
+        self.assertGreater(top, 0.12)                      # the bulk stays in view...
+        self.assertLess(top, 0.5)                          # ...spread over the axis, not at its foot
+        self.assertIsNone(pfe.cpu_axis_top(np.linspace(0.08, 0.12, 500)))  # nothing to clip
+        self.assertIsNone(pfe.cpu_axis_top(np.array([np.nan])))
 
     def test_read_pnm_p6_averages_channels(self):
         with tempfile.NamedTemporaryFile('wb', suffix='.ppm', delete=False) as f:

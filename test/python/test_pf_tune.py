@@ -1,16 +1,14 @@
 #!/usr/bin/python3
-"""Tests of scripts/pf_tune: the search space and params files, the self-supervised score on the
+"""Tests of pf_tune (pf_localization.tune): the search space and params files, the self-supervised score on the
 bundled simulated bags, the choice of the best against the seeds' noise, and whole studies on a
 2-worker Dask LocalCluster (a 6-trial study, a worker killed mid-study, a study stopped after 3
 trials and continued).
 
 Run from the repository root:  /usr/bin/python3 -m unittest discover -s test/python -v
 Needs pf_bag_runner built (scripts/build.sh; the workspace is $PF_WS or scripts/workspace.bash's
-default), python3-optuna, python3-distributed, python3-sklearn and ROS 1's rosbag. About 2 minutes.
+default, found as scripts/pf_tune finds it: pf_localization/locate.py), python3-optuna, python3-distributed, python3-sklearn and ROS 1's rosbag. About 2 minutes.
 """
 import csv
-import importlib.machinery
-import importlib.util
 import os
 import shutil
 import signal
@@ -24,13 +22,16 @@ import yaml
 
 REPO = os.path.realpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..'))
 TUNE = os.path.join(REPO, 'scripts', 'pf_tune')
-_loader = importlib.machinery.SourceFileLoader('pf_tune', TUNE)
-_spec = importlib.util.spec_from_loader('pf_tune', _loader)
-pft = importlib.util.module_from_spec(_spec)
-sys.dont_write_bytecode = True  # no __pycache__ next to scripts/pf_tune
-_loader.exec_module(pft)
+# This checkout's package, built or not (before any installed pf_localization).
+sys.path.insert(0, os.path.join(REPO, 'src'))
+from pf_localization import locate  # noqa: E402
+from pf_localization import tune as pft  # noqa: E402
 
-RUNNER = pft.find_runner()
+
+try:
+    RUNNER, NO_RUNNER = locate.find_runner(TUNE), None  # the one scripts/pf_tune uses
+except locate.NotFound as e:
+    RUNNER, NO_RUNNER = '', str(e)
 SMALL = ['--bags', os.path.join(REPO, 'bags', 'small.bag'), '--map', os.path.join(REPO, 'maps', 'small.yaml'),
          '--initial-pose', '2.5', '2.6', '0']
 TWO_BAGS = ['--bags', os.path.join(REPO, 'bags', 'small.bag'), os.path.join(REPO, 'bags', 'tracking.bag'),
@@ -163,7 +164,7 @@ class SpaceAndParamsTest(unittest.TestCase):
 
 class ScoreTest(unittest.TestCase):
     def setUp(self):
-        self.assertTrue(os.access(RUNNER, os.X_OK), 'pf_bag_runner not built at %s (scripts/build.sh; PF_WS)' % RUNNER)
+        self.assertTrue(RUNNER, NO_RUNNER)
 
     def run_bag(self, bag, mapname, pose, params, objective='self'):
         full = base_params()
@@ -171,8 +172,7 @@ class ScoreTest(unittest.TestCase):
         return pft.evaluate_bag(dict(runner=RUNNER, bag=os.path.join(REPO, 'bags', bag),
                                      map=os.path.join(REPO, 'maps', mapname), pose=pose, reference=None,
                                      params=full, seed=1, objective=objective, fit_distance=pft.FIT_DISTANCE,
-                                     timeout=300, pf_evaluate=os.path.join(REPO, 'scripts', 'pf_evaluate'),
-                                     odom_frame='odom', base_frame='base_link'))
+                                     timeout=300, odom_frame='odom', base_frame='base_link'))
 
     def test_self_supervised_score_ranks_defaults_above_wrong_alphas_and_sigma_hit(self):
         for bag, mapname, pose in (('tracking.bag', 'building.yaml', (1.5, 7.6, 0.0)),
@@ -196,8 +196,7 @@ class ScoreTest(unittest.TestCase):
                 f.write('not a bag\n')
             job = dict(runner=RUNNER, bag=broken, map=os.path.join(REPO, 'maps', 'small.yaml'), pose=None,
                        reference=None, params=base_params(), seed=1, objective='self', fit_distance=0.1, timeout=60,
-                       pf_evaluate=os.path.join(REPO, 'scripts', 'pf_evaluate'), odom_frame='odom',
-                       base_frame='base_link')
+                       odom_frame='odom', base_frame='base_link')
             r = pft.evaluate_bag(job)
         self.assertFalse(r['ok'])
         self.assertEqual(r['score'], pft.FAIL_SCORE['self'])
@@ -206,7 +205,7 @@ class ScoreTest(unittest.TestCase):
 
 class StudyTest(unittest.TestCase):
     def setUp(self):
-        self.assertTrue(os.access(RUNNER, os.X_OK), 'pf_bag_runner not built at %s (scripts/build.sh; PF_WS)' % RUNNER)
+        self.assertTrue(RUNNER, NO_RUNNER)
         self.out = tempfile.mkdtemp(prefix='pf_tune_test_')
 
     def tearDown(self):
@@ -344,7 +343,7 @@ class StudyTest(unittest.TestCase):
 
 class BenchmarkOnDaskTest(unittest.TestCase):
     def test_benchmark_datasets_on_a_local_cluster_gives_the_sequential_table(self):
-        self.assertTrue(os.access(RUNNER, os.X_OK), 'pf_bag_runner not built at %s (scripts/build.sh; PF_WS)' % RUNNER)
+        self.assertTrue(RUNNER, NO_RUNNER)
         tables = []
         with tempfile.TemporaryDirectory() as d:
             for extra in ([], ['--workers', '2']):

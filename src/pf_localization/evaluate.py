@@ -1,0 +1,636 @@
+"""Evaluate a pf_localization run against a reference trajectory.
+
+usage: pf_evaluate --traj TRAJ.tum (--bag BAG | --ref REF.tum) [--map MAP.yaml]
+                   [--log UPDATES.csv] [--particles PARTICLES.csv|.bin] [--out DIR]
+                   [--lost 0.3] [--max-gap 0.5] [--hold] [--gif-seconds 30]
+
+Inputs
+  TRAJ.tum   the filter's estimates, one line per scan: t x y z qx qy qz qw (map frame).
+  reference  the bag's /ground_truth (geometry_msgs/PoseStamped, header stamps) or a TUM file.
+
+Time association: every reference pose gets the estimate at its stamp, linearly interpolated in
+x, y and along the shorter arc in yaw between the two bracketing estimates when both lie within
+--max-gap seconds of it; otherwise the newest estimate at or before it within --max-gap (zero-order
+hold, which is all --hold uses); an estimate within 0.1 ms counts as exact. References with neither
+are unmatched and lower the coverage.
+
+Metrics (DIR/summary.json)
+  position error e = |(x, y)_est - (x, y)_ref|: RMSE (the ATE, no alignment: both are map frame),
+  median, mean, max; yaw error = |wrap(yaw_est - yaw_ref)|: RMSE and max in degrees;
+  convergence time = first matched reference time (relative to the first reference pose) from which
+  on every error is <= --lost (null if the last one is not); lost fraction = share of matched
+  references with e > --lost; coverage = matched / all references.
+  With --log, the mean/p95 update CPU time and particle counts from the runner's update log.
+
+Plots (PNG): trajectory.png (map, estimate, reference), error.png (position and yaw error over
+time); with --log spread.png (particle std dev) and cpu.png (update CPU time, particle count);
+with --particles particles.gif (the cloud over the map for the first --gif-seconds).
+Exit status: 0 on success, 2 on bad input (missing file, no reference, nothing matched).
+"""
+import argparse
+import csv
+import json
+import os
+import sys
+
+import numpy as np
+
+EXACT_S = 1e-4  # estimates this close to a reference stamp count as taken at it
+OFF_M = 0.5     # an estimate this far from the reference is "off" (the issue trackers' figure)
+SETTLE_S = 10.0  # the start of a run that off_fraction_after_settle leaves out
+WRONG_M = 1.0    # "localized" while this far off is confidently wrong
+
+
+class EvalError(Exception):
+    """Bad or missing input; main() prints it and exits with status 2."""
+
+
+# ----------------------------------------------------------------------------------- geometry
+def wrap(a):
+    """Angle(s) wrapped to [-pi, pi)."""
+    return (np.asarray(a, dtype=float) + np.pi) % (2 * np.pi) - np.pi
+
+
+def quat_yaw(qx, qy, qz, qw):
+    return np.arctan2(2 * (qw * qz + qx * qy), 1 - 2 * (qy * qy + qz * qz))
+
+
+# ------------------------------------------------------------------------------------- inputs
+def _need_file(path, what):
+    if not os.path.isfile(path):
+        raise EvalError('%s not found: %s' % (what, path))
+
+
+def read_tum(path, what='trajectory'):
+    """TUM file -> (N, 4) array t, x, y, yaw sorted by time (comments and bad lines skipped)."""
+    _need_file(path, what)
+    rows = []
+    with open(path) as f:
+        for line in f:
+            fields = line.split()
+            if len(fields) != 8 or line.lstrip().startswith('#'):
+                continue
+            try:
+                t, x, y, _, qx, qy, qz, qw = map(float, fields)
+            except ValueError:
+                continue
+            rows.append((t, x, y, quat_yaw(qx, qy, qz, qw)))
+    if not rows:
+        raise EvalError('%s %s has no poses (expected lines "t x y z qx qy qz qw")' % (what, path))
+    a = np.array(rows, dtype=float)
+    return a[np.argsort(a[:, 0], kind='stable')]
+
+
+def read_bag_reference(path, topic='/ground_truth'):
+    """A bag's PoseStamped reference topic -> (N, 4) array t (header stamp), x, y, yaw."""
+    _need_file(path, 'bag')
+    try:
+        import rosbag
+    except ImportError:
+        raise EvalError('cannot import rosbag: run with /usr/bin/python3 (ROS 1 Python) or use --ref')
+    with rosbag.Bag(path) as bag:
+        topics = bag.get_type_and_topic_info().topics
+        if topic not in topics or topics[topic].message_count == 0:
+            raise EvalError('bag %s has no %s messages (topics: %s)' % (path, topic, ', '.join(sorted(topics))))
+        rows = []
+        for _, m, _ in bag.read_messages(topics=[topic]):
+            p, q = m.pose.position, m.pose.orientation
+            rows.append((m.header.stamp.to_sec(), p.x, p.y, quat_yaw(q.x, q.y, q.z, q.w)))
+    a = np.array(rows, dtype=float)
+    return a[np.argsort(a[:, 0], kind='stable')]
+
+
+def read_update_log(path):
+    """Runner's CSV (t,particles,ess,cpu_ms,mean_beam_likelihood,std_x,std_y,std_yaw,updated)
+    -> dict column -> float array; absent or non-numeric columns are simply missing."""
+    _need_file(path, 'update log')
+    with open(path, newline='') as f:
+        rows = list(csv.DictReader(f))
+    if not rows or 't' not in rows[0]:
+        raise EvalError('update log %s is empty or has no "t" column' % path)
+    cols = {}
+    for name in rows[0]:
+        if name is None:
+            continue
+        try:
+            cols[name.strip()] = np.array([float(r[name]) if r[name] not in (None, '') else np.nan
+                                           for r in rows])
+        except ValueError:
+            if name.strip() == 'state':  # localized / uncertain / lost
+                cols['state'] = np.array([(r[name] or '').strip() for r in rows])
+    if 't' not in cols:
+        raise EvalError('update log %s: column "t" is not numeric' % path)
+    return cols
+
+
+def read_particles(path):
+    """Particle dump -> (N, 4) array t, x, y, yaw. CSV lines t,x,y,yaw (a header line is allowed)
+    or, for a .bin file, little-endian float64 records (t, x, y, yaw)."""
+    _need_file(path, 'particle dump')
+    if path.endswith('.bin'):
+        a = np.fromfile(path, dtype='<f8')
+        a = a[:len(a) // 4 * 4].reshape(-1, 4)
+    else:
+        with open(path) as f:
+            first = f.readline()
+        try:
+            [float(v) for v in first.split(',')]
+            skip = 0
+        except ValueError:
+            skip = 1
+        a = np.loadtxt(path, delimiter=',', skiprows=skip, usecols=(0, 1, 2, 3), ndmin=2)
+    if len(a) == 0:
+        raise EvalError('particle dump %s is empty' % path)
+    return a[np.argsort(a[:, 0], kind='stable')]
+
+
+def read_pnm(path):
+    """Binary PGM (P5) / PPM (P6) -> (h, w) float array in [0, 1]; colour channels are averaged
+    as map_server does."""
+    with open(path, 'rb') as f:
+        data = f.read()
+    tokens, pos = [], 0
+    while len(tokens) < 4:
+        while pos < len(data) and data[pos:pos + 1].isspace():
+            pos += 1
+        if data[pos:pos + 1] == b'#':
+            pos = data.index(b'\n', pos)
+            continue
+        end = pos
+        while end < len(data) and not data[end:end + 1].isspace():
+            end += 1
+        tokens.append(data[pos:end])
+        pos = end
+    magic, w, h, maxval = tokens[0], int(tokens[1]), int(tokens[2]), int(tokens[3])
+    if magic not in (b'P5', b'P6'):
+        raise EvalError('%s: not a binary PGM/PPM (magic %r)' % (path, magic))
+    ch = 3 if magic == b'P6' else 1
+    dtype = '>u2' if maxval > 255 else 'u1'
+    px = np.frombuffer(data, dtype=dtype, count=w * h * ch, offset=pos + 1).reshape(h, w, ch)
+    return px.astype(float).mean(axis=2) / maxval
+
+
+def read_map(yaml_path):
+    """map_server YAML + image -> (grey image for display, extent [x0, x1, y0, y1] in m).
+    Occupied (p > occupied_thresh) is dark, free (p < free_thresh) white, the rest grey."""
+    _need_file(yaml_path, 'map YAML')
+    import yaml
+    with open(yaml_path) as f:
+        info = yaml.safe_load(f)
+    try:
+        image = os.path.join(os.path.dirname(os.path.abspath(yaml_path)), info['image'])
+        res, origin = float(info['resolution']), [float(v) for v in info['origin']]
+    except (KeyError, TypeError, ValueError) as e:
+        raise EvalError('map YAML %s lacks image/resolution/origin (%s)' % (yaml_path, e))
+    _need_file(image, 'map image')
+    if image.lower().endswith(('.pgm', '.ppm', '.pnm')):
+        v = read_pnm(image)
+    else:  # map_server also accepts PNG etc.; Pillow reads those
+        from PIL import Image
+        v = np.asarray(Image.open(image).convert('L'), dtype=float) / 255.0
+    occ = v if int(info.get('negate', 0)) else 1.0 - v
+    grey = np.full(occ.shape, 0.72)
+    grey[occ > float(info.get('occupied_thresh', 0.65))] = 0.15
+    grey[occ < float(info.get('free_thresh', 0.196))] = 1.0
+    if len(origin) > 2 and abs(origin[2]) > 1e-9:
+        print('pf_evaluate: warning: map origin yaw %.3f ignored in plots' % origin[2], file=sys.stderr)
+    h, w = grey.shape
+    return grey, [origin[0], origin[0] + w * res, origin[1], origin[1] + h * res]
+
+
+# ------------------------------------------------------------------------------------ metrics
+def associate(est, ref_t, max_gap=0.5, interpolate=True):
+    """Estimate (x, y, yaw) at each reference time.
+    Returns (poses (N, 3) with NaN rows for unmatched references, kind (N,) with
+    0 unmatched, 1 exact, 2 interpolated, 3 held)."""
+    et = est[:, 0]
+    n = len(ref_t)
+    poses, kind = np.full((n, 3), np.nan), np.zeros(n, dtype=int)
+    for k, t in enumerate(ref_t):
+        i = int(np.searchsorted(et, t, side='right')) - 1          # newest at or before t
+        j = i + 1                                                  # first after t
+        if j < len(et) and et[j] - t <= EXACT_S and (i < 0 or et[j] - t < t - et[i]):
+            poses[k], kind[k] = est[j, 1:], 1
+        elif i >= 0 and t - et[i] <= EXACT_S:
+            poses[k], kind[k] = est[i, 1:], 1
+        elif interpolate and i >= 0 and j < len(et) and t - et[i] <= max_gap and et[j] - t <= max_gap:
+            s = (t - et[i]) / (et[j] - et[i])
+            a, b = est[i, 1:], est[j, 1:]
+            poses[k] = (a[0] + s * (b[0] - a[0]), a[1] + s * (b[1] - a[1]),
+                        wrap(a[2] + s * wrap(b[2] - a[2])))
+            kind[k] = 2
+        elif i >= 0 and t - et[i] <= max_gap:
+            poses[k], kind[k] = est[i, 1:], 3
+    return poses, kind
+
+
+def convergence_time(times, errors, lost, t0):
+    """Time (relative to t0) of the first sample from which on all errors are <= lost, else None."""
+    bad = np.nonzero(np.asarray(errors) > lost)[0]
+    if len(bad) == 0:
+        return float(times[0] - t0)
+    if bad[-1] == len(errors) - 1:
+        return None
+    return float(times[bad[-1] + 1] - t0)
+
+
+def evaluate(est, ref, max_gap=0.5, lost=0.3, interpolate=True):
+    """est, ref: (N, 4) arrays t, x, y, yaw. Returns (metrics dict, per-match dict of arrays)."""
+    if len(est) == 0:
+        raise EvalError('the trajectory is empty')
+    if len(ref) == 0:
+        raise EvalError('the reference is empty')
+    poses, kind = associate(est, ref[:, 0], max_gap, interpolate)
+    ok = kind > 0
+    if not ok.any():
+        raise EvalError('no estimate matched a reference pose within %.3g s (estimates %.3f..%.3f s, '
+                        'reference %.3f..%.3f s)' % (max_gap, est[0, 0], est[-1, 0], ref[0, 0], ref[-1, 0]))
+    t, r, p = ref[ok, 0], ref[ok, 1:], poses[ok]
+    pos = np.hypot(p[:, 0] - r[:, 0], p[:, 1] - r[:, 1])
+    yaw = np.abs(wrap(p[:, 2] - r[:, 2]))
+    t0 = float(ref[0, 0])
+    m = {
+        'n_reference': int(len(ref)), 'n_matched': int(ok.sum()),
+        'n_exact': int((kind == 1).sum()), 'n_interpolated': int((kind == 2).sum()),
+        'n_held': int((kind == 3).sum()),
+        'coverage': float(ok.mean()),
+        'ate_rmse_m': float(np.sqrt(np.mean(pos ** 2))), 'median_m': float(np.median(pos)),
+        'mean_m': float(np.mean(pos)), 'max_m': float(np.max(pos)),
+        'yaw_rmse_deg': float(np.degrees(np.sqrt(np.mean(yaw ** 2)))),
+        'yaw_max_deg': float(np.degrees(np.max(yaw))),
+        'convergence_time_s': convergence_time(t, pos, lost, t0),
+        'lost_fraction': float(np.mean(pos > lost)),
+        # The share of the run (after its first SETTLE_S seconds, which a
+        # global localization may need) spent more than OFF_M off.
+        'off_fraction_after_settle': float(np.mean(pos[t - t0 >= SETTLE_S] > OFF_M))
+        if np.any(t - t0 >= SETTLE_S) else None,
+        'off_threshold_m': OFF_M, 'settle_s': SETTLE_S,
+        'lost_threshold_m': lost, 'max_gap_s': max_gap,
+        'association': 'interpolate' if interpolate else 'hold',
+        'reference_start_s': t0, 'reference_duration_s': float(ref[-1, 0] - ref[0, 0]),
+        'n_estimates': int(len(est)),
+    }
+    match = {'t': t, 'est': p, 'ref': r, 'pos_err': pos, 'yaw_err': yaw, 'matched': ok,
+             'ref_t': ref[:, 0], 'unmatched_t': ref[~ok, 0], 't0': t0}
+    return m, match
+
+
+def confidently_wrong(log, match, max_gap=0.5):
+    """Updates whose state was "localized" while the estimate was more than WRONG_M off: the
+    error users fear most. Each log row is compared with the matched reference pose nearest in
+    time (within max_gap). Returns (count, times relative to the reference start)."""
+    if 'state' not in log or len(match['t']) == 0:
+        return None, []
+    t, err = match['t'], match['pos_err']
+    times = []
+    for lt, state in zip(log['t'], log['state']):
+        if state != 'localized':
+            continue
+        k = int(np.clip(np.searchsorted(t, lt), 1, len(t) - 1))
+        k = k - 1 if abs(t[k - 1] - lt) <= abs(t[k] - lt) else k
+        if abs(t[k] - lt) <= max_gap and err[k] > WRONG_M:
+            times.append(float(lt - match['t0']))
+    return len(times), times
+
+
+def log_metrics(log):
+    """Summary figures of the runner's update log."""
+    m = {'n_log_rows': int(len(log['t']))}
+    if 'cpu_ms' in log:
+        c = log['cpu_ms'][np.isfinite(log['cpu_ms'])]
+        if len(c):
+            m.update(cpu_ms_mean=float(c.mean()), cpu_ms_p95=float(np.percentile(c, 95)),
+                     cpu_ms_max=float(c.max()), cpu_s_total=float(c.sum() / 1000.0))
+        if 'updated' in log:
+            u = log['cpu_ms'][(log['updated'] > 0) & np.isfinite(log['cpu_ms'])]
+            m['n_updates'] = int(len(u))
+            if len(u):
+                m['cpu_ms_mean_updated'] = float(u.mean())
+    if 'particles' in log:
+        m.update(particles_mean=float(np.nanmean(log['particles'])),
+                 particles_max=int(np.nanmax(log['particles'])))
+    if 'ess' in log:
+        m['ess_mean'] = float(np.nanmean(log['ess']))
+    return m
+
+
+# -------------------------------------------------------------------------------------- plots
+def _relative(t, t0):
+    """Times relative to the reference start; a log on another clock is made relative to itself."""
+    t = np.asarray(t, dtype=float)
+    return t - t0 if len(t) and abs(t[0] - t0) < 3600 else t - (t[0] if len(t) else 0)
+
+
+def _break_gaps(a, factor=10.0):
+    """Copy of a (t, ...) array with NaN rows inserted where the time step exceeds factor x median,
+    so that plotted lines do not bridge gaps in the data."""
+    if len(a) < 3:
+        return a
+    dt = np.diff(a[:, 0])
+    cut = np.nonzero(dt > factor * max(np.median(dt), 1e-6))[0] + 1
+    return np.insert(a, cut, np.nan, axis=0)
+
+
+def _show_map(ax, the_map, xs, ys, margin_frac=0.1, min_margin=0.5):
+    """Draw the map (if any) and crop the view to the points xs, ys plus a margin."""
+    if the_map is not None:
+        ax.imshow(the_map[0], cmap='gray', vmin=0, vmax=1, extent=the_map[1], origin='upper',
+                  interpolation='nearest', zorder=0)
+    x0, x1, y0, y1 = np.nanmin(xs), np.nanmax(xs), np.nanmin(ys), np.nanmax(ys)
+    mg = max(min_margin, margin_frac * max(x1 - x0, y1 - y0))
+    ax.set_xlim(x0 - mg, x1 + mg)
+    ax.set_ylim(y0 - mg, y1 + mg)
+    ax.set_aspect('equal')
+    ax.set_xlabel('x (m, map frame)')
+    ax.set_ylabel('y (m, map frame)')
+
+
+def plot_trajectory(path, est, ref, the_map, title):
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(8, 7))
+    _show_map(ax, the_map, np.r_[est[:, 1], ref[:, 1]], np.r_[est[:, 2], ref[:, 2]])
+    r, e = _break_gaps(ref), _break_gaps(est)
+    ax.plot(r[:, 1], r[:, 2], '-', color='tab:green', lw=1.6, label='reference')
+    ax.plot(e[:, 1], e[:, 2], '-', color='tab:red', lw=1.0, alpha=0.85, label='estimate')
+    ax.plot(ref[0, 1], ref[0, 2], 'o', color='tab:green', ms=7, label='reference start')
+    ax.plot(est[0, 1], est[0, 2], 'x', color='tab:red', ms=8, mew=2, label='estimate start')
+    ax.set_title(title)
+    ax.legend(loc='best', fontsize=8, framealpha=0.85)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_errors(path, m, match, title):
+    import matplotlib.pyplot as plt
+    # one sample per reference pose, NaN where unmatched, so lines break at coverage gaps
+    t = match['ref_t'] - match['t0']
+    pos, yaw = np.full(len(t), np.nan), np.full(len(t), np.nan)
+    pos[match['matched']], yaw[match['matched']] = match['pos_err'], np.degrees(match['yaw_err'])
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+    a1.plot(t, pos, '.-', color='tab:blue', ms=3, lw=0.8, label='position error')
+    a1.axhline(m['lost_threshold_m'], color='tab:red', ls='--', lw=1,
+               label='lost threshold %.2f m' % m['lost_threshold_m'])
+    if m['convergence_time_s'] is not None:
+        for a in (a1, a2):
+            a.axvline(m['convergence_time_s'], color='tab:purple', ls=':', lw=1.2)
+        a1.plot([], [], color='tab:purple', ls=':', label='converged %.1f s' % m['convergence_time_s'])
+    if len(match['unmatched_t']):
+        a1.plot(match['unmatched_t'] - match['t0'], np.zeros(len(match['unmatched_t'])), '|',
+                color='grey', ms=8, label='unmatched reference (%d)' % len(match['unmatched_t']))
+    a1.set_ylabel('position error (m)')
+    a1.set_ylim(bottom=0)
+    a1.set_title('%s: ATE RMSE %.3f m, yaw RMSE %.2f deg' % (title, m['ate_rmse_m'], m['yaw_rmse_deg']))
+    a1.legend(loc='upper right', fontsize=8)
+    a2.plot(t, yaw, '.-', color='tab:orange', ms=3, lw=0.8, label='|yaw error|')
+    a2.set_ylabel('yaw error (deg)')
+    a2.set_xlabel('time since first reference pose (s)')
+    a2.set_ylim(bottom=0)
+    a2.legend(loc='upper right', fontsize=8)
+    for a in (a1, a2):
+        a.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_spread(path, log, t0, title):
+    import matplotlib.pyplot as plt
+    t = _relative(log['t'], t0)
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
+    for name, c in (('std_x', 'tab:blue'), ('std_y', 'tab:green')):
+        if name in log:
+            a1.plot(t, log[name], color=c, lw=1, label='%s (m)' % name)
+    if 'std_yaw' in log:
+        a2.plot(t, np.degrees(log['std_yaw']), color='tab:orange', lw=1, label='std_yaw (deg)')
+    for a, unit in ((a1, 'm'), (a2, 'deg')):
+        v = np.concatenate([l.get_ydata() for l in a.get_lines()]) if a.get_lines() else np.array([])
+        v = v[np.isfinite(v) & (v > 0)]
+        if len(v) and v.max() / v.min() > 100:
+            a.set_yscale('log')
+        a.set_ylabel('particle std dev (%s)' % unit)
+        a.grid(alpha=0.3)
+        if a.get_lines():
+            a.legend(loc='upper right', fontsize=8)
+        else:
+            a.text(0.5, 0.5, 'not in log', transform=a.transAxes, ha='center')
+    a1.set_title('%s: particle spread' % title)
+    a2.set_xlabel('time since first reference pose (s)')
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def cpu_axis_top(c, percentile=99.0, headroom=1.5):
+    """The top of the CPU time axis: all of c when its largest value is within `headroom` x the
+    `percentile`th, else that (a few slow updates, e.g. the first, would squash the rest onto the
+    axis). None when c has no finite value."""
+    c = np.asarray(c, dtype=float)
+    c = c[np.isfinite(c)]
+    if len(c) == 0:
+        return None
+    clip = headroom * float(np.percentile(c, percentile))
+    return clip if c.max() > clip > 0 else None
+
+
+def _plot_cpu_times(ax, t, c):
+    """The CPU times as dots, with their mean; the few above the axis's top drawn on it as
+    triangles and counted in the legend. Returns the legend's handles."""
+    handles = ax.plot(t, c, '.', color='tab:blue', ms=3, label='update CPU time')
+    if not np.isfinite(c).any():
+        return handles
+    handles.append(ax.axhline(np.nanmean(c), color='tab:blue', ls='--', lw=1,
+                              label='mean %.2f ms' % np.nanmean(c)))
+    top = cpu_axis_top(c)
+    if top is None:
+        ax.set_ylim(bottom=0)
+        return handles
+    ax.set_ylim(0, top)
+    over = np.isfinite(c) & (c > top)
+    handles += ax.plot(t[over], np.full(int(over.sum()), top), '^', color='tab:purple', ms=6, clip_on=False,
+                       label='%d above %.2f ms (max %.1f ms)' % (over.sum(), top, np.nanmax(c)))
+    return handles
+
+
+def plot_cpu(path, log, t0, title):
+    import matplotlib.pyplot as plt
+    t = _relative(log['t'], t0)
+    fig, ax = plt.subplots(figsize=(9, 4.5))
+    handles = []
+    if 'cpu_ms' in log:
+        handles += _plot_cpu_times(ax, t, log['cpu_ms'])
+    ax.set_ylabel('CPU time per update (ms)')
+    ax.set_xlabel('time since first reference pose (s)')
+    ax.grid(alpha=0.3)
+    if 'particles' in log:
+        a2 = ax.twinx()
+        handles += a2.plot(t, log['particles'], '-', color='tab:red', lw=1, label='particle count')
+        a2.set_ylabel('particles')
+        a2.set_ylim(bottom=0, top=1.1 * np.nanmax(log['particles']) + 1)
+    ax.set_title('%s: update CPU time and particle count' % title)
+    if handles:
+        ax.legend(handles=handles, loc='upper right', fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def make_particle_gif(path, parts, est, ref, the_map, seconds, title, max_frames=60,
+                      max_particles=2000):
+    """Animated GIF of the particle cloud for the first `seconds` of the dump."""
+    import matplotlib.pyplot as plt
+    from matplotlib.animation import FuncAnimation, PillowWriter
+    times, starts = np.unique(parts[:, 0], return_index=True)
+    ends = np.r_[starts[1:], len(parts)]
+    sel = np.nonzero(times <= times[0] + seconds)[0]
+    sel = sel[np.unique(np.linspace(0, len(sel) - 1, min(max_frames, len(sel))).round().astype(int))]
+    rng = np.random.default_rng(0)
+    frames = []
+    for k in sel:
+        idx = np.arange(starts[k], ends[k])
+        if len(idx) > max_particles:
+            idx = rng.choice(idx, max_particles, replace=False)
+        frames.append((times[k], ends[k] - starts[k], parts[idx, 1:3]))
+    t_end = times[sel[-1]]
+    win = lambda a: a[(a[:, 0] >= times[0] - 1) & (a[:, 0] <= t_end + 1)]
+    e, r = win(est), win(ref)
+    xs = np.concatenate([f[2][:, 0] for f in frames] + [e[:, 1], r[:, 1]])
+    ys = np.concatenate([f[2][:, 1] for f in frames] + [e[:, 2], r[:, 2]])
+    fig, ax = plt.subplots(figsize=(4.2, 4.6))
+    _show_map(ax, the_map, xs, ys, margin_frac=0.05, min_margin=0.3)
+    ax.tick_params(labelsize=7)
+    ax.xaxis.label.set_size(8)
+    ax.yaxis.label.set_size(8)
+    cloud = ax.scatter([], [], s=2.5, c='tab:blue', alpha=0.6, lw=0, label='particles')
+    ref_dot, = ax.plot([], [], 'o', color='tab:green', ms=5, label='reference')
+    est_dot, = ax.plot([], [], 'x', color='tab:red', ms=6, mew=2, label='estimate')
+    # Below the axes: inside, wherever it went, the cloud passes under it sooner or later.
+    fig.legend(handles=[cloud, ref_dot, est_dot], loc='lower center', ncol=3, fontsize=6, markerscale=1.5,
+               frameon=False)
+    head = ax.set_title('', fontsize=8)
+
+    def near(a, t):
+        if len(a) == 0:
+            return [], []
+        i = int(np.argmin(np.abs(a[:, 0] - t)))
+        return ([a[i, 1]], [a[i, 2]]) if abs(a[i, 0] - t) < 1.0 else ([], [])
+
+    def draw(f):
+        t, n, xy = f
+        cloud.set_offsets(xy)
+        ref_dot.set_data(*near(ref, t))
+        est_dot.set_data(*near(est, t))
+        head.set_text('%s  t=%.1f s  (%d of %d particles)' % (title, t - times[0], len(xy), n))
+        return cloud, ref_dot, est_dot, head
+
+    fig.tight_layout(rect=(0, 0.05, 1, 1))
+    fps = max(1.0, min(8.0, len(frames) / max(seconds, 1e-3) * 2))
+    FuncAnimation(fig, draw, frames=frames, blit=False).save(path, writer=PillowWriter(fps=fps), dpi=96)
+    plt.close(fig)
+    return len(frames)
+
+
+# --------------------------------------------------------------------------------------- main
+def parse_args(argv):
+    p = argparse.ArgumentParser(description=__doc__.split('\n')[0], epilog=__doc__[__doc__.index('Inputs'):],
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument('--traj', required=True, help='estimated trajectory (TUM)')
+    g = p.add_mutually_exclusive_group(required=True)
+    g.add_argument('--bag', help='bag with the reference on --ref-topic')
+    g.add_argument('--ref', help='reference trajectory (TUM)')
+    p.add_argument('--ref-topic', default='/ground_truth', help='PoseStamped topic in --bag')
+    p.add_argument('--map', help='map_server YAML drawn under the trajectories')
+    p.add_argument('--log', help="runner's per-update CSV log")
+    p.add_argument('--particles', help='particle dump (CSV t,x,y,yaw or .bin float64 records)')
+    p.add_argument('--out', help='report directory (default: TRAJ without extension + _eval)')
+    p.add_argument('--lost', type=float, default=0.3, help='lost / convergence threshold (m)')
+    p.add_argument('--max-gap', type=float, default=0.5, help='max time between reference and estimate (s)')
+    p.add_argument('--hold', action='store_true', help='no interpolation: newest estimate at or before')
+    p.add_argument('--gif-seconds', type=float, default=30.0, help='length of the particle GIF (s)')
+    p.add_argument('--title', help='name used in plot titles (default: the recording\'s name: the --bag '
+                                   'or --ref file\'s, without its extension)')
+    p.add_argument('--no-plots', action='store_true', help='only write summary.json')
+    return p.parse_args(argv)
+
+
+def run(args):
+    est = read_tum(args.traj)
+    ref = read_bag_reference(args.bag, args.ref_topic) if args.bag else read_tum(args.ref, 'reference')
+    the_map = read_map(args.map) if args.map else None
+    log = read_update_log(args.log) if args.log else None
+    parts = read_particles(args.particles) if args.particles else None
+    out = args.out or os.path.splitext(args.traj)[0] + '_eval'
+    os.makedirs(out, exist_ok=True)
+    title = args.title or os.path.splitext(os.path.basename(args.bag or args.ref))[0]
+
+    m, match = evaluate(est, ref, args.max_gap, args.lost, not args.hold)
+    if log is not None:
+        m.update(log_metrics(log))
+        count, times = confidently_wrong(log, match, args.max_gap)
+        if count is not None:
+            m.update(confidently_wrong_updates=count, confidently_wrong_times_s=times,
+                     confidently_wrong_threshold_m=WRONG_M)
+    m['inputs'] = {k: os.path.abspath(v) for k, v in (('traj', args.traj), ('bag', args.bag), ('ref', args.ref),
+                   ('map', args.map), ('log', args.log), ('particles', args.particles)) if v}
+    plots = []
+    if not args.no_plots:
+        import matplotlib
+        matplotlib.use('Agg')
+        plot_trajectory(os.path.join(out, 'trajectory.png'), est, ref, the_map, title + ': trajectory')
+        plot_errors(os.path.join(out, 'error.png'), m, match, title)
+        plots += ['trajectory.png', 'error.png']
+        if log is not None:
+            plot_spread(os.path.join(out, 'spread.png'), log, match['t0'], title)
+            plot_cpu(os.path.join(out, 'cpu.png'), log, match['t0'], title)
+            plots += ['spread.png', 'cpu.png']
+        if parts is not None:
+            m['gif_frames'] = make_particle_gif(os.path.join(out, 'particles.gif'), parts, est, ref, the_map,
+                                                args.gif_seconds, title)
+            plots.append('particles.gif')
+    m['plots'] = plots
+    summary = os.path.join(out, 'summary.json')
+    with open(summary, 'w') as f:
+        json.dump(m, f, indent=2)
+        f.write('\n')
+    return m, summary
+
+
+def describe(m, summary):
+    conv = m['convergence_time_s']
+    lines = [
+        'pf_evaluate: %d/%d reference poses matched (coverage %.1f %%: %d exact, %d interpolated, %d held)'
+        % (m['n_matched'], m['n_reference'], 100 * m['coverage'], m['n_exact'], m['n_interpolated'],
+           m['n_held']),
+        '  position error: RMSE %.3f m  median %.3f  mean %.3f  max %.3f m'
+        % (m['ate_rmse_m'], m['median_m'], m['mean_m'], m['max_m']),
+        '  yaw error:      RMSE %.2f deg  max %.2f deg' % (m['yaw_rmse_deg'], m['yaw_max_deg']),
+        '  converged:      %s; lost (> %.2f m) %.1f %% of matched poses'
+        % ('after %.2f s' % conv if conv is not None else 'never', m['lost_threshold_m'],
+           100 * m['lost_fraction']),
+    ]
+    if m.get('off_fraction_after_settle') is not None:
+        lines.append('  off (> %.1f m):  %.1f %% of the run after its first %.0f s'
+                     % (m['off_threshold_m'], 100 * m['off_fraction_after_settle'], m['settle_s']))
+    if 'confidently_wrong_updates' in m:
+        lines.append('  confidently wrong: %d updates "localized" while more than %.0f m off'
+                     % (m['confidently_wrong_updates'], m['confidently_wrong_threshold_m']))
+    if 'cpu_ms_mean' in m:
+        lines.append('  update CPU:     mean %.2f ms  p95 %.2f ms  (%d log rows)'
+                     % (m['cpu_ms_mean'], m['cpu_ms_p95'], m['n_log_rows']))
+    lines.append('  report: %s' % summary + (' (+ %s)' % ', '.join(m['plots']) if m['plots'] else ''))
+    return '\n'.join(lines)
+
+
+def main(argv=None):
+    args = parse_args(sys.argv[1:] if argv is None else argv)
+    try:
+        m, summary = run(args)
+    except (EvalError, OSError) as e:
+        print('pf_evaluate: error: %s' % e, file=sys.stderr)
+        return 2
+    print(describe(m, summary))
+    return 0
+
+
+if __name__ == '__main__':
+    sys.exit(main())
