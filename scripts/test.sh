@@ -102,7 +102,14 @@ check "the core and the simulator include no ROS header" core_is_ros_free
 if [ "${PF_SKIP_SANITIZE:-0}" != 1 ]; then
   check "unit tests under ASan + UBSan (scripts/sanitize.sh)" bash scripts/sanitize.sh
 fi
+no_long_functions() { /usr/bin/python3 scripts/long_functions.py --max 80 $(git ls-files 'src/*.cc'); }
+check "no function in src/ longer than 80 lines" no_long_functions
 check "clang-format clean" clang_format_clean
+# The README followed as a user follows it, from clean builds (about 10 minutes;
+# PF_SKIP_WALKTHROUGH=1 skips it in a hurry).
+if [ "${PF_SKIP_WALKTHROUGH:-0}" != 1 ]; then
+  check "the README, step by step (scripts/readme_walkthrough.sh)" bash scripts/readme_walkthrough.sh
+fi
 
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ] && [ "$passed" -gt 0 ]

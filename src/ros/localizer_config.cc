@@ -219,90 +219,96 @@ pf::Parameter<LocalizerConfig> initialCovRow(int i, pf::ParamInfo info) {
       [i](LocalizerConfig& c, const double& v) { c.initial_cov(i, i) = v; }, std::move(info));
 }
 
+using C = LocalizerConfig;
+using I = pf::ParamInfo;
+using pf::Range;
+
+pf::ParameterTable<C> frameParameters() {
+  return {pf::member(&C::global_frame,
+                     I("global_frame", "", "frame of the map and the published estimates")
+                         .amclAlias("global_frame_id")),
+          pf::member(&C::odom_frame,
+                     I("odom_frame", "", "frame of the wheel odometry").amclAlias("odom_frame_id")),
+          pf::member(&C::base_frame,
+                     I("base_frame", "", "the robot's body frame (odom -> it is odometry)")
+                         .amclAlias("base_frame_id"))};
+}
+
+pf::ParameterTable<C> outputParameters() {
+  return {
+      pf::member(&C::tf_broadcast, I("tf_broadcast", "", "publish map -> odom on tf").amcl()),
+      pf::member(&C::transform_tolerance,
+                 I("transform_tolerance", "s",
+                   "map -> odom is stamped this far ahead, so tf users never extrapolate")
+                     .in(Range::atLeast(0))
+                     .amcl()
+                     .live(0, 10)),
+      pf::member(&C::gui_publish_rate,
+                 I("gui_publish_rate", "Hz", "particlecloud messages per second at most")
+                     .in(Range::any())
+                     .withNote("<= 0: one per update")
+                     .amcl()
+                     .live(-1, 100)),
+      pf::member(&C::save_pose_rate,
+                 I("save_pose_rate", "Hz",
+                   "the pose is saved to ~initial_pose_* this often, for a restarted node")
+                     .in(Range::any())
+                     .withNote("<= 0: never")
+                     .amcl()),
+      pf::member(&C::max_update_time,
+                 I("max_update_time", "s",
+                   "cap the particle count so that an update takes this long at p95")
+                     .in(Range{-Range::kInf, 10.0})
+                     .withNote("<= 0: no cap")
+                     .live(0, 10)),
+      pf::member(&C::first_map_only,
+                 I("first_map_only", "", "ignore maps after the first on the map topic").amcl()),
+      // Read by readConfig itself: false sets first_map_only, with a note.
+      pf::computed<C, bool>(
+          [](const C&) { return true; }, [](C&, const bool&) {},
+          I("use_map_topic", "", "false: keep the first map, as amcl does without the topic")
+              .amcl())};
+}
+
+pf::ParameterTable<C> initialPoseParameters() {
+  return {
+      initialPoseRow(&pf::Pose2::x, I("initial_pose_x", "m", "initial x in global_frame")
+                                        .in(Range::any())
+                                        .unsetMeans("global localization")
+                                        .amcl()),
+      initialPoseRow(&pf::Pose2::y, I("initial_pose_y", "m", "initial y in global_frame")
+                                        .in(Range::any())
+                                        .unsetMeans("global localization")
+                                        .amcl()),
+      initialPoseRow(&pf::Pose2::yaw,
+                     I("initial_pose_a", "rad", "initial yaw").in(Range::any()).amcl()),
+      initialCovRow(
+          0, I("initial_cov_xx", "m^2", "variance of the initial x").in(Range::atLeast(0)).amcl()),
+      initialCovRow(
+          1, I("initial_cov_yy", "m^2", "variance of the initial y").in(Range::atLeast(0)).amcl()),
+      initialCovRow(2, I("initial_cov_aa", "rad^2", "variance of the initial yaw")
+                           .in(Range::atLeast(0))
+                           .amcl())};
+}
+
+pf::ParameterTable<C> scanParameters() {
+  return {
+      pf::member(&C::deskew_scans,
+                 I("deskew_scans", "",
+                   "place each beam from where the laser was when it took it (time_increment)")),
+      pf::member(&C::scan_stamp,
+                 I("scan_stamp", "", "which beam a scan's stamp is the time of, for deskew_scans")
+                     .oneOf({"first_beam", "last_beam"}))};
+}
+
 // The rows of LocalizerConfig's own members (the filter's are particleFilterParameters()).
-const pf::ParameterTable<LocalizerConfig>& ownParameters() {
-  using C = LocalizerConfig;
-  using I = pf::ParamInfo;
-  using pf::Range;
+const pf::ParameterTable<C>& ownParameters() {
   static const pf::ParameterTable<C> table = [] {
     pf::ParameterTable<C> t;
-    pf::append(
-        &t,
-        {pf::member(&C::global_frame, I("global_frame", "",
-                                        "frame of the map and the "
-                                        "published estimates")
-                                          .amclAlias("global_frame_id")),
-         pf::member(&C::odom_frame,
-                    I("odom_frame", "", "frame of the wheel odometry").amclAlias("odom_frame_id")),
-         pf::member(&C::base_frame,
-                    I("base_frame", "", "the robot's body frame (odom -> it is odometry)")
-                        .amclAlias("base_frame_id"))},
-        "frames");
-    pf::append(
-        &t,
-        {pf::member(&C::tf_broadcast, I("tf_broadcast", "", "publish map -> odom on tf").amcl()),
-         pf::member(&C::transform_tolerance,
-                    I("transform_tolerance", "s",
-                      "map -> odom is stamped this far ahead, so tf users never extrapolate")
-                        .in(Range::atLeast(0))
-                        .amcl()
-                        .live(0, 10)),
-         pf::member(&C::gui_publish_rate,
-                    I("gui_publish_rate", "Hz", "particlecloud messages per second at most")
-                        .in(Range::any())
-                        .withNote("<= 0: one per update")
-                        .amcl()
-                        .live(-1, 100)),
-         pf::member(&C::save_pose_rate,
-                    I("save_pose_rate", "Hz",
-                      "the pose is saved to ~initial_pose_* this often, for a restarted node")
-                        .in(Range::any())
-                        .withNote("<= 0: never")
-                        .amcl()),
-         pf::member(&C::max_update_time,
-                    I("max_update_time", "s",
-                      "cap the particle count so that an update takes this long at p95")
-                        .in(Range{-Range::kInf, 10.0})
-                        .withNote("<= 0: no cap")
-                        .live(0, 10)),
-         pf::member(&C::first_map_only,
-                    I("first_map_only", "", "ignore maps after the first on the map topic").amcl()),
-         pf::computed<C, bool>(
-             [](const C&) { return true; }, [](C&, const bool&) {},
-             I("use_map_topic", "", "false: keep the first map, as amcl does without the topic")
-                 .amcl())},
-        "output");
-    pf::append(
-        &t,
-        {initialPoseRow(&pf::Pose2::x, I("initial_pose_x", "m", "initial x in global_frame")
-                                           .in(Range::any())
-                                           .unsetMeans("global localization")
-                                           .amcl()),
-         initialPoseRow(&pf::Pose2::y, I("initial_pose_y", "m", "initial y in global_frame")
-                                           .in(Range::any())
-                                           .unsetMeans("global localization")
-                                           .amcl()),
-         initialPoseRow(&pf::Pose2::yaw,
-                        I("initial_pose_a", "rad", "initial yaw").in(Range::any()).amcl()),
-         initialCovRow(
-             0,
-             I("initial_cov_xx", "m^2", "variance of the initial x").in(Range::atLeast(0)).amcl()),
-         initialCovRow(
-             1,
-             I("initial_cov_yy", "m^2", "variance of the initial y").in(Range::atLeast(0)).amcl()),
-         initialCovRow(2, I("initial_cov_aa", "rad^2", "variance of the initial yaw")
-                              .in(Range::atLeast(0))
-                              .amcl())},
-        "initial_pose");
-    pf::append(
-        &t,
-        {pf::member(&C::deskew_scans,
-                    I("deskew_scans", "",
-                      "place each beam from where the laser was when it took it (time_increment)")),
-         pf::member(&C::scan_stamp, I("scan_stamp", "",
-                                      "which beam a scan's stamp is the time of, for deskew_scans")
-                                        .oneOf({"first_beam", "last_beam"}))},
-        "scan");
+    pf::append(&t, frameParameters(), "frames");
+    pf::append(&t, outputParameters(), "output");
+    pf::append(&t, initialPoseParameters(), "initial_pose");
+    pf::append(&t, scanParameters(), "scan");
     return t;
   }();
   return table;
