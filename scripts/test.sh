@@ -105,6 +105,9 @@ fi
 no_long_functions() { /usr/bin/python3 scripts/long_functions.py --max 80 $(git ls-files 'src/*.cc'); }
 check "no function in src/ longer than 80 lines" no_long_functions
 check "clang-format clean" clang_format_clean
+# The rviz workflow in a real rviz under Xvfb (about 45 s).
+check "rviz: 2D Pose Estimate clicked re-initialises pf_node (scripts/rviz_click_test.sh)" \
+  bash scripts/rviz_click_test.sh --out "$ws/rviz_click_test"
 # The README followed as a user follows it, from clean builds (about 10 minutes;
 # PF_SKIP_WALKTHROUGH=1 skips it in a hurry).
 if [ "${PF_SKIP_WALKTHROUGH:-0}" != 1 ]; then
