@@ -819,25 +819,20 @@ def save_study_plots(study, out, say=print):
     pngs = []
     with warnings.catch_warnings():
         warnings.simplefilter('ignore')
-        try:
-            ax = ovm.plot_optimization_history(study)
-            ax.figure.set_size_inches(8, 4.5)
-            ax.figure.tight_layout()
-            ax.figure.savefig(os.path.join(out, 'history.png'), dpi=100)
-            plt.close(ax.figure)
-            pngs.append(('Optimisation history', 'history.png'))
-        except Exception as e:
-            say('pf_tune: warning: no history plot: %s' % e)
-        try:
-            ax = ovm.plot_param_importances(study)
-            ax.figure.set_size_inches(8, 4.5)
-            ax.figure.tight_layout()
-            ax.figure.savefig(os.path.join(out, 'importances.png'), dpi=100)
-            plt.close(ax.figure)
-            pngs.append(('Parameter importances (fANOVA)', 'importances.png'))
-        except Exception as e:
-            say('pf_tune: warning: no importance plot (needs at least two distinct completed trials and '
-                'scikit-learn): %s' % e)
+        plots = [(ovm.plot_optimization_history, 'history.png', 'Optimisation history',
+                  'no history plot'),
+                 (ovm.plot_param_importances, 'importances.png', 'Parameter importances (fANOVA)',
+                  'no importance plot (needs at least two distinct completed trials and scikit-learn)')]
+        for plot, name, title, failed in plots:
+            try:
+                ax = plot(study)
+                ax.figure.set_size_inches(8, 4.5)
+                ax.figure.tight_layout()
+                ax.figure.savefig(os.path.join(out, name), dpi=100)
+                plt.close(ax.figure)
+                pngs.append((title, name))
+            except Exception as e:
+                say('pf_tune: warning: %s: %s' % (failed, e))
     return pngs
 
 
