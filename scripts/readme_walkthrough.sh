@@ -28,9 +28,8 @@
 # failed"; exits 1 if any check failed. Everything it makes (the two
 # workspaces, logs, outputs) is in one temporary folder, removed at the end
 # unless --keep (or a failure) says otherwise; demo.sh writes its report to
-# reports/tracking/ as it does for a user. Two builds from scratch: 9.5
-# minutes on a shared two-core machine (load 4), 30 s of it for each node
-# whose --help waited for a ROS master.
+# reports/tracking/ as it does for a user. Two builds from scratch: about 9
+# minutes on a shared two-core machine (load 4).
 set -uo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 keep=0 only=()

@@ -25,7 +25,7 @@ NAME = 'bad_params_checker'
 
 # (what, {parameter: value}, texts the message must contain)
 CASES = [
-    ('negative particle count', {'max_particles': -5}, ['max_particles', '>= min_particles']),
+    ('negative particle count', {'max_particles': -5}, ['max_particles = -5', 'must be >= 1 (particles)']),
     ('min_particles above max_particles', {'min_particles': 1000, 'max_particles': 100},
      ['max_particles', '>= min_particles (1000)']),
     ('zero min_particles', {'min_particles': 0}, ['min_particles', '>= 1']),
@@ -35,9 +35,11 @@ CASES = [
     ('z weights summing to 0', {'laser_z_hit': 0.0, 'laser_z_rand': 0.0},
      ['laser_z_hit + laser_z_rand', '> 0']),
     ('negative z weight', {'laser_z_rand': -0.5}, ['laser_z_rand', '>= 0']),
-    ('unknown odometry model', {'odom_model_type': 'tank'}, ['odom_model_type', 'diff or omni']),
-    ('negative refinement bound', {'refine_max_translation': -0.5},
-     ['refine_max_translation', '>= 0']),
+    ('unknown odometry model', {'odom_model_type': 'tank'},
+     ['odom_model_type', 'diff, diff-corrected, omni or omni-corrected']),
+    ('beam model rate of 0', {'laser_model_type': 'beam', 'laser_lambda_short': 0.0},
+     ['laser_lambda_short', '> 0 (1/m)']),
+    ('a word for a number', {'laser_sigma_hit': 'wide'}, ['laser_sigma_hit', 'expected a number']),
 ]
 
 

@@ -274,6 +274,10 @@ class PoseChecker:
                        float(param('initialpose_cov_aa', 0.06853891945200942)))
         self.ip_error = float(param('initialpose_error', 0.3))
         self.ip_timeout = float(param('initialpose_timeout', 10.0))
+        # Live parameters of pf_node to set right after the /initialpose (a
+        # dictionary; empty: none), e.g. update thresholds held off before it.
+        self.reconfigure_after_ip = dict(param('reconfigure_after_initialpose', {}) or {})
+        self.reconfigure_node = param('reconfigure_node', '/pf_node')
         self.wrong_min_error = float(param('wrong_min_error', 0.5))
         mcw = param('max_confidently_wrong', None)
         self.max_confidently_wrong = None if mcw in (None, '') else int(mcw)
@@ -404,6 +408,17 @@ class PoseChecker:
         self._process_pending(flush=True)
         return self.evaluate(end_reason)
 
+    def _reconfigure(self, values):
+        """Sets live parameters of pf_node through dynamic_reconfigure, as a user would."""
+        import dynamic_reconfigure.client
+        try:
+            client = dynamic_reconfigure.client.Client(self.reconfigure_node, timeout=10.0)
+            got = client.update_configuration(values)
+            self.ip_info.append('after the /initialpose, %s set to %s' % (
+                self.reconfigure_node, ', '.join('%s %s' % (k, got.get(k)) for k in sorted(values))))
+        except Exception as e:  # the test then fails on tracking, with this as the reason
+            self.ip_notes.append('could not reconfigure %s after the /initialpose: %s' % (self.reconfigure_node, e))
+
     # -- initialpose mode
     def _initialpose_step(self):
         if self.ip_sent is None:
@@ -437,6 +452,9 @@ class PoseChecker:
             self.ip_pub.publish(msg)
             with self.lock:
                 self.ip_sent = (msg.header.stamp, p, time.time())
+            if self.reconfigure_after_ip:
+                threading.Thread(target=self._reconfigure, args=(self.reconfigure_after_ip,),
+                                 daemon=True).start()
             rospy.loginfo('pose_checker: published /initialpose at t=%.2f s: x=%.3f y=%.3f yaw=%.3f (truth at t=%.2f s)',
                           self.rel(msg.header.stamp), p[0], p[1], p[2], t_gt)
             self.ip_info.append('/initialpose published at t=%.2f s (ground truth of t=%.2f s%s)' % (
