@@ -16,6 +16,9 @@
 #include "pf_localization/core/occupancy_grid.h"
 #include "pf_localization/core/odometry_motion_model.h"
 #include "pf_localization/core/particle_filter.h"
+#include "support/exception_message.h"
+#include "support/rooms.h"
+#include "support/scan_simulator.h"
 
 namespace pf {
 namespace {
@@ -24,40 +27,13 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr float kNaNf = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInff = std::numeric_limits<float>::infinity();
-constexpr double kRes = 0.05;
-constexpr int kW = 80, kH = 60;  // a 4 m x 3 m room with one-cell walls
 
-OccupancyGrid room() {
-  std::vector<int8_t> data(kW * kH, 0);
-  for (int y = 0; y < kH; ++y) {
-    for (int x = 0; x < kW; ++x) {
-      if (x == 0 || y == 0 || x == kW - 1 || y == kH - 1) data[y * kW + x] = 100;
-    }
-  }
-  return OccupancyGrid(kW, kH, kRes, {}, data);
-}
+// A 4 m x 3 m room with one-cell walls and nothing in it.
+OccupancyGrid room() { return test::room(4.0, 3.0, 0.05); }
 
 // 180 beams from a laser at the robot centre, each the exact distance to the
 // room's inner wall faces.
-LaserScan scanAt(const Pose2& robot) {
-  LaserScan scan;
-  scan.angle_min = -M_PI;
-  scan.angle_increment = 2.0 * M_PI / 180;
-  scan.range_min = 0.05;
-  scan.range_max = 8.0;
-  const double lo_x = kRes, hi_x = (kW - 1) * kRes, lo_y = kRes, hi_y = (kH - 1) * kRes;
-  for (int i = 0; i < 180; ++i) {
-    const double a = robot.yaw + scan.angle_min + i * scan.angle_increment;
-    const double c = std::cos(a), s = std::sin(a);
-    double t = kInf;
-    if (c > 1e-9) t = std::min(t, (hi_x - robot.x) / c);
-    if (c < -1e-9) t = std::min(t, (lo_x - robot.x) / c);
-    if (s > 1e-9) t = std::min(t, (hi_y - robot.y) / s);
-    if (s < -1e-9) t = std::min(t, (lo_y - robot.y) / s);
-    scan.ranges.push_back(static_cast<float>(t));
-  }
-  return scan;
-}
+LaserScan scanAt(const Pose2& robot) { return test::simulateScan(room(), robot); }
 
 ParticleFilterParams smallParams() {
   ParticleFilterParams p;
@@ -80,14 +56,7 @@ struct Fixture : ::testing::Test {
   ParticleFilter filter;
 };
 
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::exception& e) {
-    return e.what();
-  }
-  return "(no exception)";
-}
+using test::whatOf;
 
 // --- Scans ---------------------------------------------------------------------
 
@@ -263,7 +232,7 @@ TEST(BadMap, NoFreeCellMakesGlobalLocalizationThrowLogicError) {
   for (const int8_t v : {int8_t{100}, int8_t{-1}, int8_t{50}}) {
     ParticleFilter filter(smallParams());
     filter.setMap(OccupancyGrid(3, 2, 0.05, {}, std::vector<int8_t>(6, v)));
-    const std::string what = errorOf([&] { filter.initializeUniform(); });
+    const std::string what = whatOf([&] { filter.initializeUniform(); });
     EXPECT_NE(what.find("free cell"), std::string::npos) << what;
     EXPECT_THROW(filter.initializeUniform(), std::logic_error);
     EXPECT_FALSE(filter.isInitialized());
@@ -303,7 +272,7 @@ TEST(BadMap, GridConstructorNamesTheProblem) {
   };
   for (const auto& c : cases) {
     EXPECT_THROW(c.first(), std::invalid_argument) << c.second;
-    const std::string what = errorOf(c.first);
+    const std::string what = whatOf(c.first);
     EXPECT_NE(what.find(c.second), std::string::npos) << what;
   }
 }
@@ -336,7 +305,7 @@ TEST(BadInitialPose, NonFinitePoseOrBadCovarianceThrowsAndKeepsTheFilter) {
   };
   for (const auto& c : cases) {
     EXPECT_THROW(c.first(), std::invalid_argument) << c.second;
-    const std::string what = errorOf(c.first);
+    const std::string what = whatOf(c.first);
     EXPECT_NE(what.find(c.second), std::string::npos) << what;
   }
   // The cloud from the good initialisation is still there and usable.
@@ -420,7 +389,7 @@ TEST(BadParams, EachInvalidParameterThrowsNamingIt) {
     SCOPED_TRACE(c.name);
     EXPECT_THROW(validate(p), std::invalid_argument);
     EXPECT_THROW(ParticleFilter{p}, std::invalid_argument);
-    const std::string what = errorOf([&] { ParticleFilter filter(p); });
+    const std::string what = whatOf([&] { ParticleFilter filter(p); });
     EXPECT_NE(what.find(c.name), std::string::npos) << what;
   }
   EXPECT_NO_THROW(validate(smallParams()));
@@ -429,12 +398,12 @@ TEST(BadParams, EachInvalidParameterThrowsNamingIt) {
 TEST(BadParams, TheModelsRefuseBadParametersOnTheirOwn) {
   OdometryMotionParams m;
   m.alpha3 = -0.1;
-  const std::string what = errorOf([&] { OdometryMotionModel model(m); });
+  const std::string what = whatOf([&] { OdometryMotionModel model(m); });
   EXPECT_NE(what.find("odom_alpha3"), std::string::npos) << what;
 
   LikelihoodFieldModelParams s;
   s.sigma_hit = 0.0;
-  const std::string what2 = errorOf([&] { LikelihoodFieldModel model(room(), s); });
+  const std::string what2 = whatOf([&] { LikelihoodFieldModel model(room(), s); });
   EXPECT_NE(what2.find("laser_sigma_hit"), std::string::npos) << what2;
   s = LikelihoodFieldModelParams();
   s.z_hit = s.z_rand = 0.0;

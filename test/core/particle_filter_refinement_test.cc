@@ -1,61 +1,24 @@
 // ParticleFilter with refine_estimate: the scan fit of scan_refiner.h feeds
 // the published estimate and map -> odom (scan_refiner_test.cc tests the fit
-// itself). In a file of its own, with its own small world, so that it stays
+// itself). In a file of its own, in small_world.h's room, so that it stays
 // apart from the filter's other tests.
 #include <gtest/gtest.h>
 
 #include <Eigen/Eigenvalues>
 #include <cmath>
-#include <limits>
 #include <string>
 #include <vector>
 
 #include "expect_pose.h"
 #include "pf_localization/core/particle_filter.h"
+#include "small_world.h"
+#include "support/drive_and_track.h"
 
 namespace pf {
 namespace {
 
-constexpr double kRes = 0.05;
-
-// A 4 m x 3 m room in 0.05 m cells: one-cell walls, a box near its lower
-// right and a smaller one near its upper left.
-OccupancyGrid asymmetricRoom() {
-  const int w = 80, h = 60;
-  std::vector<int8_t> data(static_cast<std::size_t>(w) * h, 0);
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      const double cx = (x + 0.5) * kRes, cy = (y + 0.5) * kRes;
-      const bool wall = x == 0 || y == 0 || x == w - 1 || y == h - 1;
-      const bool box = cx > 2.5 && cx < 3.0 && cy > 0.5 && cy < 1.2;
-      const bool small_box = cx > 0.6 && cx < 1.0 && cy > 2.0 && cy < 2.4;
-      data[static_cast<std::size_t>(y) * w + x] = wall || box || small_box ? 100 : 0;
-    }
-  }
-  return OccupancyGrid(w, h, kRes, {}, data);
-}
-
-// 180 beams over a full turn from the robot's centre, ray cast in 1 mm steps.
-LaserScan castScan(const OccupancyGrid& grid, const Pose2& robot) {
-  LaserScan scan;
-  scan.angle_min = -M_PI;
-  scan.angle_increment = 2.0 * M_PI / 180;
-  scan.range_min = 0.05;
-  scan.range_max = 8.0;
-  scan.ranges.assign(180, std::numeric_limits<float>::quiet_NaN());
-  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
-    const double a = robot.yaw + scan.angle_min + i * scan.angle_increment;
-    for (double t = 0.0; t < scan.range_max; t += 0.001) {
-      const CellIndex c = grid.worldToCell(robot.x + t * std::cos(a), robot.y + t * std::sin(a));
-      if (!grid.contains(c)) break;
-      if (grid.state(c) == CellState::kOccupied) {
-        scan.ranges[i] = static_cast<float>(t);
-        break;
-      }
-    }
-  }
-  return scan;
-}
+using small_world::castScan;
+using small_world::kTruth;
 
 ParticleFilterParams params() {
   ParticleFilterParams p;
@@ -66,11 +29,10 @@ ParticleFilterParams params() {
   return p;
 }
 
-// The odometry frame: odom = kOdomInMap^-1 (+) truth.
+// The odometry frame is not the map frame: map -> odom is kOdomInMap.
 const Pose2 kOdomInMap{0.7, -0.4, 0.3};
-Pose2 odomOf(const Pose2& truth) { return compose(inverse(kOdomInMap), truth); }
+Pose2 odomOf(const Pose2& truth) { return test::odometryOf(truth, kOdomInMap); }
 
-const Pose2 kTruth{1.6, 1.4, 0.2};
 const Eigen::Matrix3d kStartCov =
     Eigen::Vector3d(0.05 * 0.05, 0.05 * 0.05, 0.03 * 0.03).asDiagonal();
 
@@ -82,7 +44,7 @@ void expectPositiveSemiDefinite(const Eigen::Matrix3d& m) {
 }
 
 TEST(ParticleFilterRefinement, TheFittedPoseIsPublishedThroughMapToOdom) {
-  const OccupancyGrid grid = asymmetricRoom();
+  const OccupancyGrid grid = small_world::room();
   ParticleFilter filter(params());
   filter.setMap(grid);
   filter.initializeGaussian({kTruth.x + 0.04, kTruth.y - 0.03, kTruth.yaw + 0.02}, kStartCov);
@@ -108,7 +70,7 @@ TEST(ParticleFilterRefinement, TheFittedPoseIsPublishedThroughMapToOdom) {
 }
 
 TEST(ParticleFilterRefinement, ScansBetweenUpdatesAreFittedAndStandingStillIsNot) {
-  const OccupancyGrid grid = asymmetricRoom();
+  const OccupancyGrid grid = small_world::room();
   ParticleFilter filter(params());
   filter.setMap(grid);
   filter.initializeGaussian(kTruth, kStartCov);
@@ -135,7 +97,7 @@ TEST(ParticleFilterRefinement, ScansBetweenUpdatesAreFittedAndStandingStillIsNot
 }
 
 TEST(ParticleFilterRefinement, AnOdometryFaultMakesTheFitStale) {
-  const OccupancyGrid grid = asymmetricRoom();
+  const OccupancyGrid grid = small_world::room();
   ParticleFilter filter(params());
   filter.setMap(grid);
   filter.initializeGaussian(kTruth, kStartCov);
@@ -149,7 +111,7 @@ TEST(ParticleFilterRefinement, AnOdometryFaultMakesTheFitStale) {
 }
 
 TEST(ParticleFilterRefinement, OffPublishesTheCloudsMean) {
-  const OccupancyGrid grid = asymmetricRoom();
+  const OccupancyGrid grid = small_world::room();
   ParticleFilterParams p = params();
   p.refine_estimate = false;
   ParticleFilter filter(p);
@@ -164,7 +126,7 @@ TEST(ParticleFilterRefinement, OffPublishesTheCloudsMean) {
 }
 
 TEST(ParticleFilterRefinement, ALostFilterIsNotRefined) {
-  const OccupancyGrid grid = asymmetricRoom();
+  const OccupancyGrid grid = small_world::room();
   ParticleFilter filter(params());
   filter.setMap(grid);
   filter.initializeGaussian(kTruth, kStartCov);

@@ -4,10 +4,14 @@
 
 #include <cmath>
 #include <functional>
-#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "support/drive_and_track.h"
+#include "support/exception_message.h"
+#include "support/rooms.h"
+#include "support/scan_simulator.h"
 
 namespace pf {
 namespace {
@@ -16,65 +20,29 @@ constexpr double kRes = 0.05;
 
 // --- A synthetic world ---------------------------------------------------------
 
-// A room of width x height metres in 0.05 m cells, with one-cell walls on its
-// border and the given boxes (x0, y0, x1, y1 in metres) filled.
-struct Box {
-  double x0, y0, x1, y1;
-};
-
-OccupancyGrid room(double width, double height, const std::vector<Box>& boxes) {
-  const int w = static_cast<int>(std::lround(width / kRes));
-  const int h = static_cast<int>(std::lround(height / kRes));
-  std::vector<int8_t> data(static_cast<std::size_t>(w) * h, 0);
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      const double cx = (x + 0.5) * kRes, cy = (y + 0.5) * kRes;
-      bool occupied = x == 0 || y == 0 || x == w - 1 || y == h - 1;
-      for (const Box& b : boxes) {
-        occupied = occupied || (cx > b.x0 && cx < b.x1 && cy > b.y0 && cy < b.y1);
-      }
-      data[static_cast<std::size_t>(y) * w + x] = occupied ? 100 : 0;
-    }
-  }
-  return OccupancyGrid(w, h, kRes, {}, data);
+// test/support's rooms: a room of width x height metres in 0.05 m cells, with
+// one-cell walls and the given boxes filled.
+OccupancyGrid room(double width, double height, const std::vector<test::Box>& boxes) {
+  return test::room(width, height, kRes, boxes);
 }
 
-// A 4 m x 3 m room with a box near its lower right and a smaller one near its
-// upper left, so that no rotation or mirror image of it looks the same.
-OccupancyGrid trackingRoom() {
-  return room(4.0, 3.0, {{2.5, 0.5, 3.0, 1.2}, {0.6, 2.0, 1.0, 2.4}});
-}
+// The room most tests drive in: 4 m x 3 m, two boxes, nothing symmetric.
+using test::asymmetricRoom;
 
 // 360 degrees, 2 degrees apart, from a laser 0.1 m ahead of the robot centre.
-LaserScan emptyScan() {
-  LaserScan scan;
-  scan.angle_min = -M_PI;
-  scan.angle_increment = 2.0 * M_PI / 180;
-  scan.range_min = 0.05;
-  scan.range_max = 8.0;
-  scan.sensor_pose = {0.1, 0.0, 0.0};
-  scan.ranges.assign(180, std::numeric_limits<float>::quiet_NaN());
-  return scan;
+test::ScanSpec laserAhead() {
+  test::ScanSpec spec;
+  spec.sensor_pose = {0.1, 0.0, 0.0};
+  return spec;
 }
 
-// Ray casting by small steps: the range to the first occupied cell along each
-// beam, or NaN (no return) when the beam leaves the map first.
+// That laser's scan with no return on any beam (180 NaN ranges).
+LaserScan emptyScan() { return test::noReturnScan(laserAhead()); }
+
+// The exact range to the first occupied cell along each beam, or NaN (no
+// return) when the beam leaves the map first.
 LaserScan simulateScan(const OccupancyGrid& grid, const Pose2& robot) {
-  LaserScan scan = emptyScan();
-  const Pose2 laser = compose(robot, scan.sensor_pose);
-  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
-    const double bearing = laser.yaw + scan.angle_min + i * scan.angle_increment;
-    const double c = std::cos(bearing), s = std::sin(bearing);
-    for (double t = 0.0; t < scan.range_max; t += 0.002) {
-      const CellIndex cell = grid.worldToCell(laser.x + t * c, laser.y + t * s);
-      if (!grid.contains(cell)) break;
-      if (grid.state(cell) == CellState::kOccupied) {
-        scan.ranges[i] = static_cast<float>(t);
-        break;
-      }
-    }
-  }
-  return scan;
+  return test::simulateScan(grid, robot, laserAhead());
 }
 
 ParticleFilterParams baseParams() {
@@ -91,25 +59,25 @@ Eigen::Matrix3d diag(double sx, double sy, double syaw) {
 
 double distance(const Pose2& a, const Pose2& b) { return std::hypot(a.x - b.x, a.y - b.y); }
 
-// The odometry frame is not the map frame: odom = kOdomInMap^-1 (+) truth,
-// so map -> odom is kOdomInMap.
+// The odometry frame is not the map frame: map -> odom is kOdomInMap.
 const Pose2 kOdomInMap{0.7, -0.4, 0.3};
-Pose2 odomOf(const Pose2& truth) { return compose(inverse(kOdomInMap), truth); }
+Pose2 odomOf(const Pose2& truth) { return test::odometryOf(truth, kOdomInMap); }
+
+// Drives `path` with the laser ahead, the odometry in kOdomInMap.
+test::TrackingRun track(ParticleFilter* filter, const OccupancyGrid& grid,
+                        const std::vector<Pose2>& path) {
+  test::ScanSimulator scans(grid, laserAhead());
+  return test::driveAndTrack(filter, path, &scans, kOdomInMap);
+}
 
 // A gently curving drive, 0.25 m per step, starting at (1, 1.5) facing +x.
 std::vector<Pose2> trackingPath(int steps) {
-  std::vector<Pose2> path{{1.0, 1.5, 0.0}};
-  for (int k = 1; k <= steps; ++k) path.push_back(compose(path.back(), {0.25, 0.0, 0.05}));
-  return path;
+  return test::stepPath({1.0, 1.5, 0.0}, {0.25, 0.0, 0.05}, steps);
 }
 
+// The message of the std::invalid_argument `f` throws ("" for none).
 std::string whatOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const std::invalid_argument& e) {
-    return e.what();
-  }
-  return "";
+  return test::whatOf<std::invalid_argument>(f);
 }
 
 // --- Parameters ----------------------------------------------------------------
@@ -271,7 +239,7 @@ TEST(ParticleFilter, InitializeGaussianRejectsBadInput) {
 
 TEST(ParticleFilter, InitializeUniformFillsFreeSpaceOnly) {
   ParticleFilter filter(baseParams());
-  const OccupancyGrid grid = trackingRoom();
+  const OccupancyGrid grid = asymmetricRoom();
   EXPECT_FALSE(filter.setMap(grid));  // nothing to keep yet
   ASSERT_TRUE(filter.hasMap());
   EXPECT_EQ(grid.width(), filter.map()->width());
@@ -302,21 +270,21 @@ TEST(ParticleFilter, InitializeUniformFillsFreeSpaceOnly) {
 TEST(ParticleFilterUpdate, SkipsWithoutMap) {
   ParticleFilter filter(baseParams());
   filter.initializeGaussian({1.0, 1.5, 0.0}, diag(0.1, 0.1, 0.1));
-  const UpdateReport r = filter.update({0, 0, 0}, simulateScan(trackingRoom(), {1.0, 1.5, 0.0}));
+  const UpdateReport r = filter.update({0, 0, 0}, simulateScan(asymmetricRoom(), {1.0, 1.5, 0.0}));
   EXPECT_FALSE(r.updated);
   EXPECT_EQ(SkipReason::kNoMap, r.skip_reason) << skipMessage(r);
 }
 
 TEST(ParticleFilterUpdate, SkipsWhenNotInitialised) {
   ParticleFilter filter(baseParams());
-  filter.setMap(trackingRoom());
-  const UpdateReport r = filter.update({0, 0, 0}, simulateScan(trackingRoom(), {1.0, 1.5, 0.0}));
+  filter.setMap(asymmetricRoom());
+  const UpdateReport r = filter.update({0, 0, 0}, simulateScan(asymmetricRoom(), {1.0, 1.5, 0.0}));
   EXPECT_FALSE(r.updated);
   EXPECT_EQ(SkipReason::kNotInitialized, r.skip_reason) << skipMessage(r);
 }
 
 TEST(ParticleFilterUpdate, SkipsBadScansAndBadOdometry) {
-  const OccupancyGrid grid = trackingRoom();
+  const OccupancyGrid grid = asymmetricRoom();
   ParticleFilter filter(baseParams());
   filter.setMap(grid);
   filter.initializeGaussian({1.0, 1.5, 0.0}, diag(0.1, 0.1, 0.1));
@@ -346,7 +314,7 @@ TEST(ParticleFilterUpdate, SkipsBadScansAndBadOdometry) {
 }
 
 TEST(ParticleFilterUpdate, RunsOnTheFirstScanThenOnlyAfterMotion) {
-  const OccupancyGrid grid = trackingRoom();
+  const OccupancyGrid grid = asymmetricRoom();
   ParticleFilterParams params = baseParams();  // update_min_d 0.2 m, update_min_a pi/6
   // The odometry below moves while the scan stays: only the thresholds are
   // under test here, not the check that the scan still fits (see
@@ -391,7 +359,7 @@ TEST(ParticleFilterUpdate, RunsOnTheFirstScanThenOnlyAfterMotion) {
 }
 
 TEST(ParticleFilterUpdate, NanOnlyScanIsSkippedWithAReason) {
-  const OccupancyGrid grid = trackingRoom();
+  const OccupancyGrid grid = asymmetricRoom();
   ParticleFilter filter(baseParams());
   filter.setMap(grid);
   filter.initializeGaussian({1.0, 1.5, 0.0}, diag(0.1, 0.1, 0.1));
@@ -458,7 +426,7 @@ TEST(ParticleFilterUpdate, ACollapsedFitSpreadsTheSurvivors) {
   // Expansion resetting: tracking well at `start`, then the robot is pushed
   // 0.5 m sideways without odometry seeing it. That scan fits far worse than
   // usual, and the resampled particles are spread to search nearby.
-  const OccupancyGrid grid = trackingRoom();
+  const OccupancyGrid grid = asymmetricRoom();
   ParticleFilterParams params = recoveryParams();
   params.recovery.expansion_ratio = 0.3;
   params.recovery.expansion_std_xy = 0.3;
@@ -490,9 +458,9 @@ std::size_t injectedAfterScansStopFitting(const OccupancyGrid& grid) {
   ParticleFilter filter(recoveryParams());
   filter.setMap(grid);
   filter.initializeGaussian(kTracked, Eigen::Matrix3d::Zero());
-  const LaserScan good = simulateScan(trackingRoom(), kTracked);
+  const LaserScan good = simulateScan(asymmetricRoom(), kTracked);
   for (int k = 0; k < 5; ++k) EXPECT_TRUE(filter.update({0.0, 0.0, 0.0}, good).updated);
-  const LaserScan moved = simulateScan(trackingRoom(), kMoved);
+  const LaserScan moved = simulateScan(asymmetricRoom(), kMoved);
   std::size_t injected = 0;
   for (int k = 0; k < 5; ++k) {
     const UpdateReport r = filter.update({0.0, 0.0, 0.0}, moved);
@@ -509,7 +477,7 @@ std::size_t injectedAfterScansStopFitting(const OccupancyGrid& grid) {
 TEST(ParticleFilterUpdate, RecoveryInjectsOnlyWhereThereIsFreeSpace) {
   // The same room and scans, once as mapped and once with every free cell
   // unknown (found by fuzz_core: drawing from an empty free-cell list).
-  const OccupancyGrid mapped = trackingRoom();
+  const OccupancyGrid mapped = asymmetricRoom();
   std::vector<int8_t> data(mapped.data());
   for (int8_t& v : data) v = v == 0 ? -1 : v;
   const OccupancyGrid no_free(mapped.width(), mapped.height(), kRes, {}, data);
@@ -522,7 +490,7 @@ TEST(ParticleFilterUpdate, RecoveryInjectsOnlyWhereThereIsFreeSpace) {
 // carried from kTracked to kMoved, for a filter of at least 500 and at most
 // `max_particles` particles and the given lost_share.
 std::size_t injectedOnTheFirstLostScan(std::size_t max_particles, double lost_share) {
-  const OccupancyGrid grid = trackingRoom();
+  const OccupancyGrid grid = asymmetricRoom();
   ParticleFilterParams params = recoveryParams();
   params.kld.max_particles = static_cast<int>(max_particles);
   params.recovery.lost_share = lost_share;
@@ -552,7 +520,7 @@ TEST(ParticleFilterUpdate, ACompactCloudThatIsLostSearchesAtOnceWithItsShareOfTh
 TEST(ParticleFilterUpdate, InjectedParticlesWeighTheKidnapPriorTogether) {
   // Mixture-proposal weights: whatever their number, the random particles
   // hold kidnap_prior of the weight and the survivors the rest.
-  const OccupancyGrid grid = trackingRoom();
+  const OccupancyGrid grid = asymmetricRoom();
   ParticleFilterParams params = recoveryParams();
   params.recovery.kidnap_prior = 0.01;
   ParticleFilter filter(params);
@@ -573,7 +541,7 @@ TEST(ParticleFilterUpdate, RecoveryGuessesDoNotTemperTheNextScanAway) {
   // weights' effective sample size is below N. Tempering keeps a share of
   // that ESS; measured against N instead, a share above ESS / N could never
   // be kept, and every scan was tempered to an exponent of 0: ignored.
-  const OccupancyGrid grid = trackingRoom();
+  const OccupancyGrid grid = asymmetricRoom();
   ParticleFilterParams params = recoveryParams();
   params.tempering_ess_fraction = params.tempering_ess_fraction_uncertain = 0.99;
   ParticleFilter filter(params);
@@ -592,7 +560,7 @@ TEST(ParticleFilterUpdate, RecoveryGuessesDoNotTemperTheNextScanAway) {
 // Gaussian of std `spread` m at the truth, tempering to keep 0.9 of the
 // effective particles while uncertain (and none while localized).
 double secondTempering(double spread, Confidence* after_first) {
-  const OccupancyGrid grid = trackingRoom();
+  const OccupancyGrid grid = asymmetricRoom();
   ParticleFilterParams params = baseParams();
   params.kld.min_particles = params.kld.max_particles = 1000;
   params.tempering_ess_fraction = 0.0;
@@ -618,26 +586,40 @@ TEST(ParticleFilterUpdate, AWideCloudWhoseBeamsFitIsNotTempered) {
   EXPECT_NE(std::string::npos, c.reason.find("spread")) << c.reason;
 }
 
-// The share of particles the filter gives to odometry faults after each of
-// `steps` updates in which the odometry reports 0.3 m forwards along x and the
-// scans are taken at `truth_step` metres per update from `start`.
-std::vector<double> faultShares(double truth_step, int steps, double odom_step = 0.3) {
-  const OccupancyGrid grid = trackingRoom();
+// Where the odometry fault and fit tests start, every particle there.
+const Pose2 kAtRest{1.5, 1.5, 0.0};
+
+// Gives `filter` the map `grid`, puts every particle at kAtRest and updates
+// on the scan taken there, with the odometry at its origin.
+UpdateReport firstUpdateAtRest(ParticleFilter* filter, const OccupancyGrid& grid) {
+  filter->setMap(grid);
+  filter->initializeGaussian(kAtRest, Eigen::Matrix3d::Zero());
+  return filter->update({0.0, 0.0, 0.0}, simulateScan(grid, kAtRest));
+}
+
+// exactParams with 1000 particles, of which odometry faults get 0.02 to 0.5.
+ParticleFilterParams faultParams() {
   ParticleFilterParams params = exactParams();
   params.kld.min_particles = params.kld.max_particles = 1000;
-  params.update_min_d = 0.0;  // every step updates, however short
   params.motion.fault_fraction = 0.02;
   params.motion.fault_fraction_max = 0.5;
+  return params;
+}
+
+// The share of particles the filter gives to odometry faults after each of
+// `steps` updates in which the odometry reports 0.3 m forwards along x and the
+// scans are taken at `truth_step` metres per update from kAtRest.
+std::vector<double> faultShares(double truth_step, int steps, double odom_step = 0.3) {
+  const OccupancyGrid grid = asymmetricRoom();
+  ParticleFilterParams params = faultParams();
+  params.update_min_d = 0.0;  // every step updates, however short
   params.motion.fault_margin = 0.05;
   ParticleFilter filter(params);
-  filter.setMap(grid);
-  const Pose2 start{1.5, 1.5, 0.0};
-  filter.initializeGaussian(start, Eigen::Matrix3d::Zero());
-  filter.update({0.0, 0.0, 0.0}, simulateScan(grid, start));
+  firstUpdateAtRest(&filter, grid);
   std::vector<double> shares;
   for (int k = 1; k <= steps; ++k) {
-    const UpdateReport r = filter.update(
-        {odom_step * k, 0.0, 0.0}, simulateScan(grid, {start.x + truth_step * k, start.y, 0.0}));
+    const Pose2 truth{kAtRest.x + truth_step * k, kAtRest.y, 0.0};
+    const UpdateReport r = filter.update({odom_step * k, 0.0, 0.0}, simulateScan(grid, truth));
     EXPECT_TRUE(r.updated) << skipMessage(r);
     shares.push_back(r.fault_fraction);
   }
@@ -666,21 +648,15 @@ TEST(ParticleFilterUpdate, TheFaultShareRisesWhileTheOdometryIsReversedAndFallsB
 // after one forced update on which the robot moved `truth_step` while the
 // odometry said 0.3 m forwards.
 bool updatesOnAShortStepAfter(double truth_step) {
-  const OccupancyGrid grid = trackingRoom();
-  ParticleFilterParams params = exactParams();
-  params.kld.min_particles = params.kld.max_particles = 1000;
+  const OccupancyGrid grid = asymmetricRoom();
+  ParticleFilterParams params = faultParams();
   params.update_min_d = 1.0;
   params.update_min_a = 1.0;
-  params.motion.fault_fraction = 0.02;
-  params.motion.fault_fraction_max = 0.5;
   params.motion.fault_suspect_fraction = 0.1;
   ParticleFilter filter(params);
-  filter.setMap(grid);
-  const Pose2 start{1.5, 1.5, 0.0};
-  filter.initializeGaussian(start, Eigen::Matrix3d::Zero());
-  filter.update({0.0, 0.0, 0.0}, simulateScan(grid, start));
+  firstUpdateAtRest(&filter, grid);
   filter.requestNoMotionUpdate();
-  const Pose2 truth{start.x + truth_step, start.y, 0.0};
+  const Pose2 truth{kAtRest.x + truth_step, kAtRest.y, 0.0};
   EXPECT_TRUE(filter.update({0.3, 0.0, 0.0}, simulateScan(grid, truth)).updated);
   const UpdateReport next =
       filter.update({0.6, 0.0, 0.0}, simulateScan(grid, {truth.x + truth_step, truth.y, 0.0}));
@@ -699,16 +675,14 @@ TEST(ParticleFilterUpdate, SuspectOdometryUpdatesOnEveryScan) {
 // `truth_step` m forward while the odometry counted 0.15 m (below
 // update_min_d 0.2 m).
 UpdateReport shortStepUpdate(double truth_step, double fit_drop) {
-  const OccupancyGrid grid = trackingRoom();
+  const OccupancyGrid grid = asymmetricRoom();
   ParticleFilterParams params = exactParams();
   params.update_fit_drop = fit_drop;
   params.update_fit_distance = 0.1;
   ParticleFilter filter(params);
-  filter.setMap(grid);
-  const Pose2 start{1.5, 1.5, 0.0};
-  filter.initializeGaussian(start, Eigen::Matrix3d::Zero());
-  EXPECT_TRUE(filter.update({0.0, 0.0, 0.0}, simulateScan(grid, start)).updated);
-  return filter.update({0.15, 0.0, 0.0}, simulateScan(grid, {start.x + truth_step, start.y, 0.0}));
+  EXPECT_TRUE(firstUpdateAtRest(&filter, grid).updated);
+  return filter.update({0.15, 0.0, 0.0},
+                       simulateScan(grid, {kAtRest.x + truth_step, kAtRest.y, 0.0}));
 }
 
 TEST(ParticleFilterUpdate, AScanThatStopsFittingThePredictedPoseUpdatesAtOnce) {
@@ -735,7 +709,7 @@ TEST(ParticleFilterUpdate, AScanThatStopsFittingThePredictedPoseUpdatesAtOnce) {
 // "uncertain" once the dip has lasted more than `patience` updates).
 int updatesBeforeInjection(int patience, LocalizationState state = LocalizationState::kUncertain,
                            int patience_localized = 10) {
-  const OccupancyGrid grid = trackingRoom();
+  const OccupancyGrid grid = asymmetricRoom();
   ParticleFilterParams params = recoveryParams();
   params.recovery.patience = patience;
   params.recovery.patience_localized = patience_localized;
@@ -775,7 +749,7 @@ TEST(ParticleFilterUpdate, AFilterThatIsLocalizedWaitsLongerBeforeInjecting) {
 }
 
 TEST(ParticleFilterUpdate, MotionIsAppliedFromTheLastUpdateOnly) {
-  const OccupancyGrid grid = trackingRoom();
+  const OccupancyGrid grid = asymmetricRoom();
   ParticleFilter filter(exactParams());
   filter.setMap(grid);
   const Pose2 start{1.0, 1.5, 0.2};
@@ -812,7 +786,7 @@ TEST(ParticleFilterUpdate, MotionIsAppliedFromTheLastUpdateOnly) {
 }
 
 TEST(ParticleFilter, MapToOdomIsEstimateComposedWithInverseOdometry) {
-  const OccupancyGrid grid = trackingRoom();
+  const OccupancyGrid grid = asymmetricRoom();
   ParticleFilter filter(baseParams());
   filter.setMap(grid);
   filter.initializeGaussian({1.0, 1.5, 0.0}, diag(0.05, 0.05, 0.05));
@@ -837,12 +811,11 @@ TEST(ParticleFilter, MapToOdomIsEstimateComposedWithInverseOdometry) {
 ParticleSet runTracking(uint64_t seed, int steps) {
   ParticleFilterParams params = baseParams();
   params.seed = seed;
-  const OccupancyGrid grid = trackingRoom();
+  const OccupancyGrid grid = asymmetricRoom();
   ParticleFilter filter(params);
   filter.setMap(grid);
-  const std::vector<Pose2> path = trackingPath(steps);
   filter.initializeGaussian({1.2, 1.3, 0.1}, diag(0.3, 0.3, 0.15));
-  for (const Pose2& truth : path) filter.update(odomOf(truth), simulateScan(grid, truth));
+  track(&filter, grid, trackingPath(steps));
   return filter.particles();
 }
 
@@ -861,24 +834,24 @@ TEST(ParticleFilter, SameSeedSameParticlesDifferentSeedDifferent) {
 // --- Localisation ----------------------------------------------------------------------
 
 TEST(ParticleFilter, TracksFromAnOffInitialGuess) {
-  const OccupancyGrid grid = trackingRoom();
+  const OccupancyGrid grid = asymmetricRoom();
   ParticleFilter filter(baseParams());
   filter.setMap(grid);
   const std::vector<Pose2> path = trackingPath(10);
   // 0.3 m and 0.1 rad off the truth (1, 1.5, 0).
   filter.initializeGaussian({1.18, 1.26, 0.1}, diag(0.3, 0.3, 0.15));
   ASSERT_NEAR(0.3, distance(path[0], {1.18, 1.26, 0.0}), 1e-9);
-  for (std::size_t k = 0; k < path.size(); ++k) {
-    const UpdateReport r = filter.update(odomOf(path[k]), simulateScan(grid, path[k]));
+  const test::TrackingRun run = track(&filter, grid, path);
+  for (std::size_t k = 0; k < run.steps.size(); ++k) {
+    const UpdateReport& r = run.steps[k].report;
     ASSERT_TRUE(r.updated) << "step " << k << ": " << skipMessage(r);
     EXPECT_GE(r.particles, 300u);
     EXPECT_LE(r.particles, 2000u);
   }
-  const Pose2 truth = path.back();
-  const Pose2 estimate = filter.estimate().pose;
-  EXPECT_LT(distance(truth, estimate), 0.1)
+  const Pose2 estimate = run.last().estimate;
+  EXPECT_LT(run.last().position_error, 0.1)
       << "estimate " << estimate.x << ", " << estimate.y << ", " << estimate.yaw;
-  EXPECT_LT(std::fabs(angleDiff(truth.yaw, estimate.yaw)), 0.05);
+  EXPECT_LT(run.last().yaw_error, 0.05);
   // map -> odom recovers the frame the odometry was expressed in.
   const Pose2 map_to_odom = *filter.mapToOdom();
   EXPECT_LT(distance(kOdomInMap, map_to_odom), 0.15);
@@ -891,7 +864,7 @@ TEST(ParticleFilter, TracksFromAnOffInitialGuess) {
 // The filter composes whichever sensor model laser_model_type names; each
 // one must track on the same drive.
 TEST(ParticleFilter, EveryLaserModelTracksFromAnOffInitialGuess) {
-  const OccupancyGrid grid = trackingRoom();
+  const OccupancyGrid grid = asymmetricRoom();
   for (const LaserModelType type : {LaserModelType::kLikelihoodField,
                                     LaserModelType::kLikelihoodFieldProb, LaserModelType::kBeam}) {
     ParticleFilterParams params = baseParams();
@@ -899,21 +872,18 @@ TEST(ParticleFilter, EveryLaserModelTracksFromAnOffInitialGuess) {
     params.sensor.beam_skip = true;  // used by kLikelihoodFieldProb only
     ParticleFilter filter(params);
     filter.setMap(grid);
-    const std::vector<Pose2> path = trackingPath(10);
     filter.initializeGaussian({1.18, 1.26, 0.1}, diag(0.3, 0.3, 0.15));
-    for (std::size_t k = 0; k < path.size(); ++k) {
-      const UpdateReport r = filter.update(odomOf(path[k]), simulateScan(grid, path[k]));
+    const test::TrackingRun run = track(&filter, grid, trackingPath(10));
+    for (std::size_t k = 0; k < run.steps.size(); ++k) {
+      const UpdateReport& r = run.steps[k].report;
       ASSERT_TRUE(r.updated) << "model " << static_cast<int>(type) << ", step " << k;
       // Only the skipping model may leave beams out.
       if (type != LaserModelType::kLikelihoodFieldProb) {
         EXPECT_EQ(0, r.beams_skipped);
       }
     }
-    const Pose2 truth = path.back();
-    const Pose2 estimate = filter.estimate().pose;
-    EXPECT_LT(distance(truth, estimate), 0.1) << "model " << static_cast<int>(type);
-    EXPECT_LT(std::fabs(angleDiff(truth.yaw, estimate.yaw)), 0.05)
-        << "model " << static_cast<int>(type);
+    EXPECT_LT(run.last().position_error, 0.1) << "model " << static_cast<int>(type);
+    EXPECT_LT(run.last().yaw_error, 0.05) << "model " << static_cast<int>(type);
   }
 }
 
@@ -956,6 +926,20 @@ TEST(ParticleFilterParams, SensorModelParametersAreNamed) {
       "beam_skip_error_threshold");
 }
 
+// Drives `path` (on free cells) and returns the step from which on the
+// estimate stays within 0.2 m and 0.2 rad of the truth (-1: it never settles).
+int settlesAt(ParticleFilter* filter, const OccupancyGrid& grid, const std::vector<Pose2>& path) {
+  for (std::size_t k = 0; k < path.size(); ++k) {
+    EXPECT_TRUE(grid.isFreeAt(path[k].x, path[k].y)) << "step " << k;
+  }
+  const test::TrackingRun run = track(filter, grid, path);
+  for (std::size_t k = 0; k < run.steps.size(); ++k) {
+    const UpdateReport& r = run.steps[k].report;
+    EXPECT_TRUE(r.updated) << "step " << k << ": " << skipMessage(r);
+  }
+  return run.settledAt(0.2, 0.2);
+}
+
 TEST(ParticleFilter, GlobalLocalizationInAnAsymmetricRoom) {
   // An L-shaped room: 3 m x 2 m less a 1.2 m x 0.9 m block in its upper
   // right corner, plus a pillar in the upper arm. No half turn or mirror
@@ -969,22 +953,10 @@ TEST(ParticleFilter, GlobalLocalizationInAnAsymmetricRoom) {
   filter.initializeUniform();
   // Along +x under the block, a half turn in place, and back along -x.
   std::vector<Pose2> path{{0.6, 0.8, 0.0}};
-  auto drive = [&](int n, const Pose2& step) {
-    for (int i = 0; i < n; ++i) path.push_back(compose(path.back(), step));
-  };
-  drive(6, {0.25, 0.0, 0.0});      // to (2.1, 0.8), 0.3 m below the block
-  drive(4, {0.0, 0.0, M_PI / 4});  // facing -x
-  drive(4, {0.25, 0.0, 0.0});      // to (1.1, 0.8)
-  int converged_at = -1;
-  for (std::size_t k = 0; k < path.size(); ++k) {
-    ASSERT_TRUE(grid.isFreeAt(path[k].x, path[k].y)) << "step " << k;
-    const UpdateReport r = filter.update(odomOf(path[k]), simulateScan(grid, path[k]));
-    ASSERT_TRUE(r.updated) << "step " << k << ": " << skipMessage(r);
-    const bool close = distance(path[k], filter.estimate().pose) < 0.2 &&
-                       std::fabs(angleDiff(path[k].yaw, filter.estimate().pose.yaw)) < 0.2;
-    if (close && converged_at < 0) converged_at = static_cast<int>(k);
-    if (!close) converged_at = -1;
-  }
+  test::driveOn(&path, {0.25, 0.0, 0.0}, 6);      // to (2.1, 0.8), 0.3 m below the block
+  test::driveOn(&path, {0.0, 0.0, M_PI / 4}, 4);  // facing -x
+  test::driveOn(&path, {0.25, 0.0, 0.0}, 4);      // to (1.1, 0.8)
+  const int converged_at = settlesAt(&filter, grid, path);
   EXPECT_GE(converged_at, 0) << "never settled on the true pose";
   EXPECT_LE(converged_at, 5);
   EXPECT_LT(distance(path.back(), filter.estimate().pose), 0.2);
@@ -1009,24 +981,12 @@ TEST(ParticleFilter, GlobalLocalizationIsNotCapturedByAHalfTurnAlias) {
   filter.setMap(grid);
   filter.initializeUniform();
   std::vector<Pose2> path{{0.6, 1.1, 0.0}};
-  auto drive = [&](int n, const Pose2& step) {
-    for (int i = 0; i < n; ++i) path.push_back(compose(path.back(), step));
-  };
-  drive(4, {0.25, 0.0, 0.0});      // to (1.6, 1.1)
-  drive(2, {0.0, 0.0, M_PI / 4});  // facing +y
-  drive(3, {0.21, 0.0, 0.0});      // to (1.6, 1.73)
-  drive(2, {0.0, 0.0, M_PI / 4});  // facing -x
-  drive(3, {0.25, 0.0, 0.0});      // to (0.85, 1.73)
-  int converged_at = -1;
-  for (std::size_t k = 0; k < path.size(); ++k) {
-    ASSERT_TRUE(grid.isFreeAt(path[k].x, path[k].y)) << "step " << k;
-    const UpdateReport r = filter.update(odomOf(path[k]), simulateScan(grid, path[k]));
-    ASSERT_TRUE(r.updated) << "step " << k << ": " << skipMessage(r);
-    const bool close = distance(path[k], filter.estimate().pose) < 0.2 &&
-                       std::fabs(angleDiff(path[k].yaw, filter.estimate().pose.yaw)) < 0.2;
-    if (close && converged_at < 0) converged_at = static_cast<int>(k);
-    if (!close) converged_at = -1;
-  }
+  test::driveOn(&path, {0.25, 0.0, 0.0}, 4);      // to (1.6, 1.1)
+  test::driveOn(&path, {0.0, 0.0, M_PI / 4}, 2);  // facing +y
+  test::driveOn(&path, {0.21, 0.0, 0.0}, 3);      // to (1.6, 1.73)
+  test::driveOn(&path, {0.0, 0.0, M_PI / 4}, 2);  // facing -x
+  test::driveOn(&path, {0.25, 0.0, 0.0}, 3);      // to (0.85, 1.73)
+  const int converged_at = settlesAt(&filter, grid, path);
   EXPECT_GE(converged_at, 0) << "never settled on the true pose";
   EXPECT_LE(converged_at, 6);
   EXPECT_LT(distance(path.back(), filter.estimate().pose), 0.2);
@@ -1035,7 +995,7 @@ TEST(ParticleFilter, GlobalLocalizationIsNotCapturedByAHalfTurnAlias) {
 // --- Map changes -------------------------------------------------------------------
 
 TEST(ParticleFilter, SetMapKeepsParticlesWhenTheEstimateIsStillFree) {
-  const OccupancyGrid grid = trackingRoom();
+  const OccupancyGrid grid = asymmetricRoom();
   ParticleFilter filter(baseParams());
   filter.setMap(grid);
   filter.initializeGaussian({1.0, 1.5, 0.0}, diag(0.05, 0.05, 0.05));
@@ -1062,7 +1022,7 @@ TEST(ParticleFilter, SetMapKeepsParticlesWhenTheEstimateIsStillFree) {
 
 TEST(ParticleFilter, SetMapDropsParticlesWhenTheEstimateLeavesTheMap) {
   ParticleFilter filter(baseParams());
-  filter.setMap(trackingRoom());
+  filter.setMap(asymmetricRoom());
   filter.initializeGaussian({3.5, 2.5, 0.0}, diag(0.05, 0.05, 0.05));
   EXPECT_FALSE(filter.setMap(room(2.0, 2.0, {})));  // (3.5, 2.5) is outside
   EXPECT_FALSE(filter.isInitialized());

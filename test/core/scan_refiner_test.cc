@@ -9,20 +9,13 @@
 #include <vector>
 
 #include "expect_pose.h"
+#include "support/grid_from_rows.h"
 
 namespace pf {
 namespace {
 
-// A grid drawn as text, top row first: '#' occupied, '.' free; 0.1 m cells,
-// origin at the lower-left corner.
-OccupancyGrid drawn(const std::vector<std::string>& rows) {
-  const int h = static_cast<int>(rows.size()), w = static_cast<int>(rows[0].size());
-  std::vector<int8_t> data(static_cast<std::size_t>(w) * h);
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) data[y * w + x] = rows[h - 1 - y][x] == '#' ? 100 : 0;
-  }
-  return OccupancyGrid(w, h, 0.1, {}, data);
-}
+// The worlds below are drawn in 0.1 m cells, origin at the lower-left corner.
+constexpr double kCell = 0.1;
 
 // 1.6 m x 1.2 m: walls, a square block and a stub, so that every direction
 // of the pose is pinned down.
@@ -62,7 +55,7 @@ PreparedScan scanOfObstacles(const OccupancyGrid& grid, const Pose2& pose, int m
 const Pose2 kTruth{0.83, 0.57, 0.2};
 
 TEST(ScanRefiner, RecoversAKnownOffsetToAMillimetre) {
-  const OccupancyGrid grid = drawn(kRoom);
+  const OccupancyGrid grid = test::gridFromRows(kRoom, kCell);
   const LikelihoodField field(grid, 2.0);
   const ScanRefiner refiner(field, ScanRefinerParams());
   const PreparedScan scan = scanOfObstacles(grid, kTruth);
@@ -88,7 +81,7 @@ TEST(ScanRefiner, RecoversAKnownOffsetToAMillimetre) {
 }
 
 TEST(ScanRefiner, StartingAtTheTruthStaysThere) {
-  const OccupancyGrid grid = drawn(kRoom);
+  const OccupancyGrid grid = test::gridFromRows(kRoom, kCell);
   const LikelihoodField field(grid, 2.0);
   const ScanRefiner refiner(field, ScanRefinerParams());
   const ScanRefinement r = refiner.refine(scanOfObstacles(grid, kTruth), kTruth);
@@ -122,7 +115,7 @@ TEST(ScanRefiner, AScanWithNothingToMatchIsRejected) {
 }
 
 TEST(ScanRefiner, AnEmptyScanIsRejected) {
-  const OccupancyGrid grid = drawn(kRoom);
+  const OccupancyGrid grid = test::gridFromRows(kRoom, kCell);
   const LikelihoodField field(grid, 2.0);
   const ScanRefinement r = ScanRefiner(field, ScanRefinerParams()).refine(PreparedScan(), kTruth);
   EXPECT_FALSE(r.accepted);
@@ -130,7 +123,7 @@ TEST(ScanRefiner, AnEmptyScanIsRejected) {
 }
 
 TEST(ScanRefiner, AFitThatMovesTooFarIsRejected) {
-  const OccupancyGrid grid = drawn(kRoom);
+  const OccupancyGrid grid = test::gridFromRows(kRoom, kCell);
   const LikelihoodField field(grid, 2.0);
   const PreparedScan scan = scanOfObstacles(grid, kTruth);
   const Pose2 start{kTruth.x + 0.06, kTruth.y - 0.04, kTruth.yaw};
@@ -152,17 +145,19 @@ TEST(ScanRefiner, AFitThatMovesTooFarIsRejected) {
 
 TEST(ScanRefiner, AlongAFeaturelessCorridorTheStartIsKept) {
   // Two walls 0.8 m apart, open at both ends: the scan says nothing about x.
-  const OccupancyGrid grid = drawn({
-      "##############################",  //
-      "..............................",  //
-      "..............................",  //
-      "..............................",  //
-      "..............................",  //
-      "..............................",  //
-      "..............................",  //
-      "..............................",  //
-      "##############################",  //
-  });
+  const OccupancyGrid grid = test::gridFromRows(
+      {
+          "##############################",  //
+          "..............................",  //
+          "..............................",  //
+          "..............................",  //
+          "..............................",  //
+          "..............................",  //
+          "..............................",  //
+          "..............................",  //
+          "##############################",  //
+      },
+      kCell);
   const LikelihoodField field(grid, 2.0);
   const Pose2 truth{1.5, 0.42, 0.0};
   // Only cells well inside the map, so that no stencil sees past its ends.

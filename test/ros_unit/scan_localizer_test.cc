@@ -1,5 +1,5 @@
 // ScanLocalizer: the ROS-message layer shared by pf_node and pf_bag_runner.
-// A 4 x 3 m walled room, scans ray-cast from a known pose, tf fed by hand.
+// A 4 x 3 m walled room, scans simulated from a known pose, tf fed by hand.
 #include "pf_localization/ros/scan_localizer.h"
 
 #include <gtest/gtest.h>
@@ -9,67 +9,50 @@
 #include <limits>
 
 #include "pf_localization/ros/conversions.h"
+#include "support/rooms.h"
+#include "support/scan_simulator.h"
 
 namespace pf_ros {
 namespace {
 
-constexpr double kRes = 0.05;
-constexpr int kW = 80, kH = 60;  // 4 x 3 m
-
 // Walls around the room and a 0.5 x 0.5 m pillar off-centre, so that no pose
 // has a mirror twin.
-nav_msgs::OccupancyGrid room() {
-  nav_msgs::OccupancyGrid map;
+pf::OccupancyGrid room() { return pf::test::room(4.0, 3.0, 0.05, {{2.5, 0.5, 3.0, 1.0}}); }
+
+nav_msgs::OccupancyGrid mapMsg(const pf::OccupancyGrid& grid) {
+  nav_msgs::OccupancyGrid map = toMsg(grid);
   map.header.frame_id = "map";
-  map.info.width = kW;
-  map.info.height = kH;
-  map.info.resolution = kRes;
-  map.info.origin.orientation.w = 1.0;
-  map.data.assign(kW * kH, 0);
-  for (int y = 0; y < kH; ++y) {
-    for (int x = 0; x < kW; ++x) {
-      const bool wall = x == 0 || y == 0 || x == kW - 1 || y == kH - 1;
-      const bool pillar = x >= 50 && x < 60 && y >= 10 && y < 20;
-      if (wall || pillar) map.data[y * kW + x] = 100;
-    }
-  }
   return map;
 }
 
-// Marches along each beam until it enters an occupied cell; beam i starts
-// from laser_at(i), so that a laser moving through its sweep can be drawn.
-template <typename LaserAt>
-sensor_msgs::LaserScan scanFromMoving(const nav_msgs::OccupancyGrid& map, const LaserAt& laser_at,
-                                      const ros::Time& stamp) {
-  sensor_msgs::LaserScan scan;
-  scan.header.frame_id = "laser";
-  scan.header.stamp = stamp;
-  scan.angle_min = -M_PI;
-  scan.angle_increment = M_PI / 180.0;
-  scan.angle_max = M_PI - scan.angle_increment;
-  scan.range_min = 0.02;
-  scan.range_max = 5.0;
-  for (int i = 0; i < 360; ++i) {
-    const pf::Pose2 laser = laser_at(i);
-    const double a = laser.yaw + scan.angle_min + i * scan.angle_increment;
-    float range = std::numeric_limits<float>::infinity();
-    for (double r = 0.0; r < scan.range_max; r += 0.005) {
-      const int cx = static_cast<int>(std::floor((laser.x + r * std::cos(a)) / kRes));
-      const int cy = static_cast<int>(std::floor((laser.y + r * std::sin(a)) / kRes));
-      if (cx < 0 || cy < 0 || cx >= kW || cy >= kH || map.data[cy * kW + cx] == 100) {
-        range = static_cast<float>(r);
-        break;
-      }
-    }
-    scan.ranges.push_back(range);
-  }
-  return scan;
+// The laser: 360 beams over a full turn from -pi, 0.02 to 5 m, reading +inf
+// where nothing is within range; mounted at `mount` on the base.
+pf::test::ScanSpec laserSpec(const pf::Pose2& mount) {
+  pf::test::ScanSpec spec;
+  spec.beams = 360;
+  spec.angle_increment = M_PI / 180.0;
+  spec.range_min = 0.02;
+  spec.range_max = 5.0;
+  spec.sensor_pose = mount;
+  spec.no_return = std::numeric_limits<float>::infinity();
+  return spec;
 }
 
-sensor_msgs::LaserScan scanFrom(const nav_msgs::OccupancyGrid& map, const pf::Pose2& laser,
-                                const ros::Time& stamp) {
-  return scanFromMoving(
-      map, [&](int) { return laser; }, stamp);
+// The message the laser publishes for `scan`, in frame "laser" (the mounting
+// is tf's business, not the message's).
+sensor_msgs::LaserScan scanMsg(const pf::LaserScan& scan, const ros::Time& stamp) {
+  sensor_msgs::LaserScan msg;
+  msg.header.frame_id = "laser";
+  msg.header.stamp = stamp;
+  msg.angle_min = static_cast<float>(scan.angle_min);
+  msg.angle_increment = static_cast<float>(scan.angle_increment);
+  msg.angle_max =
+      static_cast<float>(scan.angle_min + (scan.ranges.size() - 1.0) * scan.angle_increment);
+  msg.time_increment = static_cast<float>(scan.sweep.time_increment);
+  msg.range_min = static_cast<float>(scan.range_min);
+  msg.range_max = static_cast<float>(scan.range_max);
+  msg.ranges = scan.ranges;
+  return msg;
 }
 
 geometry_msgs::TransformStamped transform(const std::string& parent, const std::string& child,
@@ -90,8 +73,6 @@ class ScanLocalizerTest : public ::testing::Test {
     config_.filter.seed = 7;
     config_.filter.update_min_d = 0.0;
     config_.filter.update_min_a = 0.0;
-    // The laser is mounted backwards, as on the AC109 Neato.
-    mount_ = {-0.1, 0.0, M_PI};
     tf_.setTransform(transform("base_link", "laser", mount_, ros::Time(0)), "test", true);
   }
 
@@ -100,13 +81,16 @@ class ScanLocalizerTest : public ::testing::Test {
     const ros::Time stamp(t);
     tf_.setTransform(transform("odom", "base_link", odom, stamp), "test");
     tf_.setTransform(transform("odom", "base_link", odom, stamp + ros::Duration(0.01)), "test");
-    return scanFrom(map_, pf::compose(truth, mount_), stamp);
+    return scanMsg(scans_.scanFrom(truth), stamp);
   }
 
   LocalizerConfig config_;
   tf2::BufferCore tf_;
-  pf::Pose2 mount_;
-  nav_msgs::OccupancyGrid map_ = room();
+  // The laser is mounted backwards, as on the AC109 Neato.
+  pf::Pose2 mount_{-0.1, 0.0, M_PI};
+  pf::OccupancyGrid grid_ = room();
+  nav_msgs::OccupancyGrid map_ = mapMsg(grid_);
+  pf::test::ScanSimulator scans_{grid_, laserSpec(mount_)};
 };
 
 TEST_F(ScanLocalizerTest, ScanBeforeMapIsRejectedWithAClearReason) {
@@ -132,7 +116,7 @@ TEST_F(ScanLocalizerTest, MissingLaserMountingSaysWhichTransformIsMissing) {
 TEST_F(ScanLocalizerTest, MissingOdometrySaysWhichTransformIsMissing) {
   ScanLocalizer localizer(config_, &tf_);
   ASSERT_EQ(localizer.setMap(map_), "");
-  const sensor_msgs::LaserScan scan = scanFrom(map_, {1, 1, 0}, ros::Time(10));
+  const sensor_msgs::LaserScan scan = scanMsg(scans_.scanFrom({1, 1, 0}), ros::Time(10));
   const ScanResult r = localizer.processScan(scan);
   EXPECT_EQ(r.error, ScanError::kNoOdometry) << errorMessage(r);
   EXPECT_EQ(r.error_detail.rfind("no transform odom -> base_link at t=10.000 ", 0), 0u)
@@ -326,6 +310,12 @@ TEST_F(ScanLocalizerTest, DeskewingRemovesTheSpinsYawBias) {
   config_.initial_pose = pf::compose(start, {0.0, 0.0, kRate * 10.0});  // at the first scan
   config_.initial_cov = Eigen::Vector3d(1e-4, 1e-4, 1e-4).asDiagonal();
   config_.scan_stamp = "last_beam";
+  // Beam i is taken (359 - i) / 359 of a sweep before the stamp.
+  pf::test::ScanSpec spinning = laserSpec(mount_);
+  spinning.sweep.first_beam_time = -kSweep;
+  spinning.sweep.time_increment = kSweep / 359.0;
+  spinning.sweep.base_velocity = {0.0, 0.0, kRate};
+  pf::test::ScanSimulator scans(grid_, spinning);
   auto final_yaw_error = [&](bool deskew) {
     config_.deskew_scans = deskew;
     ScanLocalizer localizer(config_, &tf_);
@@ -333,16 +323,9 @@ TEST_F(ScanLocalizerTest, DeskewingRemovesTheSpinsYawBias) {
     double error = 0.0;
     for (int k = 0; k < 10; ++k) {
       const double stamp = 10.0 + 0.1 * k;
-      // Beam i is taken (359 - i) / 359 of a sweep before the stamp.
-      auto laser_at = [&](int i) {
-        const double t = stamp - kSweep * (359 - i) / 359.0;
-        return pf::compose(pf::compose(start, {0.0, 0.0, kRate * t}), mount_);
-      };
-      sensor_msgs::LaserScan scan = scanFromMoving(map_, laser_at, ros::Time(stamp));
-      scan.time_increment = static_cast<float>(kSweep / 359.0);
-      const ScanResult r = localizer.processScan(scan);
-      EXPECT_EQ(r.error, ScanError::kNone) << errorMessage(r);
       const pf::Pose2 truth = pf::compose(start, {0.0, 0.0, kRate * stamp});
+      const ScanResult r = localizer.processScan(scanMsg(scans.scanFrom(truth), ros::Time(stamp)));
+      EXPECT_EQ(r.error, ScanError::kNone) << errorMessage(r);
       const auto est = localizer.estimate(ros::Time(stamp));
       error = pf::angleDiff(toPose2(est->pose.pose).yaw, truth.yaw);
     }

@@ -23,6 +23,10 @@ OccupancyGrid room(double width, double height, double resolution, const std::ve
   return OccupancyGrid(w, h, resolution, origin, data);
 }
 
+OccupancyGrid asymmetricRoom() {
+  return room(4.0, 3.0, 0.05, {{2.5, 0.5, 3.0, 1.2}, {0.6, 2.0, 1.0, 2.4}});
+}
+
 OccupancyGrid wallGrid(int column, const Pose2& origin) {
   std::vector<int8_t> data(50, 0);
   for (int y = 0; y < 5; ++y) data[y * 10 + column] = 100;

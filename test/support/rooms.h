@@ -19,6 +19,11 @@ struct Box {
 OccupancyGrid room(double width, double height, double resolution,
                    const std::vector<Box>& boxes = {}, const Pose2& origin = {});
 
+/// A 4 m x 3 m room in 0.05 m cells with a box near its lower right
+/// (x 2.5-3.0, y 0.5-1.2) and a smaller one near its upper left (x 0.6-1.0,
+/// y 2.0-2.4), so that no rotation or mirror image of it looks the same.
+OccupancyGrid asymmetricRoom();
+
 /// 10 x 5 cells of 0.1 m (1 m x 0.5 m), free but for the cells of column
 /// `column`: a single wall, x in [column / 10, column / 10 + 0.1) in the
 /// grid's frame, whose ranges and distances are easy to work out by hand.

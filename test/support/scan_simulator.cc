@@ -21,22 +21,27 @@ ScanSimulator::ScanSimulator(const OccupancyGrid& grid, const ScanSpec& spec)
     : caster_(grid), spec_(spec), random_(spec.seed) {}
 
 LaserScan ScanSimulator::scanFrom(const Pose2& base) {
-  LaserScan scan;
-  scan.angle_min = spec_.angle_min;
-  scan.angle_increment = spec_.angle_increment;
-  scan.range_min = spec_.range_min;
-  scan.range_max = spec_.range_max;
-  scan.sensor_pose = spec_.sensor_pose;
-  scan.sweep = spec_.sweep;
-  scan.ranges.reserve(static_cast<std::size_t>(spec_.beams));
+  LaserScan scan = noReturnScan(spec_);
   for (int i = 0; i < spec_.beams; ++i) {
     const Pose2 laser = compose(base, laserAtBeam(i));
     const double bearing = laser.yaw + spec_.angle_min + i * spec_.angle_increment;
     const double range = caster_.cast(laser.x, laser.y, bearing, spec_.range_max);
-    scan.ranges.push_back(std::isfinite(range)
-                              ? static_cast<float>(range + random_.gaussian(spec_.noise_sigma))
-                              : spec_.no_return);
+    if (std::isfinite(range)) {
+      scan.ranges[i] = static_cast<float>(range + random_.gaussian(spec_.noise_sigma));
+    }
   }
+  return scan;
+}
+
+LaserScan noReturnScan(const ScanSpec& spec) {
+  LaserScan scan;
+  scan.angle_min = spec.angle_min;
+  scan.angle_increment = spec.angle_increment;
+  scan.range_min = spec.range_min;
+  scan.range_max = spec.range_max;
+  scan.sensor_pose = spec.sensor_pose;
+  scan.sweep = spec.sweep;
+  scan.ranges.assign(static_cast<std::size_t>(spec.beams), spec.no_return);
   return scan;
 }
 

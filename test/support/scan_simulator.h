@@ -53,6 +53,10 @@ class ScanSimulator {
   Random random_;
 };
 
+/// A scan of `spec` (its angles, limits, mounting and sweep) in which no
+/// beam returns: every range is spec.no_return.
+LaserScan noReturnScan(const ScanSpec& spec = {});
+
 /// One scan of `grid` from `base` (a ScanSimulator used once).
 LaserScan simulateScan(const OccupancyGrid& grid, const Pose2& base, const ScanSpec& spec = {});
 

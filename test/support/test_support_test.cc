@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <stdexcept>
+#include <vector>
 
 #include "support/drive_and_track.h"
 #include "support/grid_from_rows.h"
@@ -40,6 +41,13 @@ TEST(Rooms, WallsOnTheBorderAndBoxesByCellCentre) {
   EXPECT_EQ(CellState::kOccupied, grid.state({5, 2}));
   EXPECT_EQ(CellState::kOccupied, grid.state({5, 3}));
   EXPECT_EQ(CellState::kFree, grid.state({4, 2}));
+  const OccupancyGrid asymmetric = asymmetricRoom();
+  ASSERT_EQ(80, asymmetric.width());
+  ASSERT_EQ(60, asymmetric.height());
+  EXPECT_EQ(CellState::kOccupied, asymmetric.state(asymmetric.worldToCell(2.75, 0.85)));
+  EXPECT_EQ(CellState::kOccupied, asymmetric.state(asymmetric.worldToCell(0.8, 2.2)));
+  EXPECT_EQ(CellState::kFree, asymmetric.state(asymmetric.worldToCell(0.8, 0.85)));
+  EXPECT_EQ(CellState::kFree, asymmetric.state(asymmetric.worldToCell(2.75, 2.2)));
   const OccupancyGrid wall = wallGrid(8);
   EXPECT_EQ(CellState::kOccupied, wall.state({8, 4}));
   EXPECT_EQ(CellState::kFree, wall.state({7, 4}));
@@ -66,6 +74,23 @@ TEST(ScanSimulator, ExactRangesFromTheMountedLaser) {
   spec.range_max = 0.5;
   spec.no_return = 0.0f;
   EXPECT_EQ(0.0f, simulateScan(wallGrid(8), {0.15, 0.25, 0.0}, spec).ranges[0]);
+}
+
+TEST(ScanSimulator, ANoReturnScanHasTheSpecsLayoutAndNoRange) {
+  ScanSpec spec;
+  spec.beams = 7;
+  spec.angle_min = -0.3;
+  spec.sensor_pose = {0.2, 0.0, 0.1};
+  spec.sweep.time_increment = 0.01;
+  LaserScan scan = noReturnScan(spec);
+  ASSERT_EQ(7u, scan.ranges.size());
+  for (float range : scan.ranges) EXPECT_TRUE(std::isnan(range));
+  EXPECT_EQ(-0.3, scan.angle_min);
+  EXPECT_EQ(0.2, scan.sensor_pose.x);
+  EXPECT_EQ(0.01, scan.sweep.time_increment);
+  spec.no_return = 0.0f;
+  scan = noReturnScan(spec);
+  for (float range : scan.ranges) EXPECT_EQ(0.0f, range);
 }
 
 TEST(ScanSimulator, SeededNoiseOfTheGivenSpread) {
@@ -113,8 +138,41 @@ TEST(ScanSimulator, EachBeamIsCastFromWhereTheSweepHasCarriedTheLaser) {
   EXPECT_EQ(1.0, scan.sweep.time_increment);
 }
 
+TEST(DriveAndTrack, PathsOfSeveralLegsAndTheOdometryOfAFrame) {
+  std::vector<Pose2> path{{1.0, 0.0, 0.0}};
+  driveOn(&path, {0.5, 0.0, 0.0}, 2);
+  driveOn(&path, {0.0, 0.0, M_PI / 2}, 1);
+  driveOn(&path, {0.5, 0.0, 0.0}, 1);
+  ASSERT_EQ(5u, path.size());
+  EXPECT_NEAR(2.0, path[3].x, 1e-12);
+  EXPECT_NEAR(M_PI / 2, path[3].yaw, 1e-12);
+  EXPECT_NEAR(0.5, path[4].y, 1e-12);
+  // Odometry in a frame 1 m along x and a quarter turn from the map's.
+  const Pose2 odom_in_map{1.0, 0.0, M_PI / 2};
+  const Pose2 odom = odometryOf({1.0, 2.0, M_PI / 2}, odom_in_map);
+  EXPECT_NEAR(2.0, odom.x, 1e-12);
+  EXPECT_NEAR(0.0, odom.y, 1e-12);
+  EXPECT_NEAR(0.0, odom.yaw, 1e-12);
+}
+
+TEST(DriveAndTrack, SettledAtIsWhereTheErrorsStayWithinTheLimits) {
+  TrackingRun run;
+  for (double error : {0.5, 0.1, 0.3, 0.1, 0.05, 0.1}) {
+    TrackedStep step;
+    step.position_error = error;
+    step.yaw_error = error / 10.0;
+    run.steps.push_back(step);
+  }
+  EXPECT_EQ(3, run.settledAt(0.2, 0.2));  // not at 1: step 2 is off again
+  EXPECT_EQ(0, run.settledAt(1.0, 1.0));
+  EXPECT_EQ(-1, run.settledAt(0.08, 1.0));   // the last is off
+  EXPECT_EQ(-1, run.settledAt(1.0, 0.008));  // by its yaw, 0.01
+  EXPECT_EQ(0.5, run.maxPositionError());
+  EXPECT_EQ(0.1, run.maxPositionError(3));
+}
+
 TEST(DriveAndTrack, ReportsTheErrorsOfAFilterThatTracks) {
-  const OccupancyGrid grid = room(4.0, 3.0, 0.05, {{2.5, 0.5, 3.0, 1.2}, {0.6, 2.0, 1.0, 2.4}});
+  const OccupancyGrid grid = asymmetricRoom();
   ParticleFilterParams params;
   params.kld.min_particles = 300;
   params.kld.max_particles = 2000;
