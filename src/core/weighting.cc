@@ -55,8 +55,8 @@ double priorEffectiveSampleSize(const std::vector<double>& w, bool uniform) {
 // Nearly always the product prior * likelihood / max likelihood can be
 // taken as it is, without a logarithm per particle: when the best product
 // is far from underflowing and the scan needs no tempering. Then writes
-// the normalised posterior into *weights and returns true; *posterior is working
-// storage of N values.
+// the normalised posterior into *weights and returns true; *posterior is
+// working storage of N values.
 bool multiplyDirectly(const std::vector<double>& ll, double min_ess, std::vector<double>* weights,
                       std::vector<double>* posterior) {
   std::vector<double>& w = *weights;
