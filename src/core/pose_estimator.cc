@@ -142,37 +142,33 @@ Cluster summarize(const ParticleSet& particles, const std::vector<std::size_t>& 
   return c;
 }
 
-PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& params) {
-  PoseEstimate estimate;
-  if (particles.empty()) return estimate;
+namespace {
 
-  // Bin every particle; yaw bins wrap around, so the last bin touches the
-  // first. The working storage is kept between calls (per thread), so that
-  // estimating allocates nothing once the widest cloud has been seen.
-  const int64_t yaw_bins = std::max<int64_t>(1, std::llround(2.0 * M_PI / params.cell_yaw));
-  struct Scratch {
-    BinTable bin_of;
-    std::vector<uint64_t> packed;
-    std::vector<BinTable::Bin> keys;
-    std::vector<int> particle_bin, parent, cluster_of_root, cluster;
-    std::vector<double> bin_weight, sin_yaw, cos_yaw, sums, moments;
-  };
-  Scratch& scratch = threadScratch<Scratch>();
-  BinTable& bin_of = scratch.bin_of;
-  std::vector<BinTable::Bin>& keys = scratch.keys;
-  std::vector<int>& particle_bin = scratch.particle_bin;
-  std::vector<int>& parent = scratch.parent;
-  std::vector<int>& cluster_of_root = scratch.cluster_of_root;
-  std::vector<int>& cluster = scratch.cluster;
-  std::vector<double>& bin_weight = scratch.bin_weight;
+// The working storage of estimatePose, kept between calls (per thread), so
+// that estimating allocates nothing once the widest cloud has been seen.
+struct EstimatorScratch {
+  BinTable bin_of;
+  std::vector<uint64_t> packed;
+  std::vector<BinTable::Bin> keys;
+  std::vector<int> particle_bin, parent, cluster_of_root, cluster;
+  std::vector<double> bin_weight, sin_yaw, cos_yaw, sums, moments;
+};
+
+// Bins every particle: s->keys the occupied bins in order of first
+// appearance, s->particle_bin[i] the index of particle i's bin in them.
+void binParticles(const ParticleSet& particles, double cell_xy, int64_t yaw_bins,
+                  EstimatorScratch* s) {
+  BinTable& bin_of = s->bin_of;
+  std::vector<BinTable::Bin>& keys = s->keys;
+  std::vector<int>& particle_bin = s->particle_bin;
   bin_of.reset(particles.size());
   keys.clear();
   particle_bin.resize(particles.size());
   // The keys first, for the whole cloud (vectorised), then the look-ups.
   // Bins beyond +-2^20 cells (524 km at 0.5 m) share the edge bin.
-  std::vector<uint64_t>& packed = scratch.packed;
+  std::vector<uint64_t>& packed = s->packed;
   packed.resize(particles.size());
-  packClusterBins(particles, params.cell_xy, yaw_bins, packed.data());
+  packClusterBins(particles, cell_xy, yaw_bins, packed.data());
   // Resampling leaves the copies of one particle side by side, so the bin of
   // the particle before is the likeliest: it spares most hash look-ups.
   uint64_t last_key = ~uint64_t{0};
@@ -186,14 +182,22 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
     }
     particle_bin[i] = last_id;
   }
+}
 
-  // Join occupied bins that touch (26-neighbourhood) into clusters, but only
-  // bins that carry weight (see ClusterParams::join_weight_ratio).
+// Joins occupied bins that touch (26-neighbourhood) into clusters, but only
+// bins that carry weight (see ClusterParams::join_weight_ratio): s->parent
+// is the union-find forest over s->keys.
+void joinTouchingBins(const ParticleSet& particles, double join_weight_ratio, int64_t yaw_bins,
+                      EstimatorScratch* s) {
+  const BinTable& bin_of = s->bin_of;
+  const std::vector<BinTable::Bin>& keys = s->keys;
+  std::vector<int>& parent = s->parent;
+  std::vector<double>& bin_weight = s->bin_weight;
   bin_weight.assign(keys.size(), 0.0);
-  accumulateRuns<1>(particle_bin, bin_weight.data(),
+  accumulateRuns<1>(s->particle_bin, bin_weight.data(),
                     [&](std::size_t i, double* a) { a[0] += particles.weight[i]; });
   const double join_weight =
-      params.join_weight_ratio * *std::max_element(bin_weight.begin(), bin_weight.end());
+      join_weight_ratio * *std::max_element(bin_weight.begin(), bin_weight.end());
   parent.resize(keys.size());
   std::iota(parent.begin(), parent.end(), 0);
   for (std::size_t b = 0; b < keys.size(); ++b) {
@@ -213,29 +217,42 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
       }
     }
   }
+}
 
-  // Cluster ids in order of first appearance, then the weighted sums of each
-  // cluster in two passes (means, then covariances) over flat arrays.
-  // The roots are found once per bin, not once per particle.
-  for (std::size_t b = 0; b < keys.size(); ++b) parent[b] = find(parent, static_cast<int>(b));
-  cluster_of_root.assign(keys.size(), -1);
-  cluster.resize(particles.size());
+// Cluster ids in order of first appearance: s->cluster[i] for particle i.
+// Returns the number of clusters. The roots are found once per bin, not
+// once per particle.
+int labelClusters(std::size_t particle_count, EstimatorScratch* s) {
+  std::vector<int>& parent = s->parent;
+  const std::vector<int>& particle_bin = s->particle_bin;
+  std::vector<int>& cluster_of_root = s->cluster_of_root;
+  std::vector<int>& cluster = s->cluster;
+  for (std::size_t b = 0; b < s->keys.size(); ++b) parent[b] = find(parent, static_cast<int>(b));
+  cluster_of_root.assign(s->keys.size(), -1);
+  cluster.resize(particle_count);
   int clusters = 0;
-  for (std::size_t i = 0; i < particles.size(); ++i) {
+  for (std::size_t i = 0; i < particle_count; ++i) {
     int& id = cluster_of_root[parent[particle_bin[i]]];
     if (id < 0) id = clusters++;
     cluster[i] = id;
   }
+  return clusters;
+}
+
+// Each cluster's count, weight and weighted mean, in one pass over flat
+// arrays.
+std::vector<Cluster> clusterMeans(const ParticleSet& particles, int clusters, EstimatorScratch* s) {
+  const std::vector<int>& cluster = s->cluster;
   // The headings' sines and cosines for the whole cloud at once (sinCos
   // vectorises), for the mean directions.
-  std::vector<double>& sin_yaw = scratch.sin_yaw;
-  std::vector<double>& cos_yaw = scratch.cos_yaw;
+  std::vector<double>& sin_yaw = s->sin_yaw;
+  std::vector<double>& cos_yaw = s->cos_yaw;
   sin_yaw.resize(particles.size());
   cos_yaw.resize(particles.size());
   sinCos(particles.yaw.data(), particles.size(), sin_yaw.data(), cos_yaw.data());
   std::vector<Cluster> c(clusters);
   // Per cluster: the count, the weight and the weighted sums of x, y, sin, cos.
-  std::vector<double>& sums = scratch.sums;
+  std::vector<double>& sums = s->sums;
   sums.assign(6 * static_cast<std::size_t>(clusters), 0.0);
   accumulateRuns<6>(cluster, sums.data(), [&](std::size_t i, double* a) {
     const double w = particles.weight[i];
@@ -253,11 +270,19 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
     const double w = c[k].weight > 0.0 ? c[k].weight : 1.0;
     c[k].mean = {sum[2] / w, sum[3] / w, normalizeAngle(std::atan2(sum[4], sum[5]))};
   }
+  return c;
+}
+
+// Each cluster's weighted covariance about its mean, in a second pass.
+void clusterCovariances(const ParticleSet& particles, EstimatorScratch* s,
+                        std::vector<Cluster>* clusters) {
+  std::vector<Cluster>& c = *clusters;
+  const std::vector<int>& cluster = s->cluster;
   // The second moments in plain arrays (an Eigen temporary per particle went
   // through the stack and stalled on store forwarding), with the same
   // products in the same order as w d d^T.
-  std::vector<double>& moments = scratch.moments;
-  moments.assign(9 * static_cast<std::size_t>(clusters), 0.0);
+  std::vector<double>& moments = s->moments;
+  moments.assign(9 * c.size(), 0.0);
   accumulateRuns<9>(cluster, moments.data(), [&](std::size_t i, double* m) {
     const Cluster& k = c[cluster[i]];
     const double d[3] = {particles.x[i] - k.mean.x, particles.y[i] - k.mean.y,
@@ -268,11 +293,25 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
       for (int col = 0; col < 3; ++col) m[3 * col + r] += wd * d[col];
     }
   });
-  for (int k = 0; k < clusters; ++k) {
-    c[k].covariance = Eigen::Map<const Eigen::Matrix3d>(&moments[9 * static_cast<std::size_t>(k)]);
+  for (std::size_t k = 0; k < c.size(); ++k) {
+    c[k].covariance = Eigen::Map<const Eigen::Matrix3d>(&moments[9 * k]);
     if (c[k].weight > 0.0) c[k].covariance /= c[k].weight;
   }
-  estimate.clusters = std::move(c);
+}
+
+}  // namespace
+
+PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& params) {
+  PoseEstimate estimate;
+  if (particles.empty()) return estimate;
+  // Yaw bins wrap around, so the last bin touches the first.
+  const int64_t yaw_bins = std::max<int64_t>(1, std::llround(2.0 * M_PI / params.cell_yaw));
+  EstimatorScratch& scratch = threadScratch<EstimatorScratch>();
+  binParticles(particles, params.cell_xy, yaw_bins, &scratch);
+  joinTouchingBins(particles, params.join_weight_ratio, yaw_bins, &scratch);
+  const int clusters = labelClusters(particles.size(), &scratch);
+  estimate.clusters = clusterMeans(particles, clusters, &scratch);
+  clusterCovariances(particles, &scratch, &estimate.clusters);
   // Heaviest first; ties broken by the mean so the order never depends on hashing.
   std::sort(estimate.clusters.begin(), estimate.clusters.end(),
             [](const Cluster& a, const Cluster& b) {

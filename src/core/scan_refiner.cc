@@ -125,21 +125,17 @@ ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start)
   return refine(scan, start, std::nullopt);
 }
 
-ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start,
-                                   const std::optional<Eigen::Matrix3d>& prior_covariance) const {
-  ScanRefinement out;
-  out.pose = start;
-  const int n = static_cast<int>(scan.size());
-  const int needed = std::max(params_.min_matched_beams,
-                              static_cast<int>(std::ceil(params_.min_matched_fraction * n)));
-  const auto too_few = [&](int matched) {
-    return "only " + std::to_string(matched) + " of " + std::to_string(n) + " beams end within " +
-           text(params_.outlier_distance) + " m of a mapped obstacle (" + std::to_string(needed) +
-           " needed): nothing to match";
-  };
+namespace {
 
-  // The prior in the scaled coordinates (x, y, kYawScale yaw): a tiny floor
-  // keeps a zero covariance from becoming an infinite information.
+std::string tooFewMatchedDetail(int matched, int beams, int needed, double outlier_distance) {
+  return "only " + std::to_string(matched) + " of " + std::to_string(beams) + " beams end within " +
+         text(outlier_distance) + " m of a mapped obstacle (" + std::to_string(needed) +
+         " needed): nothing to match";
+}
+
+// The prior in the scaled coordinates (x, y, kYawScale yaw): a tiny floor
+// keeps a zero covariance from becoming an infinite information.
+Eigen::Matrix3d priorInformation(const std::optional<Eigen::Matrix3d>& prior_covariance) {
   Eigen::Matrix3d prior_information = Eigen::Matrix3d::Zero();
   if (prior_covariance) {
     const Eigen::DiagonalMatrix<double, 3> scale(1.0, 1.0, kYawScale);
@@ -147,23 +143,53 @@ ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start,
     prior_information = (scaled + 1e-6 * Eigen::Matrix3d::Identity()).inverse();
     if (!prior_information.allFinite()) prior_information.setZero();
   }
-  const double inv_beam_variance = 1.0 / (params_.beam_std * params_.beam_std);
-  // The total cost: the scan's over beam_std^2, plus the prior's.
-  const auto total = [&](const Evaluation& ev, const Pose2& at) {
-    const Eigen::Vector3d d(at.x - start.x, at.y - start.y,
-                            kYawScale * angleDiff(at.yaw, start.yaw));
-    return ev.cost * inv_beam_variance + 0.5 * d.dot(prior_information * d);
-  };
+  return prior_information;
+}
 
-  Pose2 pose = start;
-  Evaluation e = evaluate(scan, pose, true);
-  if (e.matched < needed) {
-    out.matched_beams = e.matched;
-    out.rejection = ScanRejection::kTooFewMatchedBeams;
-    out.rejection_detail = too_few(e.matched);
-    return out;
+// The fit's covariance: the residual variance per unit weight (with the
+// fitted degrees of freedom taken off, floored by the map's own precision)
+// times the pseudo-inverse of the scan's Hessian (eigen-decomposed in
+// `eig`), which says nothing about the directions the scan does not
+// constrain.
+Eigen::Matrix3d fitCovariance(const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& eig,
+                              double sum_weight, double sum_weighted_sq,
+                              const ScanRefinerParams& params) {
+  const Eigen::Vector3d lambda = eig.eigenvalues();
+  int rank = 0;
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < 3; ++i) {
+    if (lambda(i) < params.degeneracy_ratio * lambda(2)) continue;
+    const Eigen::Vector3d v = eig.eigenvectors().col(i);
+    cov += v * v.transpose() / lambda(i);
+    ++rank;
   }
-  double cost = total(e, pose);
+  const double dof = std::max(1.0, sum_weight - rank);
+  const double variance =
+      std::max(params.min_beam_std * params.min_beam_std, sum_weighted_sq / dof);
+  cov *= variance;
+  // Back from the scaled yaw.
+  cov.row(2) /= kYawScale;
+  cov.col(2) /= kYawScale;
+  return 0.5 * (cov + cov.transpose());
+}
+
+}  // namespace
+
+double ScanRefiner::totalCost(const Evaluation& e, const Pose2& at, const Pose2& start,
+                              const Eigen::Matrix3d& prior_information) const {
+  const double inv_beam_variance = 1.0 / (params_.beam_std * params_.beam_std);
+  const Eigen::Vector3d d(at.x - start.x, at.y - start.y, kYawScale * angleDiff(at.yaw, start.yaw));
+  return e.cost * inv_beam_variance + 0.5 * d.dot(prior_information * d);
+}
+
+int ScanRefiner::minimise(const PreparedScan& scan, const Pose2& start,
+                          const Eigen::Matrix3d& prior_information, Pose2* fitted,
+                          Evaluation* fitted_evaluation) const {
+  const double inv_beam_variance = 1.0 / (params_.beam_std * params_.beam_std);
+  Pose2& pose = *fitted;
+  Evaluation& e = *fitted_evaluation;
+  double cost = totalCost(e, pose, start, prior_information);
+  int iterations = 0;
   for (int it = 0; it < params_.max_iterations; ++it) {
     const Eigen::Vector3d d(pose.x - start.x, pose.y - start.y,
                             kYawScale * angleDiff(pose.yaw, start.yaw));
@@ -190,7 +216,7 @@ ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start,
       const Pose2 trial{pose.x + scale * step(0), pose.y + scale * step(1),
                         normalizeAngle(pose.yaw + scale * step(2) / kYawScale)};
       const Evaluation te = evaluate(scan, trial, true);
-      const double trial_cost = total(te, trial);
+      const double trial_cost = totalCost(te, trial, start, prior_information);
       if (trial_cost < cost) {
         pose = trial;
         e = te;
@@ -199,24 +225,44 @@ ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start,
         break;
       }
     }
-    out.iterations = it + 1;
+    iterations = it + 1;
     if (!improved || scale * step.norm() < params_.convergence) break;
   }
+  return iterations;
+}
+
+ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start,
+                                   const std::optional<Eigen::Matrix3d>& prior_covariance) const {
+  ScanRefinement out;
+  out.pose = start;
+  const int n = static_cast<int>(scan.size());
+  const int needed = std::max(params_.min_matched_beams,
+                              static_cast<int>(std::ceil(params_.min_matched_fraction * n)));
+  const Eigen::Matrix3d prior_information = priorInformation(prior_covariance);
+
+  Pose2 pose = start;
+  Evaluation e = evaluate(scan, pose, true);
+  if (e.matched < needed) {
+    out.matched_beams = e.matched;
+    out.rejection = ScanRejection::kTooFewMatchedBeams;
+    out.rejection_detail = tooFewMatchedDetail(e.matched, n, needed, params_.outlier_distance);
+    return out;
+  }
+  out.iterations = minimise(scan, start, prior_information, &pose, &e);
 
   out.matched_beams = e.matched;
   out.translation = std::hypot(pose.x - start.x, pose.y - start.y);
   out.rotation = angleDiff(pose.yaw, start.yaw);
   // The scan's own information, without the prior: what the fit adds.
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(e.hessian);
-  const Eigen::Vector3d lambda = eig.eigenvalues();
-  if (!(lambda(2) > 0.0)) {
+  if (!(eig.eigenvalues()(2) > 0.0)) {
     out.rejection = ScanRejection::kDegenerate;
     out.rejection_detail = "the scan constrains no direction of the pose";
     return out;
   }
   if (e.matched < needed) {
     out.rejection = ScanRejection::kTooFewMatchedBeams;
-    out.rejection_detail = too_few(e.matched);
+    out.rejection_detail = tooFewMatchedDetail(e.matched, n, needed, params_.outlier_distance);
     return out;
   }
   if (out.translation > params_.max_translation || std::fabs(out.rotation) > params_.max_rotation) {
@@ -227,26 +273,7 @@ ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start,
         " rad): the scan fits another place better, which is for the filter to decide";
     return out;
   }
-  // The fit's covariance: the residual variance per unit weight (with the
-  // fitted degrees of freedom taken off, floored by the map's own
-  // precision) times the pseudo-inverse of the scan's Hessian, which says
-  // nothing about the directions the scan does not constrain.
-  int rank = 0;
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (int i = 0; i < 3; ++i) {
-    if (lambda(i) < params_.degeneracy_ratio * lambda(2)) continue;
-    const Eigen::Vector3d v = eig.eigenvectors().col(i);
-    cov += v * v.transpose() / lambda(i);
-    ++rank;
-  }
-  const double dof = std::max(1.0, e.sum_weight - rank);
-  const double variance =
-      std::max(params_.min_beam_std * params_.min_beam_std, e.sum_weighted_sq / dof);
-  cov *= variance;
-  // Back from the scaled yaw.
-  cov.row(2) /= kYawScale;
-  cov.col(2) /= kYawScale;
-  out.covariance = 0.5 * (cov + cov.transpose());
+  out.covariance = fitCovariance(eig, e.sum_weight, e.sum_weighted_sq, params_);
   out.rms_distance = std::sqrt(e.sum_sq / e.matched);
   out.pose = pose;
   out.accepted = true;

@@ -164,33 +164,29 @@ class ProgressBar {
   int last_ = -1;
 };
 
-}  // namespace
-
-int main(int argc, char** argv) {
-  const Options opt = parse(argc, argv);
-  const pf_ros::LocalizerConfig config = makeConfig(opt);
-
-  rosbag::Bag bag;
+// Opens the bag, which must have the scan topic and /tf.
+void openBag(const Options& opt, rosbag::Bag* bag) {
   try {
-    bag.open(opt.bag, rosbag::bagmode::Read);
+    bag->open(opt.bag, rosbag::bagmode::Read);
   } catch (const rosbag::BagException& e) {
     fail(opt.bag + ": cannot read the bag: " + e.what());
   }
-  {
-    rosbag::View all(bag);
-    std::set<std::string> topics;
-    for (const rosbag::ConnectionInfo* c : all.getConnections()) topics.insert(c->topic);
-    for (const std::string& needed : {opt.scan_topic, std::string("/tf")}) {
-      if (!topics.count(needed)) {
-        std::string have;
-        for (const auto& t : topics) have += " " + t;
-        fail(opt.bag + ": no " + needed + " topic in the bag (it has:" + have + ")");
-      }
+  rosbag::View all(*bag);
+  std::set<std::string> topics;
+  for (const rosbag::ConnectionInfo* c : all.getConnections()) topics.insert(c->topic);
+  for (const std::string& needed : {opt.scan_topic, std::string("/tf")}) {
+    if (!topics.count(needed)) {
+      std::string have;
+      for (const auto& t : topics) have += " " + t;
+      fail(opt.bag + ": no " + needed + " topic in the bag (it has:" + have + ")");
     }
   }
+}
 
-  // Odometry comes from /tf when the bag has it there, else from the odometry
-  // topic; never both, or tf2 would see every odometry stamp twice.
+// Whether the bag's /tf carries odometry (odom -> base). Odometry comes from
+// /tf when the bag has it there, else from the odometry topic; never both,
+// or tf2 would see every odometry stamp twice.
+bool odometryOnTf(const rosbag::Bag& bag, const pf_ros::LocalizerConfig& config) {
   bool odom_on_tf = false;
   for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery("/tf"))) {
     const auto msg = m.instantiate<tf2_msgs::TFMessage>();
@@ -199,135 +195,216 @@ int main(int argc, char** argv) {
     }
     if (odom_on_tf) break;
   }
+  return odom_on_tf;
+}
 
-  tf2::BufferCore tf(ros::Duration(600.0));
-  pf_ros::ScanLocalizer localizer(config, &tf);
+void loadMap(const Options& opt, pf_ros::ScanLocalizer* localizer) {
   try {
-    const std::string error = localizer.setMap(pf_ros::toMsg(pf::loadMap(opt.map)));
+    const std::string error = localizer->setMap(pf_ros::toMsg(pf::loadMap(opt.map)));
     if (!error.empty()) fail(opt.map + ": " + error);
   } catch (const pf::MapLoadError& e) {
     fail(e.what());
   }
+}
 
-  std::ofstream out(opt.out);
-  if (!out) fail(opt.out + ": cannot write");
-  out << std::fixed << std::setprecision(6);
-  std::ofstream log, dump;
+// The files a run writes: the trajectory, and the optional update log and
+// particle dump (closed streams when not asked for).
+struct Outputs {
+  std::ofstream out, log, dump;
+};
+
+void openOutputs(const Options& opt, Outputs* o) {
+  o->out.open(opt.out);
+  if (!o->out) fail(opt.out + ": cannot write");
+  o->out << std::fixed << std::setprecision(6);
   if (!opt.log.empty()) {
-    log.open(opt.log);
-    if (!log) fail(opt.log + ": cannot write");
-    log << "t,particles,ess,cpu_ms,mean_beam_likelihood,std_x,std_y,std_yaw,updated,injected,"
-           "tempering,hit_fraction,rivals,state,refined,refine_translation,refine_rotation,"
-           "refine_rms,refine_matched,fault_fraction\n";
+    o->log.open(opt.log);
+    if (!o->log) fail(opt.log + ": cannot write");
+    o->log << "t,particles,ess,cpu_ms,mean_beam_likelihood,std_x,std_y,std_yaw,updated,injected,"
+              "tempering,hit_fraction,rivals,state,refined,refine_translation,refine_rotation,"
+              "refine_rms,refine_matched,fault_fraction\n";
   }
   if (!opt.particles_out.empty()) {
-    dump.open(opt.particles_out);
-    if (!dump) fail(opt.particles_out + ": cannot write");
-    dump << "t,x,y,yaw\n" << std::setprecision(4) << std::fixed;
+    o->dump.open(opt.particles_out);
+    if (!o->dump) fail(opt.particles_out + ": cannot write");
+    o->dump << "t,x,y,yaw\n" << std::setprecision(4) << std::fixed;
   }
+}
 
-  rosbag::View view(bag, rosbag::TopicQuery({opt.scan_topic, opt.odom_topic, "/tf", "/tf_static"}));
-  const double t_begin = view.getBeginTime().toSec(), t_end = view.getEndTime().toSec();
-  ProgressBar progress(!opt.quiet);
-  std::deque<sensor_msgs::LaserScan::ConstPtr> pending;
-  std::map<std::string, int> errors;
+// What the summary reports.
+struct RunCounts {
   std::size_t scans = 0, written = 0, updates = 0;
   double cpu_total = 0.0;
   // CPU time of every update, for the percentiles in the summary.
-  pf_ros::RollingPercentiles update_cpu(std::numeric_limits<std::size_t>::max());
-  double first_stamp = -1.0;
+  pf_ros::RollingPercentiles update_cpu{std::numeric_limits<std::size_t>::max()};
+  std::map<std::string, int> errors;  // scans not used, by reason
+};
 
-  auto process = [&](const sensor_msgs::LaserScan& scan) {
-    const double cpu0 = threadCpuSeconds();
-    const pf_ros::ScanResult r = localizer.processScan(scan);
-    const double cpu = threadCpuSeconds() - cpu0;
-    cpu_total += cpu;
-    const double t = scan.header.stamp.toSec();
-    if (first_stamp < 0) first_stamp = t;
-    if (r.error != pf_ros::ScanError::kNone) {
-      if (errors[pf_ros::toString(r.error)]++ == 0)
-        std::cerr << "\npf_bag_runner: warning: " << pf_ros::errorMessage(r) << "\n";
-      return;
-    }
-    if (r.report.updated) {
-      ++updates;
-      update_cpu.add(cpu);
-      if (log) {
-        const auto& est = localizer.filter().estimate();
-        const pf::Confidence& conf = localizer.filter().confidence();
-        log << std::fixed << std::setprecision(6) << t << "," << r.report.particles << ","
-            << std::setprecision(1) << r.report.ess << "," << std::setprecision(3) << cpu * 1e3
-            << "," << std::setprecision(6) << r.report.mean_beam_likelihood << ","
-            << std::sqrt(est.covariance(0, 0)) << "," << std::sqrt(est.covariance(1, 1)) << ","
-            << std::sqrt(est.covariance(2, 2)) << ",1," << r.report.injected << ","
-            << r.report.tempering << "," << conf.hit_fraction << "," << conf.rivals << ","
-            << pf::toString(conf.state) << "," << r.report.refinement.accepted << ","
-            << r.report.refinement.translation << "," << r.report.refinement.rotation << ","
-            << r.report.refinement.rms_distance << "," << r.report.refinement.matched_beams << ","
-            << r.report.fault_fraction << "\n";
-      }
-      if (dump && t - first_stamp <= kParticleDumpSeconds) {
-        const pf::ParticleSet& p = localizer.filter().particles();
-        for (std::size_t i = 0; i < p.size(); ++i) {
-          dump << t << "," << p.x[i] << "," << p.y[i] << "," << p.yaw[i] << "\n";
-        }
-      }
-    }
-    const auto m2o = localizer.filter().mapToOdom();
-    if (!m2o || !r.odom) return;
-    const pf::Pose2 pose = pf::compose(*m2o, *r.odom);
-    out << t << " " << pose.x << " " << pose.y << " 0 0 0 " << std::sin(pose.yaw / 2) << " "
-        << std::cos(pose.yaw / 2) << "\n";
-    ++written;
-  };
+// The replay: feeds the bag's tf and odometry to tf2 and each scan, once its
+// odometry has arrived, to the localizer, writing what each one gives.
+class Replay {
+ public:
+  Replay(const Options& opt, const pf_ros::LocalizerConfig& config, bool odom_on_tf,
+         tf2::BufferCore* tf, pf_ros::ScanLocalizer* localizer, Outputs* outputs)
+      : opt_(opt),
+        config_(config),
+        odom_on_tf_(odom_on_tf),
+        tf_(*tf),
+        localizer_(*localizer),
+        outputs_(*outputs) {}
 
+  void run(const rosbag::Bag& bag);
+  const RunCounts& counts() const { return counts_; }
+
+ private:
+  void handle(const rosbag::MessageInstance& m);
+  void process(const sensor_msgs::LaserScan& scan);
+  void logUpdate(double t, const pf_ros::ScanResult& r, double cpu);
+  void dumpParticles(double t);
+
+  const Options& opt_;
+  const pf_ros::LocalizerConfig& config_;
+  const bool odom_on_tf_;
+  tf2::BufferCore& tf_;
+  pf_ros::ScanLocalizer& localizer_;
+  Outputs& outputs_;
+  std::deque<sensor_msgs::LaserScan::ConstPtr> pending_;
+  RunCounts counts_;
+  double first_stamp_ = -1.0;
+};
+
+void Replay::run(const rosbag::Bag& bag) {
+  rosbag::View view(bag,
+                    rosbag::TopicQuery({opt_.scan_topic, opt_.odom_topic, "/tf", "/tf_static"}));
+  const double t_begin = view.getBeginTime().toSec(), t_end = view.getEndTime().toSec();
+  ProgressBar progress(!opt_.quiet);
   try {
     for (const rosbag::MessageInstance& m : view) {
       const double now = m.getTime().toSec();
-      if (m.getTopic() == "/tf" || m.getTopic() == "/tf_static") {
-        const bool is_static = m.getTopic() == "/tf_static";
-        if (const auto msg = m.instantiate<tf2_msgs::TFMessage>()) {
-          for (const auto& t : msg->transforms) tf.setTransform(t, "bag", is_static);
-        }
-      } else if (m.getTopic() == opt.odom_topic) {
-        const auto odom = m.instantiate<nav_msgs::Odometry>();
-        if (odom && !odom_on_tf) tf.setTransform(pf_ros::odometryToTransform(*odom), "odom_topic");
-      } else if (const auto scan = m.instantiate<sensor_msgs::LaserScan>()) {
-        ++scans;
-        pending.push_back(scan);
-      }
+      handle(m);
       // A scan is used once odometry reaches its stamp, as pf_node's tf
       // message filter would, or when it has waited too long.
-      while (!pending.empty()) {
-        const auto& s = pending.front();
-        const bool ready = tf.canTransform(config.odom_frame, config.base_frame, s->header.stamp) &&
-                           tf.canTransform(config.base_frame, s->header.frame_id, ros::Time(0));
+      while (!pending_.empty()) {
+        const auto& s = pending_.front();
+        const bool ready =
+            tf_.canTransform(config_.odom_frame, config_.base_frame, s->header.stamp) &&
+            tf_.canTransform(config_.base_frame, s->header.frame_id, ros::Time(0));
         if (!ready && now - s->header.stamp.toSec() < kMaxTfWait) {
           break;
         }
         process(*s);
-        pending.pop_front();
+        pending_.pop_front();
       }
       progress.show((now - t_begin) / std::max(1e-9, t_end - t_begin), now - t_begin);
     }
   } catch (const rosbag::BagException& e) {
-    fail(opt.bag + ": error while reading: " + e.what());
+    fail(opt_.bag + ": error while reading: " + e.what());
   }
-  for (const auto& s : pending) process(*s);
+  for (const auto& s : pending_) process(*s);
   progress.done();
+}
 
-  std::cerr << "pf_bag_runner: " << scans << " scans, " << updates << " filter updates, " << written
-            << " poses written to " << opt.out << "; CPU " << std::setprecision(3) << cpu_total
-            << " s (" << (updates ? 1e3 * cpu_total / updates : 0.0) << " ms per update)\n";
-  if (updates > 0) {
-    std::cerr << "pf_bag_runner: CPU per update: p50 " << 1e3 * update_cpu.percentile(0.5)
-              << " ms, p95 " << 1e3 * update_cpu.percentile(0.95) << " ms, max "
-              << 1e3 * update_cpu.max() << " ms\n";
+// One message: tf and odometry into tf2, a scan into the queue.
+void Replay::handle(const rosbag::MessageInstance& m) {
+  if (m.getTopic() == "/tf" || m.getTopic() == "/tf_static") {
+    const bool is_static = m.getTopic() == "/tf_static";
+    if (const auto msg = m.instantiate<tf2_msgs::TFMessage>()) {
+      for (const auto& t : msg->transforms) tf_.setTransform(t, "bag", is_static);
+    }
+  } else if (m.getTopic() == opt_.odom_topic) {
+    const auto odom = m.instantiate<nav_msgs::Odometry>();
+    if (odom && !odom_on_tf_) tf_.setTransform(pf_ros::odometryToTransform(*odom), "odom_topic");
+  } else if (const auto scan = m.instantiate<sensor_msgs::LaserScan>()) {
+    ++counts_.scans;
+    pending_.push_back(scan);
   }
-  for (const auto& e : errors) {
+}
+
+void Replay::process(const sensor_msgs::LaserScan& scan) {
+  const double cpu0 = threadCpuSeconds();
+  const pf_ros::ScanResult r = localizer_.processScan(scan);
+  const double cpu = threadCpuSeconds() - cpu0;
+  counts_.cpu_total += cpu;
+  const double t = scan.header.stamp.toSec();
+  if (first_stamp_ < 0) first_stamp_ = t;
+  if (r.error != pf_ros::ScanError::kNone) {
+    if (counts_.errors[pf_ros::toString(r.error)]++ == 0)
+      std::cerr << "\npf_bag_runner: warning: " << pf_ros::errorMessage(r) << "\n";
+    return;
+  }
+  if (r.report.updated) {
+    ++counts_.updates;
+    counts_.update_cpu.add(cpu);
+    if (outputs_.log) logUpdate(t, r, cpu);
+    if (outputs_.dump && t - first_stamp_ <= kParticleDumpSeconds) dumpParticles(t);
+  }
+  // The pose a tf user would get: the newest map -> odom composed with the
+  // odometry at the scan's stamp.
+  const auto m2o = localizer_.filter().mapToOdom();
+  if (!m2o || !r.odom) return;
+  const pf::Pose2 pose = pf::compose(*m2o, *r.odom);
+  outputs_.out << t << " " << pose.x << " " << pose.y << " 0 0 0 " << std::sin(pose.yaw / 2) << " "
+               << std::cos(pose.yaw / 2) << "\n";
+  ++counts_.written;
+}
+
+// One line of the update log (the columns of openOutputs' header).
+void Replay::logUpdate(double t, const pf_ros::ScanResult& r, double cpu) {
+  const auto& est = localizer_.filter().estimate();
+  const pf::Confidence& conf = localizer_.filter().confidence();
+  outputs_.log << std::fixed << std::setprecision(6) << t << "," << r.report.particles << ","
+               << std::setprecision(1) << r.report.ess << "," << std::setprecision(3) << cpu * 1e3
+               << "," << std::setprecision(6) << r.report.mean_beam_likelihood << ","
+               << std::sqrt(est.covariance(0, 0)) << "," << std::sqrt(est.covariance(1, 1)) << ","
+               << std::sqrt(est.covariance(2, 2)) << ",1," << r.report.injected << ","
+               << r.report.tempering << "," << conf.hit_fraction << "," << conf.rivals << ","
+               << pf::toString(conf.state) << "," << r.report.refinement.accepted << ","
+               << r.report.refinement.translation << "," << r.report.refinement.rotation << ","
+               << r.report.refinement.rms_distance << "," << r.report.refinement.matched_beams
+               << "," << r.report.fault_fraction << "\n";
+}
+
+void Replay::dumpParticles(double t) {
+  const pf::ParticleSet& p = localizer_.filter().particles();
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    outputs_.dump << t << "," << p.x[i] << "," << p.y[i] << "," << p.yaw[i] << "\n";
+  }
+}
+
+// The summary on stderr; exits with an error when no scan was found or no
+// pose written.
+void summarize(const Options& opt, const RunCounts& c) {
+  std::cerr << "pf_bag_runner: " << c.scans << " scans, " << c.updates << " filter updates, "
+            << c.written << " poses written to " << opt.out << "; CPU " << std::setprecision(3)
+            << c.cpu_total << " s (" << (c.updates ? 1e3 * c.cpu_total / c.updates : 0.0)
+            << " ms per update)\n";
+  if (c.updates > 0) {
+    std::cerr << "pf_bag_runner: CPU per update: p50 " << 1e3 * c.update_cpu.percentile(0.5)
+              << " ms, p95 " << 1e3 * c.update_cpu.percentile(0.95) << " ms, max "
+              << 1e3 * c.update_cpu.max() << " ms\n";
+  }
+  for (const auto& e : c.errors) {
     std::cerr << "pf_bag_runner: " << e.second << " scans not used: " << e.first << "\n";
   }
-  if (scans == 0) fail(opt.bag + ": no scans on " + opt.scan_topic);
-  if (written == 0) fail("no pose could be estimated (see the warnings above)", 3);
+  if (c.scans == 0) fail(opt.bag + ": no scans on " + opt.scan_topic);
+  if (c.written == 0) fail("no pose could be estimated (see the warnings above)", 3);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const Options opt = parse(argc, argv);
+  const pf_ros::LocalizerConfig config = makeConfig(opt);
+  rosbag::Bag bag;
+  openBag(opt, &bag);
+  const bool odom_on_tf = odometryOnTf(bag, config);
+  tf2::BufferCore tf(ros::Duration(600.0));
+  pf_ros::ScanLocalizer localizer(config, &tf);
+  loadMap(opt, &localizer);
+  Outputs outputs;
+  openOutputs(opt, &outputs);
+  Replay replay(opt, config, odom_on_tf, &tf, &localizer, &outputs);
+  replay.run(bag);
+  summarize(opt, replay.counts());
   return 0;
 }

@@ -166,6 +166,78 @@ geometry_msgs::TransformStamped transform(const ros::Time& stamp, const std::str
   return t;
 }
 
+// /tf (odom -> base_link and the laser's mounting) and /odom at `stamp`.
+void writeOdometry(const ros::Time& stamp, const pf::sim::DiffDriveRobot& robot, uint32_t seq,
+                   rosbag::Bag* bag) {
+  tf2_msgs::TFMessage odom_tf, mount_tf;
+  odom_tf.transforms.push_back(transform(stamp, "odom", "base_link", robot.odomPose()));
+  mount_tf.transforms.push_back(
+      transform(stamp, "base_link", "base_laser_link", kLaserMount, kLaserHeight));
+  bag->write("/tf", stamp, odom_tf);
+  bag->write("/tf", stamp, mount_tf);
+
+  nav_msgs::Odometry odom;
+  odom.header.seq = seq;
+  odom.header.stamp = stamp;
+  odom.header.frame_id = "odom";
+  odom.child_frame_id = "base_link";
+  odom.pose.pose = pf_ros::toPoseMsg(robot.odomPose());
+  // The covariance the Neato driver publishes (x, y, z 0.1; angles 1e5).
+  for (int i = 0; i < 6; ++i) odom.pose.covariance[i * 7] = i < 3 ? 0.1 : 1e5;
+  odom.twist.twist.linear.x = robot.odomLinearVelocity();
+  odom.twist.twist.angular.z = robot.odomAngularVelocity();
+  bag->write("/odom", stamp, odom);
+}
+
+// /ground_truth at `stamp`: the true base_link pose in the map.
+void writeGroundTruth(const ros::Time& stamp, const pf::sim::DiffDriveRobot& robot, uint32_t seq,
+                      rosbag::Bag* bag) {
+  geometry_msgs::PoseStamped truth;
+  truth.header.seq = seq;
+  truth.header.stamp = stamp;
+  truth.header.frame_id = "map";
+  truth.pose = pf_ros::toPoseMsg(robot.truePose());
+  bag->write("/ground_truth", stamp, truth);
+}
+
+// The true range of every beam from `sensor` at time t (s into the run): to
+// the map's walls or the nearest person, at most range_max.
+std::vector<double> idealRanges(const pf::sim::RayCaster& caster,
+                                const std::vector<pf::sim::Person>& people, const Pose2& sensor,
+                                double t, double range_max) {
+  std::vector<double> ideal(kBeams);
+  for (int i = 0; i < kBeams; ++i) {
+    const double angle = sensor.yaw + i * (2.0 * M_PI / kBeams);
+    double r = caster.cast(sensor.x, sensor.y, angle, range_max);
+    for (const pf::sim::Person& p : people) {
+      double px, py;
+      p.positionAt(t, &px, &py);
+      r = std::min(r, pf::sim::castToCircle(sensor.x, sensor.y, angle, px, py, p.radius));
+    }
+    ideal[i] = r;
+  }
+  return ideal;
+}
+
+// A /scan message at `stamp` with the Neato's readings of `ideal`.
+sensor_msgs::LaserScan neatoScan(const ros::Time& stamp, uint32_t seq,
+                                 const std::vector<double>& ideal, const NeatoLaserParams& laser,
+                                 pf::sim::SimRandom* laser_random) {
+  sensor_msgs::LaserScan scan;
+  scan.header.seq = seq;
+  scan.header.stamp = stamp;
+  scan.header.frame_id = "base_laser_link";
+  scan.angle_min = 0.0;
+  scan.angle_increment = 2.0 * M_PI / kBeams;
+  scan.angle_max = (kBeams - 1) * scan.angle_increment;
+  scan.time_increment = 0.0;            // every beam is cast from the pose at the stamp
+  scan.scan_time = kScanEvery * kTick;  // one turn of the laser, however sparse the log
+  scan.range_min = laser.range_min;
+  scan.range_max = laser.range_max;
+  scan.ranges = pf::sim::neatoReadings(ideal, laser, laser_random);
+  return scan;
+}
+
 // Writes the run into the bag; returns the fraction of invalid beams.
 double simulate(const Options& o, const pf::OccupancyGrid& map, const pf::sim::PathScript& script,
                 rosbag::Bag* bag) {
@@ -190,60 +262,13 @@ double simulate(const Options& o, const pf::OccupancyGrid& map, const pf::sim::P
 
     ros::Time stamp;
     stamp.fromNSec(start_ns + tick * kTickNs);
-    if (tick % kOdomEvery == 0) {
-      tf2_msgs::TFMessage odom_tf, mount_tf;
-      odom_tf.transforms.push_back(transform(stamp, "odom", "base_link", robot.odomPose()));
-      mount_tf.transforms.push_back(
-          transform(stamp, "base_link", "base_laser_link", kLaserMount, kLaserHeight));
-      bag->write("/tf", stamp, odom_tf);
-      bag->write("/tf", stamp, mount_tf);
-
-      nav_msgs::Odometry odom;
-      odom.header.seq = odom_seq++;
-      odom.header.stamp = stamp;
-      odom.header.frame_id = "odom";
-      odom.child_frame_id = "base_link";
-      odom.pose.pose = pf_ros::toPoseMsg(robot.odomPose());
-      // The covariance the Neato driver publishes (x, y, z 0.1; angles 1e5).
-      for (int i = 0; i < 6; ++i) odom.pose.covariance[i * 7] = i < 3 ? 0.1 : 1e5;
-      odom.twist.twist.linear.x = robot.odomLinearVelocity();
-      odom.twist.twist.angular.z = robot.odomAngularVelocity();
-      bag->write("/odom", stamp, odom);
-    }
-    if (tick % kTruthEvery == 0) {
-      geometry_msgs::PoseStamped truth;
-      truth.header.seq = truth_seq++;
-      truth.header.stamp = stamp;
-      truth.header.frame_id = "map";
-      truth.pose = pf_ros::toPoseMsg(robot.truePose());
-      bag->write("/ground_truth", stamp, truth);
-    }
+    if (tick % kOdomEvery == 0) writeOdometry(stamp, robot, odom_seq++, bag);
+    if (tick % kTruthEvery == 0) writeGroundTruth(stamp, robot, truth_seq++, bag);
     if (tick % o.scan_every == kScanOffset % o.scan_every) {
       const Pose2 sensor = pf::compose(robot.truePose(), kLaserMount);
-      const double t = tick * kTick;
-      std::vector<double> ideal(kBeams);
-      for (int i = 0; i < kBeams; ++i) {
-        const double angle = sensor.yaw + i * (2.0 * M_PI / kBeams);
-        double r = caster.cast(sensor.x, sensor.y, angle, laser.range_max);
-        for (const pf::sim::Person& p : people) {
-          double px, py;
-          p.positionAt(t, &px, &py);
-          r = std::min(r, pf::sim::castToCircle(sensor.x, sensor.y, angle, px, py, p.radius));
-        }
-        ideal[i] = r;
-      }
-      sensor_msgs::LaserScan scan;
-      scan.header.seq = scan_seq++;
-      scan.header.stamp = stamp;
-      scan.header.frame_id = "base_laser_link";
-      scan.angle_min = 0.0;
-      scan.angle_increment = 2.0 * M_PI / kBeams;
-      scan.angle_max = (kBeams - 1) * scan.angle_increment;
-      scan.time_increment = 0.0;            // every beam is cast from the pose at the stamp
-      scan.scan_time = kScanEvery * kTick;  // one turn of the laser, however sparse the log
-      scan.range_min = laser.range_min;
-      scan.range_max = laser.range_max;
-      scan.ranges = pf::sim::neatoReadings(ideal, laser, &laser_random);
+      const std::vector<double> ideal =
+          idealRanges(caster, people, sensor, tick * kTick, laser.range_max);
+      const sensor_msgs::LaserScan scan = neatoScan(stamp, scan_seq++, ideal, laser, &laser_random);
       for (float r : scan.ranges) invalid += r == 0.0f;
       beams += kBeams;
       bag->write("/scan", stamp, scan);

@@ -126,6 +126,15 @@ class ScanRefiner {
  private:
   struct Evaluation;
   Evaluation evaluate(const PreparedScan& scan, const Pose2& pose, bool with_derivatives) const;
+  /// The scan's cost over beam_std^2 plus the prior's, at `at`.
+  double totalCost(const Evaluation& e, const Pose2& at, const Pose2& start,
+                   const Eigen::Matrix3d& prior_information) const;
+  /// Gauss-Newton with a backtracking line search from *fitted (evaluated in
+  /// *fitted_evaluation, with derivatives), both updated to the fit. Returns
+  /// the iterations taken.
+  int minimise(const PreparedScan& scan, const Pose2& start,
+               const Eigen::Matrix3d& prior_information, Pose2* fitted,
+               Evaluation* fitted_evaluation) const;
 
   BicubicDistanceField field_;
   ScanRefinerParams params_;
