@@ -104,7 +104,8 @@ const ParameterTable<RecoveryParams>& recoveryParameters() {
       member(&P::alpha_slow,
              I("recovery_alpha_slow", "1/update", "long-term average rate of the scan fit")
                  .in(Range::closed(0, 1))
-                 .withNote("0: no injection on a falling fit; a cloud that turns lost is still searched")
+                 .withNote(
+                     "0: no injection on a falling fit; a cloud that turns lost is still searched")
                  .amcl()
                  .live(0, 1)),
       member(&P::alpha_fast,
