@@ -188,7 +188,7 @@ wanted bag_demo &&
   check "bag_demo: roslaunch bag_demo.launch rviz:=false: map -> odom on /tf, pf_status localized" bag_demo
 if wanted help; then
   for tool in pf_evaluate pf_tune benchmark_datasets compare_scans.py \
-              pf_bag_runner map_publisher pf_simulator pf_make_map pf_node; do
+              pf_bag_runner map_publisher pf_simulator pf_make_map pf_param_docs pf_node; do
     check "help $tool: rosrun pf_localization $tool --help, no ROS master" tool_help "$tool"
   done
 fi
