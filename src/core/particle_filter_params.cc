@@ -40,11 +40,11 @@ void setLaserModel(ParticleFilterParams& p, const std::string& word) {
                                                          : LaserModelType::kLikelihoodField;
 }
 
-// The rows of ParticleFilterParams' own members.
-const ParameterTable<ParticleFilterParams>& ownParameters() {
+// ParticleFilterParams' own members, by the group each is listed under.
+ParameterTable<ParticleFilterParams> updateParameters() {
   using P = ParticleFilterParams;
   using I = ParamInfo;
-  static const ParameterTable<P> table = {
+  return {
       member(&P::update_min_d, I("update_min_d", "m", "translation that triggers a filter update")
                                    .in(Range::atLeast(0))
                                    .amcl()
@@ -52,12 +52,29 @@ const ParameterTable<ParticleFilterParams>& ownParameters() {
       member(&P::update_min_a, I("update_min_a", "rad", "rotation that triggers a filter update")
                                    .in(Range::atLeast(0))
                                    .amcl()
-                                   .live(0, 6.2832)),
-      computed<P, std::string>([](const P& p) { return laserModelName(p.laser_model_type); },
-                               setLaserModel, laserModelInfo()),
-      member(&P::refine_estimate,
-             I("refine_estimate", "", "publish the pose fitted to the map by the scan").live()),
-  };
+                                   .live(0, 6.2832))};
+}
+
+ParameterTable<ParticleFilterParams> laserModelParameters() {
+  return {computed<ParticleFilterParams, std::string>(
+      [](const ParticleFilterParams& p) { return laserModelName(p.laser_model_type); },
+      setLaserModel, laserModelInfo())};
+}
+
+ParameterTable<ParticleFilterParams> refinementParameters() {
+  return {member(
+      &ParticleFilterParams::refine_estimate,
+      ParamInfo("refine_estimate", "", "publish the pose fitted to the map by the scan").live())};
+}
+
+// All of them, for the check.
+const ParameterTable<ParticleFilterParams>& ownParameters() {
+  static const ParameterTable<ParticleFilterParams> table = [] {
+    ParameterTable<ParticleFilterParams> t = updateParameters();
+    append(&t, laserModelParameters(), "sensor");
+    append(&t, refinementParameters(), "refinement");
+    return t;
+  }();
   return table;
 }
 
@@ -138,20 +155,16 @@ void validateInternals(const RecoveryParams& r) {
 const ParameterTable<ParticleFilterParams>& particleFilterParameters() {
   using P = ParticleFilterParams;
   static const ParameterTable<P> table = [] {
-    const ParameterTable<P>& own = ownParameters();
-    const auto rows = [&own](std::size_t from, std::size_t to) {
-      return ParameterTable<P>(own.begin() + from, own.begin() + to);
-    };
     ParameterTable<P> t;
     append(&t, nested(&P::kld, kldParameters()), "particles");
-    append(&t, rows(0, 2), "updates");
+    append(&t, updateParameters(), "updates");
     append(&t, nested(&P::recovery, recoveryParameters()), "recovery");
     append(&t, nested(&P::motion, odometryMotionParameters()), "motion");
-    append(&t, rows(2, 3), "sensor");
+    append(&t, laserModelParameters(), "sensor");
     append(&t, nested(&P::sensor, likelihoodFieldParameters()), "sensor");
     append(&t, nested(&P::sensor, beamSkipParameters()), "sensor");
     append(&t, nested(&P::beam, beamModelParameters()), "sensor");
-    append(&t, rows(3, 4), "refinement");
+    append(&t, refinementParameters(), "refinement");
     return t;
   }();
   return table;
