@@ -21,35 +21,43 @@ void cubicWeights(double t, double w[4], double dw[4]) {
 
 }  // namespace
 
+BicubicDistanceField::BicubicDistanceField(const LikelihoodField& field)
+    : field_(field),
+      cos_yaw_(std::cos(field.grid().origin().yaw)),
+      sin_yaw_(std::sin(field.grid().origin().yaw)),
+      inv_resolution_(1.0 / field.grid().resolution()),
+      origin_x_(field.grid().origin().x),
+      origin_y_(field.grid().origin().y),
+      width_(field.grid().width()),
+      height_(field.grid().height()) {}
+
 FieldSample BicubicDistanceField::sample(double wx, double wy) const {
-  const OccupancyGrid& grid = field_.grid();
-  const double max_distance = field_.maxDistance();
-  const double c = std::cos(grid.origin().yaw), s = std::sin(grid.origin().yaw);
-  const double inv_res = 1.0 / grid.resolution();
-  const double ox = wx - grid.origin().x, oy = wy - grid.origin().y;
+  const double c = cos_yaw_, s = sin_yaw_, inv_res = inv_resolution_;
+  const double ox = wx - origin_x_, oy = wy - origin_y_;
   // Continuous cell coordinates in which cell centres are integers.
   const double gx = (c * ox + s * oy) * inv_res - 0.5;
   const double gy = (-s * ox + c * oy) * inv_res - 0.5;
   // Well off the map (or NaN): nothing there, as in the likelihood field.
-  if (!(gx > -2.0 && gy > -2.0 && gx < grid.width() + 1.0 && gy < grid.height() + 1.0)) {
-    return {max_distance, 0.0, 0.0};
+  if (!(gx > -2.0 && gy > -2.0 && gx < width_ + 1.0 && gy < height_ + 1.0)) {
+    return {field_.maxDistance(), 0.0, 0.0};
   }
   const int ix = static_cast<int>(std::floor(gx)), iy = static_cast<int>(std::floor(gy));
   double wxs[4], dwxs[4], wys[4], dwys[4];
   cubicWeights(gx - ix, wxs, dwxs);
   cubicWeights(gy - iy, wys, dwys);
-  const std::vector<float>& d = field_.distances();
-  double value = 0.0, dgx = 0.0, dgy = 0.0;
   // A stencil that reaches past the map's edge repeats the edge cells.
   // max_distance there instead would be a cliff next to a wall on the edge,
   // which the cubic overshoots into negative distances, making false minima.
   const auto clamp = [](int v, int size) { return v < 0 ? 0 : (v >= size ? size - 1 : v); };
+  int xs[4];
+  for (int i = 0; i < 4; ++i) xs[i] = clamp(ix - 1 + i, width_);
+  const float* d = field_.distances().data();
+  double value = 0.0, dgx = 0.0, dgy = 0.0;
   for (int j = 0; j < 4; ++j) {
-    const int y = clamp(iy - 1 + j, grid.height());
+    const float* row_cells = d + static_cast<std::size_t>(clamp(iy - 1 + j, height_)) * width_;
     double row = 0.0, drow = 0.0;
     for (int i = 0; i < 4; ++i) {
-      const double v =
-          d[static_cast<std::size_t>(y) * grid.width() + clamp(ix - 1 + i, grid.width())];
+      const double v = row_cells[xs[i]];
       row += wxs[i] * v;
       drow += dwxs[i] * v;
     }

@@ -29,7 +29,7 @@ struct FieldSample {
 class BicubicDistanceField {
  public:
   /// Keeps a reference: `field` must outlive this object.
-  explicit BicubicDistanceField(const LikelihoodField& field) : field_(field) {}
+  explicit BicubicDistanceField(const LikelihoodField& field);
 
   /// The distance at world point (wx, wy) and its gradient. More than a
   /// cell and a half off the map, or at a non-finite point: max_distance
@@ -38,6 +38,10 @@ class BicubicDistanceField {
 
  private:
   const LikelihoodField& field_;
+  // The grid's geometry, taken once: sample() runs for every beam of every
+  // Gauss-Newton evaluation.
+  double cos_yaw_, sin_yaw_, inv_resolution_, origin_x_, origin_y_;
+  int width_, height_;
 };
 
 }  // namespace pf
