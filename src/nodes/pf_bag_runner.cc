@@ -5,7 +5,12 @@
 //
 // Writes the estimate at every scan in TUM format (t x y z qx qy qz qw): the
 // newest map -> odom composed with the odometry at the scan's stamp, which is
-// exactly the pose a tf user would get from pf_node at that time.
+// exactly the pose a tf user would get from pf_node at that time. With
+// --covariance, beside each of those poses the covariance a pf_pose
+// subscriber holds at that scan: pf_node publishes the estimate at each filter
+// update (and on a re-initialisation), so between updates it is the last
+// update's.
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
 #include <tf2/buffer_core.h>
@@ -20,6 +25,7 @@
 #include <iostream>
 #include <limits>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -41,6 +47,8 @@ constexpr char kUsage[] =
     "         [--scan-topic /scan] [--odom-topic /odom]\n"
     "         [--log UPDATES.csv]        one line per filter update\n"
     "         [--particles-out P.csv]    every particle of every update in the first 30 s\n"
+    "         [--covariance COV.csv]     t,xx,xy,yy,yawyaw,xyaw,yyaw: pf_pose's covariance\n"
+    "                                    at each pose of the trajectory (same stamps)\n"
     "         [--quiet]                  no progress bar\n";
 
 // How long (bag time) a scan may wait for its odometry before it is used anyway.
@@ -49,7 +57,7 @@ constexpr double kMaxTfWait = 1.0;
 constexpr double kParticleDumpSeconds = 30.0;
 
 struct Options {
-  std::string bag, map, out, params, log, particles_out;
+  std::string bag, map, out, params, log, particles_out, covariance;
   std::string scan_topic = "/scan", odom_topic = "/odom";
   std::optional<pf::Pose2> initial_pose;
   int particles = 0, max_beams = 0;
@@ -91,6 +99,8 @@ Options parse(int argc, char** argv) {
       o.log = value(), ++i;
     else if (a == "--particles-out")
       o.particles_out = value(), ++i;
+    else if (a == "--covariance")
+      o.covariance = value(), ++i;
     else if (a == "--scan-topic")
       o.scan_topic = value(), ++i;
     else if (a == "--odom-topic")
@@ -207,10 +217,10 @@ void loadMap(const Options& opt, pf_ros::ScanLocalizer* localizer) {
   }
 }
 
-// The files a run writes: the trajectory, and the optional update log and
-// particle dump (closed streams when not asked for).
+// The files a run writes: the trajectory, and the optional update log,
+// particle dump and covariance (closed streams when not asked for).
 struct Outputs {
-  std::ofstream out, log, dump;
+  std::ofstream out, log, dump, cov;
 };
 
 void openOutputs(const Options& opt, Outputs* o) {
@@ -228,6 +238,11 @@ void openOutputs(const Options& opt, Outputs* o) {
     o->dump.open(opt.particles_out);
     if (!o->dump) fail(opt.particles_out + ": cannot write");
     o->dump << "t,x,y,yaw\n" << std::setprecision(4) << std::fixed;
+  }
+  if (!opt.covariance.empty()) {
+    o->cov.open(opt.covariance);
+    if (!o->cov) fail(opt.covariance + ": cannot write");
+    o->cov << "t,xx,xy,yy,yawyaw,xyaw,yyaw\n";
   }
 }
 
@@ -261,6 +276,7 @@ class Replay {
   void process(const sensor_msgs::LaserScan& scan);
   void logUpdate(double t, const pf_ros::ScanResult& r, double cpu);
   void dumpParticles(double t);
+  void writeCovariance(double t);
 
   const Options& opt_;
   const pf_ros::LocalizerConfig& config_;
@@ -269,6 +285,8 @@ class Replay {
   pf_ros::ScanLocalizer& localizer_;
   Outputs& outputs_;
   std::deque<sensor_msgs::LaserScan::ConstPtr> pending_;
+  // What pf_node last published on pf_pose (it publishes at each update).
+  std::optional<geometry_msgs::PoseWithCovarianceStamped> published_;
   RunCounts counts_;
   double first_stamp_ = -1.0;
 };
@@ -278,6 +296,8 @@ void Replay::run(const rosbag::Bag& bag) {
                     rosbag::TopicQuery({opt_.scan_topic, opt_.odom_topic, "/tf", "/tf_static"}));
   const double t_begin = view.getBeginTime().toSec(), t_end = view.getEndTime().toSec();
   ProgressBar progress(!opt_.quiet);
+  // pf_node publishes the estimate once it has the map, as the filter starts.
+  published_ = localizer_.estimate(ros::Time(t_begin));
   try {
     for (const rosbag::MessageInstance& m : view) {
       const double now = m.getTime().toSec();
@@ -333,6 +353,7 @@ void Replay::process(const sensor_msgs::LaserScan& scan) {
     return;
   }
   if (r.report.updated) {
+    published_ = localizer_.estimate(scan.header.stamp);
     ++counts_.updates;
     counts_.update_cpu.add(cpu);
     if (outputs_.log) logUpdate(t, r, cpu);
@@ -345,7 +366,22 @@ void Replay::process(const sensor_msgs::LaserScan& scan) {
   const pf::Pose2 pose = pf::compose(*m2o, *r.odom);
   outputs_.out << t << " " << pose.x << " " << pose.y << " 0 0 0 " << std::sin(pose.yaw / 2) << " "
                << std::cos(pose.yaw / 2) << "\n";
+  if (outputs_.cov) writeCovariance(t);
   ++counts_.written;
+}
+
+// One line of the covariance file: the published message's x, y, yaw terms
+// (ROS's 6 x 6 row-major order: x 0, y 1, yaw 5).
+void Replay::writeCovariance(double t) {
+  outputs_.cov << std::fixed << std::setprecision(6) << t;
+  if (!published_) {
+    outputs_.cov << ",nan,nan,nan,nan,nan,nan\n";
+    return;
+  }
+  const auto& c = published_->pose.covariance;
+  outputs_.cov << std::scientific << std::setprecision(9);
+  for (const int i : {0, 1, 7, 35, 5, 11}) outputs_.cov << "," << c[i];
+  outputs_.cov << "\n";
 }
 
 // One line of the update log (the columns of openOutputs' header).

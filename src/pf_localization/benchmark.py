@@ -11,12 +11,14 @@ the same devel or install space, and the bundled bags of the package ROS finds: 
 pf_localization/locate.py)
 from the dataset's known initial pose (global localization for bags/global.bag), with the default
 configuration (config/pf.yaml's values; add particle counts, e.g. 5000, for more rows), evaluates
-the trajectory with pf_evaluate, and prints one table: ATE RMSE, median and max error, the
-share of the run more than 0.5 m off after its first 10 s, the confidently wrong updates (state
-"localized" while more than 1 m off), yaw RMSE, convergence time, CPU time per update and wall time
-per run. With --workers N (a Dask LocalCluster of N worker processes) or --scheduler (a running Dask
+the trajectory with pf_evaluate, and prints one table: ATE RMSE (raw, and after the best rigid fit
+onto the reference), median and max error, the share of the run more than 0.5 m off after its first
+10 s, the confidently wrong updates (state "localized" while more than 1 m off), the published
+covariance's honesty after the first 10 s (share of reference poses inside its 95 % ellipse, with
+the reference's own noise added; mean NEES, 2 if honest), yaw RMSE, convergence time, CPU time per
+update and wall time per run. With --workers N (a Dask LocalCluster of N worker processes) or --scheduler (a running Dask
 cluster: README.md, "Tuning the parameters: pf_tune") every run is a Dask task, as in pf_tune; the
-table is the same, but CPU and wall times then include the contention of parallel runs. Each run's files (trajectory, update log, runner output, evaluation report) go to
+table is the same, but CPU and wall times then include the contention of parallel runs. Each run's files (trajectory, update log, covariance, runner output, evaluation report) go to
 OUT/<dataset>_<particles>/; the table is also written to OUT/results.csv and OUT/results.md. Exit
 status 0 if every run succeeded, 1 if not (a missing data folder is not a failure: it is reported,
 and the bundled bags still run).
@@ -36,14 +38,24 @@ from pf_localization import locate
 
 # name: folder ('{data}' for ../shared/data/<name>, '{repo}' for the package), bag, map, initial
 # pose (x, y, yaw) in the map frame or None for global localization, reference (pf_evaluate option,
-# file in the folder)
+# file in the folder), ref_std: the reference's own position std dev per axis (m, pf_evaluate
+# --ref-std: added to the published covariance when judging it; the bundled bags' is 0, exact truth)
 DATASETS = {
+    # AprilTag reference "good to about 0.1 m" (README.txt): its distance to a scan-to-map match of
+    # every scan has median 0.078 m, which for an isotropic Gaussian (median radius 1.177 sigma)
+    # is sigma = 0.066 m per axis, the scan matcher's own error included: 0.07 m.
     'neato_ac109_1': dict(dir='{data}/neato_ac109_1', bag='ac109_1.bag', map='ac109_1.yaml',
-                          pose=(3.972, -0.090, 2.904), ref=('--bag', 'ac109_1.bag')),
+                          pose=(3.972, -0.090, 2.904), ref=('--bag', 'ac109_1.bag'), ref_std=0.07),
+    # GMapping's corrected poses, a SLAM result. The map was ray-cast from these very poses, so the
+    # SLAM run's global error is shared by map and reference and does not count; what does is its
+    # local jitter, ~1-3 cm per step (README.txt, "good to a few cm locally"): 0.03 m. Scan end points
+    # lie on the map's walls (mean 0.014 m off, 83 % within 5 cm), which bounds it too.
     'intel_lab': dict(dir='{data}/intel_lab', bag='intel.bag', map='intel_map.yaml',
-                      pose=(0.600, -0.032, -0.355), ref=('--ref', 'intel_reference_tum.txt')),
+                      pose=(0.600, -0.032, -0.355), ref=('--ref', 'intel_reference_tum.txt'), ref_std=0.03),
+    # Made like intel_lab, but its scans fit the map less well (end points 0.033 m off on average,
+    # 72 % within 5 cm): 0.05 m.
     'fr079': dict(dir='{data}/fr079', bag='fr079.bag', map='fr079_map.yaml', pose=(0.001, -0.001, 0.0),
-                  ref=('--ref', 'fr079_reference_tum.txt')),
+                  ref=('--ref', 'fr079_reference_tum.txt'), ref_std=0.05),
 }
 BUNDLED = {
     'sim_tracking': dict(dir='{repo}', bag='bags/tracking.bag', map='maps/building.yaml', pose=(1.5, 7.6, 0.0),
@@ -68,8 +80,10 @@ SKIPPED = {
     'neato_ksoltan_2018': 'no ground truth (a symmetric box: smoke test only)',
 }
 COLUMNS = [('dataset', 'dataset', '%s'), ('particles', 'particles', '%s'), ('particles_mean', 'mean n', '%.0f'),
-           ('ate_rmse_m', 'ATE RMSE m', '%.3f'), ('median_m', 'median m', '%.3f'), ('max_m', 'max m', '%.2f'),
+           ('ate_rmse_m', 'ATE RMSE m', '%.3f'), ('ate_aligned_rmse_m', 'ATE aligned m', '%.3f'),
+           ('median_m', 'median m', '%.3f'), ('max_m', 'max m', '%.2f'),
            ('off_pct', '> 0.5 m off %', '%.1f'), ('confidently_wrong_updates', 'confidently wrong', '%d'),
+           ('inside_95_pct', 'in 95 % ellipse %', '%.1f'), ('nees_mean', 'NEES mean', '%.2f'),
            ('yaw_rmse_deg', 'yaw RMSE deg', '%.2f'),
            ('convergence_time_s', 'converged s', '%.1f'), ('cpu_ms_per_update', 'CPU ms/update', '%.2f'),
            ('wall_s', 'wall s', '%.1f'), ('status', 'status', '%s')]
@@ -83,11 +97,12 @@ def run_one(runner, folder, name, spec, n, out, args):
     run_dir = os.path.join(out, '%s_%s' % (name, label))
     os.makedirs(run_dir, exist_ok=True)
     traj, log = os.path.join(run_dir, 'traj.tum'), os.path.join(run_dir, 'updates.csv')
-    for f in (traj, log):
+    cov = os.path.join(run_dir, 'cov.csv')
+    for f in (traj, log, cov):
         if os.path.exists(f):
             os.remove(f)
     cmd = [runner, '--bag', os.path.join(d, spec['bag']), '--map', os.path.join(d, spec['map']),
-           '--seed', str(args.seed), '--out', traj, '--log', log, '--quiet']
+           '--seed', str(args.seed), '--out', traj, '--log', log, '--covariance', cov, '--quiet']
     if spec['pose'] is not None:
         cmd += ['--initial-pose'] + ['%.6f' % v for v in spec['pose']]
     if n:
@@ -113,6 +128,8 @@ def run_one(runner, folder, name, spec, n, out, args):
           '--out', os.path.join(run_dir, 'eval'), '--title', '%s, %s particles' % (name, label)]
     if os.path.isfile(log):
         ev += ['--log', log]
+    if os.path.isfile(cov):
+        ev += ['--cov', cov, '--ref-std', str(spec.get('ref_std', 0.0))]
     ev += list(spec.get('eval_args', ()))
     if args.no_plots:
         ev.append('--no-plots')
@@ -123,8 +140,10 @@ def run_one(runner, folder, name, spec, n, out, args):
         return row
     with open(os.path.join(run_dir, 'eval', 'summary.json')) as f:
         m = json.load(f)
-    row.update({k: m.get(k) for k in ('ate_rmse_m', 'median_m', 'yaw_rmse_deg', 'max_m', 'convergence_time_s',
-                                      'particles_mean', 'confidently_wrong_updates')})
+    row.update({k: m.get(k) for k in ('ate_rmse_m', 'ate_aligned_rmse_m', 'median_m', 'yaw_rmse_deg', 'max_m',
+                                      'convergence_time_s', 'particles_mean', 'confidently_wrong_updates')})
+    c = m.get('covariance') or {}
+    row.update(inside_95_pct=c.get('inside_95_percent'), nees_mean=c.get('nees_mean'))
     if m.get('off_fraction_after_settle') is not None:
         row['off_pct'] = 100.0 * m['off_fraction_after_settle']
     if m.get('cpu_ms_mean') is not None:

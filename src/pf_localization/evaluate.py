@@ -2,11 +2,14 @@
 
 usage: pf_evaluate --traj TRAJ.tum (--bag BAG | --ref REF.tum) [--map MAP.yaml]
                    [--log UPDATES.csv] [--particles PARTICLES.csv|.bin] [--out DIR]
-                   [--lost 0.3] [--max-gap 0.5] [--hold] [--gif-seconds 30]
+                   [--cov COV.csv] [--ref-std 0] [--lost 0.3] [--max-gap 0.5] [--hold]
+                   [--gif-seconds 30]
 
 Inputs
   TRAJ.tum   the filter's estimates, one line per scan: t x y z qx qy qz qw (map frame).
   reference  the bag's /ground_truth (geometry_msgs/PoseStamped, header stamps) or a TUM file.
+  COV.csv    pf_bag_runner --covariance: t,xx,xy,yy,yawyaw,xyaw,yyaw, the published covariance
+             (pf_pose) in force from each stamp on.
 
 Time association: every reference pose gets the estimate at its stamp, linearly interpolated in
 x, y and along the shorter arc in yaw between the two bracketing estimates when both lie within
@@ -20,10 +23,20 @@ Metrics (DIR/summary.json)
   convergence time = first matched reference time (relative to the first reference pose) from which
   on every error is <= --lost (null if the last one is not); lost fraction = share of matched
   references with e > --lost; coverage = matched / all references.
+  Aligned ATE: the RMSE after the best rigid 2D fit (rotation + translation, no scale; Umeyama
+  1991) of the matched estimate positions onto the reference's, with the fit's rotation and
+  translation: what is left once a reference turned or shifted against the map is taken out.
+  With --cov, the covariance's honesty over the matched references after the first 10 s (as
+  off_fraction_after_settle): d^2 = e^T S^-1 e, e = (x, y) error, S = the published xy covariance
+  in force at the reference's time (newest row at or before it, within --max-gap) + --ref-std^2 I
+  (the reference's own noise); inside_95_percent = share with d^2 <= 5.991 (chi-square, 2 dof:
+  95 if honest), NEES mean (2 if honest) and median (2 ln 2 = 1.39 if honest) of the finite d^2.
+  A singular S (a degenerate covariance) counts as not covering (d^2 = inf) and is counted.
   With --log, the mean/p95 update CPU time and particle counts from the runner's update log.
 
 Plots (PNG): trajectory.png (map, estimate, reference), error.png (position and yaw error over
 time); with --log spread.png (particle std dev) and cpu.png (update CPU time, particle count);
+with --cov nees.png (d^2 over time against the 95 % bound);
 with --particles particles.gif (the cloud over the map for the first --gif-seconds).
 Exit status: 0 on success, 2 on bad input (missing file, no reference, nothing matched).
 """
@@ -39,6 +52,7 @@ EXACT_S = 1e-4  # estimates this close to a reference stamp count as taken at it
 OFF_M = 0.5     # an estimate this far from the reference is "off" (the issue trackers' figure)
 SETTLE_S = 10.0  # the start of a run that off_fraction_after_settle leaves out
 WRONG_M = 1.0    # "localized" while this far off is confidently wrong
+CHI2_95_2DOF = 5.991  # 95 % quantile of the chi-square distribution with 2 degrees of freedom
 
 
 class EvalError(Exception):
@@ -121,6 +135,34 @@ def read_update_log(path):
     if 't' not in cols:
         raise EvalError('update log %s: column "t" is not numeric' % path)
     return cols
+
+
+COV_COLUMNS = ('t', 'xx', 'xy', 'yy', 'yawyaw', 'xyaw', 'yyaw')
+
+
+def read_covariance(path):
+    """Runner's covariance CSV (header t,xx,xy,yy,yawyaw,xyaw,yyaw) -> (N, 7) array in that column
+    order, sorted by time. Lines that do not parse are skipped; 'nan' is kept (no estimate yet)."""
+    _need_file(path, 'covariance file')
+    with open(path, newline='') as f:
+        reader = csv.reader(f)
+        header = [h.strip() for h in next(reader, [])]
+        missing = [c for c in COV_COLUMNS if c not in header]
+        if missing:
+            raise EvalError('covariance file %s lacks column(s) %s (expected header %s)'
+                            % (path, ', '.join(missing), ','.join(COV_COLUMNS)))
+        idx = [header.index(c) for c in COV_COLUMNS]
+        rows = []
+        for r in reader:
+            try:
+                rows.append([float(r[i]) for i in idx])
+            except (ValueError, IndexError):
+                continue
+    a = np.array(rows, dtype=float).reshape(-1, len(COV_COLUMNS))
+    a = a[np.isfinite(a[:, 0])]
+    if len(a) == 0:
+        raise EvalError('covariance file %s has no rows' % path)
+    return a[np.argsort(a[:, 0], kind='stable')]
 
 
 def read_particles(path):
@@ -234,6 +276,26 @@ def convergence_time(times, errors, lost, t0):
     return float(times[bad[-1] + 1] - t0)
 
 
+def rigid_fit(src, dst):
+    """The rotation (rad) and translation (2,) that best map the points src (N, 2) onto dst (N, 2)
+    in the least-squares sense, no scale: Umeyama (1991) / Horn (1987) in 2D, where the rotation
+    has a closed form: atan2 of the summed cross and dot products of the centred pairs."""
+    src, dst = np.asarray(src, dtype=float), np.asarray(dst, dtype=float)
+    ms, md = src.mean(axis=0), dst.mean(axis=0)
+    a, b = src - ms, dst - md
+    angle = float(np.arctan2(np.sum(a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]), np.sum(a * b)))
+    rot = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+    return angle, md - rot @ ms
+
+
+def aligned_ate(est_xy, ref_xy):
+    """ATE RMSE after rigid_fit of the estimates onto the reference: (rmse, angle rad, (tx, ty))."""
+    angle, shift = rigid_fit(est_xy, ref_xy)
+    c, s = np.cos(angle), np.sin(angle)
+    moved = np.c_[c * est_xy[:, 0] - s * est_xy[:, 1], s * est_xy[:, 0] + c * est_xy[:, 1]] + shift
+    return float(np.sqrt(np.mean(np.sum((moved - ref_xy) ** 2, axis=1)))), angle, shift
+
+
 def evaluate(est, ref, max_gap=0.5, lost=0.3, interpolate=True):
     """est, ref: (N, 4) arrays t, x, y, yaw. Returns (metrics dict, per-match dict of arrays)."""
     if len(est) == 0:
@@ -249,6 +311,7 @@ def evaluate(est, ref, max_gap=0.5, lost=0.3, interpolate=True):
     pos = np.hypot(p[:, 0] - r[:, 0], p[:, 1] - r[:, 1])
     yaw = np.abs(wrap(p[:, 2] - r[:, 2]))
     t0 = float(ref[0, 0])
+    aligned, angle, shift = aligned_ate(p[:, :2], r[:, :2])
     m = {
         'n_reference': int(len(ref)), 'n_matched': int(ok.sum()),
         'n_exact': int((kind == 1).sum()), 'n_interpolated': int((kind == 2).sum()),
@@ -256,6 +319,8 @@ def evaluate(est, ref, max_gap=0.5, lost=0.3, interpolate=True):
         'coverage': float(ok.mean()),
         'ate_rmse_m': float(np.sqrt(np.mean(pos ** 2))), 'median_m': float(np.median(pos)),
         'mean_m': float(np.mean(pos)), 'max_m': float(np.max(pos)),
+        'ate_aligned_rmse_m': aligned, 'aligned_rotation_deg': float(np.degrees(angle)),
+        'aligned_translation_m': [float(shift[0]), float(shift[1])],
         'yaw_rmse_deg': float(np.degrees(np.sqrt(np.mean(yaw ** 2)))),
         'yaw_max_deg': float(np.degrees(np.max(yaw))),
         'convergence_time_s': convergence_time(t, pos, lost, t0),
@@ -273,6 +338,56 @@ def evaluate(est, ref, max_gap=0.5, lost=0.3, interpolate=True):
     match = {'t': t, 'est': p, 'ref': r, 'pos_err': pos, 'yaw_err': yaw, 'matched': ok,
              'ref_t': ref[:, 0], 'unmatched_t': ref[~ok, 0], 't0': t0}
     return m, match
+
+
+def covariance_at(cov, t, max_gap=0.5):
+    """The xy covariance rows (N, 3: xx, xy, yy) in force at the times t: the newest row at or
+    before each (one within EXACT_S after it counts as at it), at most max_gap before; NaN rows
+    where none is."""
+    ct = cov[:, 0]
+    out = np.full((len(t), 3), np.nan)
+    for k, tk in enumerate(t):
+        i = int(np.searchsorted(ct, tk + EXACT_S, side='right')) - 1
+        if i >= 0 and tk - ct[i] <= max_gap:
+            out[k] = cov[i, 1:4]
+    return out
+
+
+def mahalanobis_sq(err, s_xy, ref_std=0.0):
+    """d^2 = e^T S^-1 e for each (x, y) error e (N, 2), S = [[xx, xy], [xy, yy]] from s_xy (N, 3)
+    + ref_std^2 I. Returns (d2, degenerate): a non-finite or numerically singular S (determinant
+    <= 1e-12 of xx * yy, or a non-positive variance) gives d2 = inf and degenerate True."""
+    xx, xy, yy = (s_xy[:, i] + (ref_std ** 2 if i != 1 else 0.0) for i in range(3))
+    det = xx * yy - xy * xy
+    with np.errstate(invalid='ignore'):
+        degenerate = ~(np.isfinite(det) & (xx > 0) & (yy > 0) & (det > 1e-12 * xx * yy))
+    ex, ey = err[:, 0], err[:, 1]
+    d2 = np.full(len(err), np.inf)
+    ok = ~degenerate
+    d2[ok] = (yy[ok] * ex[ok] ** 2 - 2 * xy[ok] * ex[ok] * ey[ok] + xx[ok] * ey[ok] ** 2) / det[ok]
+    return d2, degenerate
+
+
+def covariance_metrics(cov, match, max_gap=0.5, ref_std=0.0):
+    """How honest the published covariance is, over the matched references after the first
+    SETTLE_S seconds (the samples of off_fraction_after_settle). Returns (the summary's
+    "covariance" dict, per-sample dict t, d2, degenerate for the plot)."""
+    t = match['t']
+    s_xy = covariance_at(cov, t, max_gap)
+    has = np.all(np.isfinite(s_xy), axis=1)
+    use = has & (t - match['t0'] >= SETTLE_S)
+    err = match['est'][:, :2] - match['ref'][:, :2]
+    d2, degenerate = mahalanobis_sq(err[use], s_xy[use], ref_std)
+    finite = d2[np.isfinite(d2)]
+    c = {
+        'samples': int(use.sum()), 'degenerate': int(degenerate.sum()),
+        'without_covariance': int((~has & (t - match['t0'] >= SETTLE_S)).sum()),
+        'inside_95_percent': float(100.0 * np.mean(d2 <= CHI2_95_2DOF)) if use.any() else None,
+        'nees_mean': float(finite.mean()) if len(finite) else None,
+        'nees_median': float(np.median(finite)) if len(finite) else None,
+        'chi2_95': CHI2_95_2DOF, 'after_s': SETTLE_S, 'ref_std_m': float(ref_std),
+    }
+    return c, {'t': t[use], 'd2': d2, 'degenerate': degenerate, 't0': match['t0']}
 
 
 def confidently_wrong(log, match, max_gap=0.5):
@@ -389,6 +504,33 @@ def plot_errors(path, m, match, title):
     a2.legend(loc='upper right', fontsize=8)
     for a in (a1, a2):
         a.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_nees(path, c, samples, title):
+    """d^2 of every covariance sample over time on a log axis, with the 95 % bound; degenerate
+    covariances (d^2 = inf) as triangles on the axis's top."""
+    import matplotlib.pyplot as plt
+    t, d2 = samples['t'] - samples['t0'], samples['d2']
+    fin = np.isfinite(d2)
+    fig, ax = plt.subplots(figsize=(9, 4.5))
+    ax.semilogy(t[fin], np.maximum(d2[fin], 1e-6), '.', color='tab:blue', ms=3, label='d$^2$ = e$^T$ S$^{-1}$ e')
+    ax.axhline(CHI2_95_2DOF, color='tab:red', ls='--', lw=1, label='95 %% bound (%.3f)' % CHI2_95_2DOF)
+    ax.axhline(2.0, color='tab:green', ls=':', lw=1, label='consistent mean (2)')
+    top = max(10 * CHI2_95_2DOF, float(d2[fin].max()) * 2 if fin.any() else 0.0)
+    if (~fin).any():
+        ax.plot(t[~fin], np.full(int((~fin).sum()), top), 'v', color='tab:purple', ms=6,
+                label='degenerate S (%d)' % (~fin).sum())
+    inside = c['inside_95_percent']
+    ax.set_title('%s: %s inside the 95 %% ellipse, NEES mean %s (after the first %.0f s)'
+                 % (title, '-' if inside is None else '%.1f %%' % inside,
+                    '-' if c['nees_mean'] is None else '%.2f' % c['nees_mean'], c['after_s']))
+    ax.set_xlabel('time since first reference pose (s)')
+    ax.set_ylabel('normalised squared error d$^2$')
+    ax.grid(alpha=0.3, which='both')
+    ax.legend(loc='upper right', fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -543,6 +685,9 @@ def parse_args(argv):
     p.add_argument('--log', help="runner's per-update CSV log")
     p.add_argument('--particles', help='particle dump (CSV t,x,y,yaw or .bin float64 records)')
     p.add_argument('--out', help='report directory (default: TRAJ without extension + _eval)')
+    p.add_argument('--cov', help="runner's covariance CSV (pf_bag_runner --covariance)")
+    p.add_argument('--ref-std', type=float, default=0.0,
+                   help="the reference's own position std dev (m), added as ref_std^2 I to the covariance")
     p.add_argument('--lost', type=float, default=0.3, help='lost / convergence threshold (m)')
     p.add_argument('--max-gap', type=float, default=0.5, help='max time between reference and estimate (s)')
     p.add_argument('--hold', action='store_true', help='no interpolation: newest estimate at or before')
@@ -559,6 +704,9 @@ def run(args):
     the_map = read_map(args.map) if args.map else None
     log = read_update_log(args.log) if args.log else None
     parts = read_particles(args.particles) if args.particles else None
+    cov = read_covariance(args.cov) if args.cov else None
+    if not (np.isfinite(args.ref_std) and args.ref_std >= 0):
+        raise EvalError('--ref-std must be a finite number >= 0, got %g' % args.ref_std)
     out = args.out or os.path.splitext(args.traj)[0] + '_eval'
     os.makedirs(out, exist_ok=True)
     title = args.title or os.path.splitext(os.path.basename(args.bag or args.ref))[0]
@@ -570,8 +718,10 @@ def run(args):
         if count is not None:
             m.update(confidently_wrong_updates=count, confidently_wrong_times_s=times,
                      confidently_wrong_threshold_m=WRONG_M)
+    if cov is not None:
+        m['covariance'], cov_samples = covariance_metrics(cov, match, args.max_gap, args.ref_std)
     m['inputs'] = {k: os.path.abspath(v) for k, v in (('traj', args.traj), ('bag', args.bag), ('ref', args.ref),
-                   ('map', args.map), ('log', args.log), ('particles', args.particles)) if v}
+                   ('map', args.map), ('log', args.log), ('particles', args.particles), ('cov', args.cov)) if v}
     plots = []
     if not args.no_plots:
         import matplotlib
@@ -583,6 +733,9 @@ def run(args):
             plot_spread(os.path.join(out, 'spread.png'), log, match['t0'], title)
             plot_cpu(os.path.join(out, 'cpu.png'), log, match['t0'], title)
             plots += ['spread.png', 'cpu.png']
+        if cov is not None:
+            plot_nees(os.path.join(out, 'nees.png'), m['covariance'], cov_samples, title)
+            plots.append('nees.png')
         if parts is not None:
             m['gif_frames'] = make_particle_gif(os.path.join(out, 'particles.gif'), parts, est, ref, the_map,
                                                 args.gif_seconds, title)
@@ -603,6 +756,8 @@ def describe(m, summary):
            m['n_held']),
         '  position error: RMSE %.3f m  median %.3f  mean %.3f  max %.3f m'
         % (m['ate_rmse_m'], m['median_m'], m['mean_m'], m['max_m']),
+        '  aligned ATE:    RMSE %.3f m after the best rigid fit onto the reference (rotation %.2f deg, '
+        'translation %.3f, %.3f m)' % ((m['ate_aligned_rmse_m'], m['aligned_rotation_deg']) + tuple(m['aligned_translation_m'])),
         '  yaw error:      RMSE %.2f deg  max %.2f deg' % (m['yaw_rmse_deg'], m['yaw_max_deg']),
         '  converged:      %s; lost (> %.2f m) %.1f %% of matched poses'
         % ('after %.2f s' % conv if conv is not None else 'never', m['lost_threshold_m'],
@@ -614,11 +769,24 @@ def describe(m, summary):
     if 'confidently_wrong_updates' in m:
         lines.append('  confidently wrong: %d updates "localized" while more than %.0f m off'
                      % (m['confidently_wrong_updates'], m['confidently_wrong_threshold_m']))
+    if 'covariance' in m:
+        lines.append(describe_covariance(m['covariance']))
     if 'cpu_ms_mean' in m:
         lines.append('  update CPU:     mean %.2f ms  p95 %.2f ms  (%d log rows)'
                      % (m['cpu_ms_mean'], m['cpu_ms_p95'], m['n_log_rows']))
     lines.append('  report: %s' % summary + (' (+ %s)' % ', '.join(m['plots']) if m['plots'] else ''))
     return '\n'.join(lines)
+
+
+def describe_covariance(c):
+    """The text summary's covariance line."""
+    if not c['samples']:
+        return '  covariance:     no matched pose with a covariance after the first %.0f s' % c['after_s']
+    fmt = lambda v: '-' if v is None else '%.2f' % v
+    return ('  covariance:     %.1f %% of %d poses after the first %.0f s inside the 95 %% ellipse '
+            '(honest: 95); NEES mean %s, median %s (honest: 2, 1.39); %d degenerate; ref std %.3f m'
+            % (c['inside_95_percent'], c['samples'], c['after_s'], fmt(c['nees_mean']),
+               fmt(c['nees_median']), c['degenerate'], c['ref_std_m']))
 
 
 def main(argv=None):

@@ -1,10 +1,12 @@
 #!/usr/bin/python3
 """Unit tests of pf_evaluate (pf_localization.evaluate): association and metrics on tiny literal
-trajectories, and the CPU plot's axis.
+trajectories, the covariance's honesty (coverage of the 95 % ellipse, NEES) and the aligned ATE on
+synthetic runs with errors of known covariance, and the CPU plot's axis.
 
 Run from the repository root:  /usr/bin/python3 -m unittest discover -s test/python -v
 Needs numpy only (no ROS, no matplotlib).
 """
+import json
 import math
 import os
 import sys
@@ -138,6 +140,148 @@ class MetricsTest(unittest.TestCase):
         finally:
             os.unlink(f.name)
         np.testing.assert_allclose(v, [[0.0, 2 / 3]])
+
+
+def noisy_run(n, cov, rng, dt=0.1):
+    """A reference wandering over 20 x 10 m for n samples every dt s, and an estimate off it by
+    errors drawn from N(0, cov) (2 x 2)."""
+    t = np.arange(n) * dt
+    ref = np.c_[t, 10 + 10 * np.sin(t / 37.0), 5 + 5 * np.cos(t / 23.0), np.zeros(n)]
+    est = ref.copy()
+    est[:, 1:3] += rng.multivariate_normal([0.0, 0.0], cov, size=n)
+    return est, ref
+
+
+def cov_rows(t, cov):
+    """Covariance file rows (t, xx, xy, yy, yawyaw, xyaw, yyaw) with cov (2 x 2) at each time t."""
+    return np.array([(tk, cov[0][0], cov[0][1], cov[1][1], 0.01, 0.0, 0.0) for tk in t], dtype=float)
+
+
+class CovarianceTest(unittest.TestCase):
+    S = np.array([[0.04, 0.015], [0.015, 0.01]])      # correlated, 0.2 m x 0.1 m
+    N = 4000
+
+    def metrics(self, est, ref, cov, ref_std=0.0):
+        _, match = pfe.evaluate(est, ref)
+        return pfe.covariance_metrics(cov, match, ref_std=ref_std)[0]
+
+    def test_honest_covariance_covers_95_percent_with_nees_2(self):
+        est, ref = noisy_run(self.N, self.S, np.random.default_rng(1))
+        c = self.metrics(est, ref, cov_rows(est[:, 0], self.S))
+        n_after = int(np.sum(ref[:, 0] - ref[0, 0] >= pfe.SETTLE_S))
+        self.assertEqual(c['samples'], n_after)           # the first 10 s are left out
+        # binomial std of the share over ~3900 samples: 0.35 %; NEES mean's std: 2 / sqrt(n) = 0.03
+        self.assertAlmostEqual(c['inside_95_percent'], 95.0, delta=1.5)
+        self.assertAlmostEqual(c['nees_mean'], 2.0, delta=0.15)
+        self.assertAlmostEqual(c['nees_median'], 2 * math.log(2), delta=0.15)
+        self.assertEqual(c['degenerate'], 0)
+
+    def test_overconfident_covariance_covers_far_fewer(self):
+        est, ref = noisy_run(self.N, self.S, np.random.default_rng(2))
+        c = self.metrics(est, ref, cov_rows(est[:, 0], self.S / 10))
+        # d^2 ten times larger: P(chi2_2 <= 0.599) = 26 %
+        self.assertLess(c['inside_95_percent'], 40.0)
+        self.assertGreater(c['nees_mean'], 15.0)
+
+    def test_reference_noise_is_added_to_the_covariance(self):
+        r = 0.1
+        est, ref = noisy_run(self.N, self.S + r * r * np.eye(2), np.random.default_rng(3))
+        rows = cov_rows(est[:, 0], self.S)
+        self.assertLess(self.metrics(est, ref, rows)['inside_95_percent'], 90.0)
+        c = self.metrics(est, ref, rows, ref_std=r)
+        self.assertAlmostEqual(c['inside_95_percent'], 95.0, delta=1.5)
+        self.assertAlmostEqual(c['nees_mean'], 2.0, delta=0.15)
+
+    def test_each_reference_uses_the_covariance_in_force(self):
+        ref = traj([(t, 0.0, 0.0, 0.0) for t in np.arange(0.0, 20.0, 0.5)])
+        est = ref + [0, 0.3, 0.0, 0]                                 # 0.3 m off in x
+        big, tiny = [[1.0, 0.0], [0.0, 1.0]], [[1e-4, 0.0], [0.0, 1e-4]]
+        # rows 10 ms after each reference: the one in force is the newest at or before it, so
+        # the reference at 14.0 s still has the big one (the tiny one's 14.01 s is nearer)
+        cov = np.r_[cov_rows(np.arange(0.0, 14.0, 0.5) + 0.01, big),
+                    cov_rows(np.arange(14.0, 20.0, 0.5) + 0.01, tiny)]
+        c = self.metrics(est, ref, cov)
+        self.assertEqual((c['samples'], c['without_covariance']), (20, 0))   # 10 .. 19.5 s
+        self.assertAlmostEqual(c['inside_95_percent'], 100.0 * 9 / 20)        # 10 .. 14 s
+        self.assertAlmostEqual(c['nees_mean'], (9 * 0.09 + 11 * 900.0) / 20)
+        self.assertAlmostEqual(c['nees_median'], 900.0)
+        # a row is held at most --max-gap (0.5 s): without those at 11.01 .. 12.51 s,
+        # the references at 11.5 .. 13.0 s have none
+        gap = (cov[:, 0] > 11.0) & (cov[:, 0] < 13.0)
+        c = self.metrics(est, ref, cov[~gap])
+        self.assertEqual((c['samples'], c['without_covariance']), (16, 4))
+        # a row written before any estimate (nan) is no covariance either
+        nan_rows = cov.copy()
+        nan_rows[:, 1:] = np.nan
+        c = self.metrics(est, ref, nan_rows)
+        self.assertEqual((c['samples'], c['without_covariance'], c['inside_95_percent']), (0, 20, None))
+
+    def test_singular_covariance_does_not_cover_and_is_counted(self):
+        est, ref = noisy_run(200, self.S, np.random.default_rng(4))
+        for singular in ([[0.0, 0.0], [0.0, 0.0]], [[0.04, 0.02], [0.02, 0.01]], [[-0.01, 0], [0, 0.01]]):
+            c = self.metrics(est, ref, cov_rows(est[:, 0], singular))
+            self.assertEqual(c['degenerate'], c['samples'])
+            self.assertEqual(c['inside_95_percent'], 0.0)
+            self.assertIsNone(c['nees_mean'])
+        # the reference's own noise makes a zero covariance invertible
+        c = self.metrics(est, ref, cov_rows(est[:, 0], [[0.0, 0.0], [0.0, 0.0]]), ref_std=0.2)
+        self.assertEqual(c['degenerate'], 0)
+        self.assertGreater(c['inside_95_percent'], 80.0)
+
+    def test_command_line_writes_the_covariance_summary_and_plot(self):
+        est, ref = noisy_run(300, self.S, np.random.default_rng(5))
+        rows = cov_rows(est[:, 0], self.S)
+        rows[:5, 1:4] = 0.0                                          # degenerate while settling
+        with tempfile.TemporaryDirectory() as d:
+            for name, a in (('traj.tum', est), ('ref.tum', ref)):
+                with open(os.path.join(d, name), 'w') as f:
+                    f.writelines('%.6f %.6f %.6f 0 0 0 %.9f %.9f\n' % (r[0], r[1], r[2], math.sin(r[3] / 2),
+                                                                      math.cos(r[3] / 2)) for r in a)
+            with open(os.path.join(d, 'cov.csv'), 'w') as f:
+                f.write('t,xx,xy,yy,yawyaw,xyaw,yyaw\n')
+                f.writelines(','.join('%.9g' % v for v in r) + '\n' for r in rows)
+            argv = ['--traj', os.path.join(d, 'traj.tum'), '--ref', os.path.join(d, 'ref.tum'),
+                    '--cov', os.path.join(d, 'cov.csv'), '--out', os.path.join(d, 'eval')]
+            try:
+                import matplotlib  # noqa: F401
+            except ImportError:
+                argv.append('--no-plots')
+            self.assertEqual(pfe.main(argv), 0)
+            with open(os.path.join(d, 'eval', 'summary.json')) as f:
+                m = json.load(f)
+            c = m['covariance']
+            self.assertEqual((c['samples'], c['degenerate']), (200, 0))  # 10 s of 30 left out
+            self.assertGreater(c['inside_95_percent'], 88.0)
+            if '--no-plots' not in argv:
+                self.assertTrue(os.path.isfile(os.path.join(d, 'eval', 'nees.png')))
+            self.assertEqual(pfe.main(argv + ['--ref-std', '-1']), 2)
+
+
+class AlignedAteTest(unittest.TestCase):
+    def test_rotation_and_translation_are_recovered(self):
+        rng = np.random.default_rng(6)
+        sigma, n = 0.02, 2000
+        _, ref = noisy_run(n, np.zeros((2, 2)), rng)
+        angle, shift = math.radians(3.0), np.array([0.4, -0.25])
+        c, s = math.cos(angle), math.sin(angle)
+        est = ref.copy()
+        est[:, 1] = c * ref[:, 1] - s * ref[:, 2] + shift[0]
+        est[:, 2] = s * ref[:, 1] + c * ref[:, 2] + shift[1]
+        est[:, 1:3] += rng.normal(0.0, sigma, (n, 2))
+        m, _ = pfe.evaluate(est, ref)
+        self.assertGreater(m['ate_rmse_m'], 0.4)                     # 3 deg at ~11 m and the shift
+        # what is left is the noise: radial RMS sigma * sqrt(2)
+        self.assertAlmostEqual(m['ate_aligned_rmse_m'], sigma * math.sqrt(2), delta=0.003)
+        self.assertAlmostEqual(m['aligned_rotation_deg'], -3.0, delta=0.05)   # est -> ref: the inverse
+        inverse_shift = -np.array([[c, s], [-s, c]]) @ shift
+        np.testing.assert_allclose(m['aligned_translation_m'], inverse_shift, atol=0.01)
+
+    def test_no_misalignment_leaves_the_ate(self):
+        ref = traj([(t, t, 0.5 * t * t, 0.0) for t in range(10)])
+        est = ref + [0, 0.0, 0.1, 0]
+        m, _ = pfe.evaluate(est, ref)
+        self.assertAlmostEqual(m['ate_rmse_m'], 0.1, places=12)
+        self.assertAlmostEqual(m['ate_aligned_rmse_m'], 0.0, places=9)   # a pure shift is taken out
 
 
 if __name__ == '__main__':
