@@ -336,7 +336,7 @@ def evaluate(est, ref, max_gap=0.5, lost=0.3, interpolate=True):
         'n_estimates': int(len(est)),
     }
     match = {'t': t, 'est': p, 'ref': r, 'pos_err': pos, 'yaw_err': yaw, 'matched': ok,
-             'ref_t': ref[:, 0], 'unmatched_t': ref[~ok, 0], 't0': t0}
+             'ref_t': ref[:, 0], 'unmatched_t': ref[~ok, 0], 't0': t0, 'alignment': (angle, shift)}
     return m, match
 
 
@@ -368,15 +368,27 @@ def mahalanobis_sq(err, s_xy, ref_std=0.0):
     return d2, degenerate
 
 
-def covariance_metrics(cov, match, max_gap=0.5, ref_std=0.0):
+def covariance_metrics(cov, match, max_gap=0.5, ref_std=0.0, aligned=False):
     """How honest the published covariance is, over the matched references after the first
-    SETTLE_S seconds (the samples of off_fraction_after_settle). Returns (the summary's
+    SETTLE_S seconds (the samples of off_fraction_after_settle). With aligned, the errors are
+    measured after the rigid fit onto the reference (for a reference whose frame is turned from
+    the map's, which no covariance of a pose on the map should cover). Returns (the summary's
     "covariance" dict, per-sample dict t, d2, degenerate for the plot)."""
     t = match['t']
     s_xy = covariance_at(cov, t, max_gap)
     has = np.all(np.isfinite(s_xy), axis=1)
     use = has & (t - match['t0'] >= SETTLE_S)
-    err = match['est'][:, :2] - match['ref'][:, :2]
+    est = match['est'][:, :2]
+    if aligned:
+        angle, shift = match['alignment']
+        c, s = np.cos(angle), np.sin(angle)
+        est = np.c_[c * est[:, 0] - s * est[:, 1], s * est[:, 0] + c * est[:, 1]] + shift
+        # The covariance turns with the estimate.
+        xx, xy, yy = s_xy[:, 0], s_xy[:, 1], s_xy[:, 2]
+        s_xy = np.c_[c * c * xx - 2 * c * s * xy + s * s * yy,
+                     c * s * (xx - yy) + (c * c - s * s) * xy,
+                     s * s * xx + 2 * c * s * xy + c * c * yy]
+    err = est - match['ref'][:, :2]
     d2, degenerate = mahalanobis_sq(err[use], s_xy[use], ref_std)
     finite = d2[np.isfinite(d2)]
     c = {
@@ -386,6 +398,7 @@ def covariance_metrics(cov, match, max_gap=0.5, ref_std=0.0):
         'nees_mean': float(finite.mean()) if len(finite) else None,
         'nees_median': float(np.median(finite)) if len(finite) else None,
         'chi2_95': CHI2_95_2DOF, 'after_s': SETTLE_S, 'ref_std_m': float(ref_std),
+        'after_rigid_fit': bool(aligned),
     }
     return c, {'t': t[use], 'd2': d2, 'degenerate': degenerate, 't0': match['t0']}
 
@@ -688,6 +701,8 @@ def parse_args(argv):
     p.add_argument('--cov', help="runner's covariance CSV (pf_bag_runner --covariance)")
     p.add_argument('--ref-std', type=float, default=0.0,
                    help="the reference's own position std dev (m), added as ref_std^2 I to the covariance")
+    p.add_argument('--cov-aligned', action='store_true',
+                   help='judge the covariance on the errors after the rigid fit (a reference turned from the map)')
     p.add_argument('--lost', type=float, default=0.3, help='lost / convergence threshold (m)')
     p.add_argument('--max-gap', type=float, default=0.5, help='max time between reference and estimate (s)')
     p.add_argument('--hold', action='store_true', help='no interpolation: newest estimate at or before')
@@ -719,7 +734,8 @@ def run(args):
             m.update(confidently_wrong_updates=count, confidently_wrong_times_s=times,
                      confidently_wrong_threshold_m=WRONG_M)
     if cov is not None:
-        m['covariance'], cov_samples = covariance_metrics(cov, match, args.max_gap, args.ref_std)
+        m['covariance'], cov_samples = covariance_metrics(cov, match, args.max_gap, args.ref_std,
+                                                          args.cov_aligned)
     m['inputs'] = {k: os.path.abspath(v) for k, v in (('traj', args.traj), ('bag', args.bag), ('ref', args.ref),
                    ('map', args.map), ('log', args.log), ('particles', args.particles), ('cov', args.cov)) if v}
     plots = []
@@ -786,7 +802,8 @@ def describe_covariance(c):
     return ('  covariance:     %.1f %% of %d poses after the first %.0f s inside the 95 %% ellipse '
             '(honest: 95); NEES mean %s, median %s (honest: 2, 1.39); %d degenerate; ref std %.3f m'
             % (c['inside_95_percent'], c['samples'], c['after_s'], fmt(c['nees_mean']),
-               fmt(c['nees_median']), c['degenerate'], c['ref_std_m']))
+               fmt(c['nees_median']), c['degenerate'], c['ref_std_m'])
+            + (', after the rigid fit' if c.get('after_rigid_fit') else ''))
 
 
 def main(argv=None):
