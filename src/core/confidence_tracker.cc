@@ -26,8 +26,10 @@ void ConfidenceTracker::holdAfterJump(const std::optional<Pose2>& predicted, con
   if (predicted) pf::holdAfterJump(*predicted, estimate, params, &settle_left_, &confidence_);
 }
 
-void ConfidenceTracker::cover(const Eigen::Matrix3d& covariance) {
-  confidence_.covariance = coveringCovariance(covariance, confidence_.covariance);
+void ConfidenceTracker::addFit(const Eigen::Matrix3d& fit_covariance) {
+  confidence_.covariance = confidence_.rivals > 0
+                               ? coveringCovariance(fit_covariance, confidence_.covariance)
+                               : fusedCovariance(fit_covariance, confidence_.covariance);
 }
 
 void ConfidenceTracker::demoteAfterLowFit(int low_fit_updates, int patience) {

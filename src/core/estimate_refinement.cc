@@ -27,10 +27,9 @@ ScanRefinement EstimateRefinement::atUpdate(const SensorModel& model, const Lase
                   estimate->covariance);
   if (!r.accepted) return r;
   refined_ = Fit{compose(r.pose, inverse(odom)), odom, odom};
-  // The fit is sharper than the cloud, but the cloud's spread (or its
-  // rivals') is evidence too: what is published covers both.
+  // The cloud was the fit's prior: what is known of the pose is both.
   estimate->pose = r.pose;
-  estimate->covariance = coveringCovariance(r.covariance, estimate->covariance);
+  estimate->covariance = fusedCovariance(r.covariance, estimate->covariance);
   return r;
 }
 
@@ -54,7 +53,7 @@ ScanRefinement EstimateRefinement::betweenUpdates(const SensorModel& model, cons
       estimate.clusters.empty() ? std::nullopt
                                 : std::optional<Eigen::Matrix3d>(estimate.clusters[0].covariance);
   r = ScanRefiner(model.field(), params.refiner)
-          .refine(model.prepare(scan, params.refiner.max_beams), predicted, prior);
+          .refine(model.prepare(scan, params.refiner.max_beams_between_updates), predicted, prior);
   if (r.accepted) refined_ = Fit{compose(r.pose, inverse(odom)), odom_at_update, odom};
   return r;
 }

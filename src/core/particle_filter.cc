@@ -196,7 +196,7 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
   estimateAndJudge(*gate.scan, predicted);
   report.refinement = refinement_.atUpdate(sensor_.model(), scan, odom,
                                            confidence_.confidence().state, params_, &estimate_);
-  if (report.refinement.accepted) confidence_.cover(report.refinement.covariance);
+  if (report.refinement.accepted) confidence_.addFit(report.refinement.covariance);
   resample(&report);
   confidence_.demoteAfterLowFit(recovery_.lowFitUpdates(), params_.recovery.patience);
   report.updated = true;

@@ -59,13 +59,15 @@ TEST_F(ConfidenceTrackerTest, AFitBelowTheTriggerForLongerThanPatienceDemotes) {
   EXPECT_NE(std::string::npos, tracker_.confidence().reason.find("6 updates"));
 }
 
-TEST_F(ConfidenceTrackerTest, CoverWidensThePublishedCovariance) {
-  assessLocalized();
-  const Eigen::Matrix3d wide = Eigen::Vector3d(1.0, 1.0, 1.0).asDiagonal();
-  tracker_.cover(wide);
+TEST_F(ConfidenceTrackerTest, AFitNarrowsThePublishedCovarianceWhereItConstrains) {
+  const Eigen::Matrix3d cloud = Eigen::Vector3d(0.04, 0.01, 0.005).asDiagonal();
+  tracker_.restart(cloud);
+  // Sharp in y and yaw, nothing along x (a corridor).
+  tracker_.addFit(Eigen::Vector3d(0.0, 1e-6, 1e-7).asDiagonal());
   const Eigen::Matrix3d c = tracker_.confidence().covariance;
-  EXPECT_GE(c(0, 0), 1.0 - 1e-9);
-  EXPECT_GE(c(2, 2), 1.0 - 1e-9);
+  EXPECT_NEAR(cloud(0, 0), c(0, 0), 0.05 * cloud(0, 0));
+  EXPECT_LT(c(1, 1), 1e-6);
+  EXPECT_LT(c(2, 2), 1e-7);
 }
 
 }  // namespace

@@ -31,8 +31,10 @@ class ConfidenceTracker {
   /// estimate moved by the odometry since; nothing without one.
   void holdAfterJump(const std::optional<Pose2>& predicted, const Pose2& estimate,
                      const ConfidenceParams& params);
-  /// Widens the published covariance to cover `covariance` too (a scan fit's).
-  void cover(const Eigen::Matrix3d& covariance);
+  /// Adds a scan fit's covariance to the published one (fusedCovariance),
+  /// unless that is the whole cloud's for rival hypotheses, which a fit of
+  /// the best one cannot narrow: then it widens it to cover the fit's too.
+  void addFit(const Eigen::Matrix3d& fit_covariance);
   /// "localized" becomes "uncertain" after more than `patience` consecutive
   /// updates with a fit below recovery's trigger.
   void demoteAfterLowFit(int low_fit_updates, int patience);

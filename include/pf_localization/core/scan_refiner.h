@@ -43,11 +43,17 @@
 namespace pf {
 
 struct ScanRefinerParams {
-  // Beams fitted per scan, evenly spaced over the valid ones (<= 0: all).
-  // More than the particles are weighed with: the fit runs once per scan,
-  // not once per particle, and which few beams a dropout leaves would
-  // otherwise shift the fit from scan to scan.
-  int max_beams = 0;
+  // Beams fitted per scan at a filter update, evenly spaced over the valid
+  // ones (<= 0: all). More than the particles are weighed with: the fit runs
+  // once per scan, not once per particle, and which few beams a dropout
+  // leaves would otherwise shift the fit from scan to scan. 180 is half a
+  // 0.5-degree scan: on every bag with a reference, fitting all beams is no
+  // more precise (docs/design.md, "What refinement costs").
+  int max_beams = 180;
+  // Beams fitted on a scan between updates. That fit only has to carry the
+  // last update's pose over the odometry's drift of a fraction of a second,
+  // from a start within millimetres of it.
+  int max_beams_between_updates = 90;
   int max_iterations = 20;        // Gauss-Newton iterations at most
   double outlier_distance = 0.3;  // m: end points this far from any obstacle do not pull
   double cauchy_scale = 0.05;     // m: residuals well beyond this are down-weighted (Cauchy)
@@ -70,7 +76,10 @@ struct ScanRefinerParams {
   // A direction whose Hessian eigenvalue is below this fraction of the
   // largest one (yaw scaled by 1 m) is unconstrained.
   double degeneracy_ratio = 1e-3;
-  double convergence = 1e-6;  // m (and rad times 1 m): a smaller step ends the iterations
+  // m (and rad times 1 m): a smaller Gauss-Newton step ends the iterations.
+  // The Cauchy-reweighted iterations converge linearly, so a tighter bound
+  // buys tenths of a millimetre for twice the iterations.
+  double convergence = 1e-3;
 };
 
 /// Throws std::invalid_argument naming the first parameter out of range (with
@@ -97,7 +106,8 @@ struct ScanRefinement {
   std::string rejection_detail;                    // the figures behind it, for the log
   Pose2 pose;                                      // the refined pose when accepted, else the start
   // The fit's covariance (x, y, yaw): the residual variance times the
-  // inverse Hessian, zero in the directions the scan does not constrain.
+  // inverse Hessian, widened for the beams' correlation (scan_refiner.cc,
+  // kIndependentBeams); zero in the directions the scan does not constrain.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   int iterations = 0;
   int matched_beams = 0;      // ending within outlier_distance, at the final pose
@@ -139,6 +149,14 @@ class ScanRefiner {
   BicubicDistanceField field_;
   ScanRefinerParams params_;
 };
+
+/// The covariance of the pose that `fit` (a scan fit's: zero in the
+/// directions the scan does not constrain, which carry no information) and
+/// `prior` (the cloud's) give together: their informations added, the
+/// fit's through its pseudo-inverse. Along a corridor's length, where the fit
+/// says nothing, it is the prior's; across, the sharper of the two and
+/// sharper still. For publishing a refined pose with what is known of it.
+Eigen::Matrix3d fusedCovariance(const Eigen::Matrix3d& fit, const Eigen::Matrix3d& prior);
 
 /// A covariance at least as wide as both `a` and `b` in every direction (C -
 /// a and C - b positive semi-definite), and no wider than needed along their
