@@ -126,8 +126,8 @@ struct ParticleFilterParams {
   // The published pose (and map -> odom) is the cloud's estimate refined
   // against the map by a scan fit (scan_refiner.h), whenever the filter is
   // not lost and the fit is accepted; the scans between updates are fitted
-  // too. Off by default (docs/design.md, "The estimate is fitted to the scan").
-  bool refine_estimate = false;
+  // too. On by default (docs/design.md, "The estimate is fitted to the scan").
+  bool refine_estimate = true;
   ScanRefinerParams refiner;
 };
 
