@@ -184,15 +184,17 @@ constexpr Recess kCorridorRecesses[] = {
     {19.6, 20.5, true, 0.2},
 };
 
+// Walls 0.3 m thick, unknown behind them (as in a map built by SLAM: a solid
+// block would look like a room full of walls to a likelihood field).
 void drawCorridorDoorsStretch(MapCanvas* c) {
-  c->fill({kCorridorInterior.x0, 0.0, kCorridorFeaturelessFrom, 8.0}, kWall);
+  const Box& corridor = kCorridorInterior;
+  c->fill({corridor.x0, corridor.y0 - 0.3, kCorridorFeaturelessFrom, corridor.y1 + 0.3}, kWall);
   for (const SideRoom& r : kCorridorRooms) {
-    const double wall_y0 = r.north ? kCorridorInterior.y1 : kCorridorInterior.y0 - 0.3;
-    if (r.north) {
-      c->fill({r.x0, kCorridorInterior.y1 + 0.3, r.x1, 7.7}, kFree);
-    } else {
-      c->fill({r.x0, 0.3, r.x1, kCorridorInterior.y0 - 0.3}, kFree);
-    }
+    const double wall_y0 = r.north ? corridor.y1 : corridor.y0 - 0.3;
+    const Box room =
+        r.north ? Box{r.x0, corridor.y1 + 0.3, r.x1, 7.7} : Box{r.x0, 0.3, r.x1, corridor.y0 - 0.3};
+    c->fill({room.x0 - 0.3, room.y0 - 0.3, room.x1 + 0.3, room.y1 + 0.3}, kWall);
+    c->fill(room, kFree);
     c->fill({r.door_x0, wall_y0, r.door_x1, wall_y0 + 0.3}, kFree);
   }
   for (const Recess& r : kCorridorRecesses) {
