@@ -81,21 +81,24 @@ OccupancyGrid makeSmallMap();
 
 /// The corridor map: a straight corridor 2.2 m wide along x, 35.55 m long
 /// between a room at its west end and a T-junction at its east end (42.5 m
-/// in all). From its west end to x = kCorridorFeaturelessFrom its 0.3 m walls
+/// in all); walls 0.3 m thick with unknown space behind them, as in a map
+/// built by SLAM. From its west end to x = kCorridorFeaturelessFrom the walls
 /// have doors at irregular spacing: four open into small rooms, five closed
 /// ones and an alcove are recesses in the walls, one closed door stands in a
-/// frame; from there to the T-junction (16.2 m, over three times a Neato's
-/// 5 m range) the two walls are plain and parallel, so that a lidar there
-/// sees nothing that says how far along the corridor it is.
+/// frame, a radiator stands out 0.1 m; from there to the T-junction (16.2 m,
+/// over three times a Neato's 5 m range) the two walls are plain and
+/// parallel, so that a lidar there sees nothing that says how far along the
+/// corridor it is.
 ///
-///   y=8 +------+--+N1+---+N2+----+-------------------------+-+  T-
-///       | room |          doors stretch    featureless     | |  junction
-///       |      +=====================================================+ |
-///       |       corridor, 2.2 m wide, y 2.85-5.05                     |
-///       |      +=====================================================+ |
-///       |      |     S1        S2      |                             | |
-///   y=0 +------+-----------------------+                             +-+
-///      x=0   4.45                     23.8                        40.0 42.5
+///   y=8 +------+ +-N1-+    +-N2-+                                    +---+
+///       | room | |    |    |    |                                    |   |
+///       |      +-+-  -+-[]-+-  -+-[]--+------------------------------+   |
+///       |        doors stretch        |  featureless stretch         | T |
+///       |      +--[]-+-  -+--[]--+-  -+------------------------------+   |
+///       |      |     | S1 |      | S2 |                              |   |
+///   y=0 +------+     +----+      +----+                              +---+
+///      x=0   4.45                   23.8                          40.0  42.5
+///   ("-  -": an open door, "[]": a closed one in a recess)
 inline constexpr Box kCorridorExtent{-0.2, -0.2, 42.7, 8.2};
 /// The corridor's own free space, from the west room to the T-junction.
 inline constexpr Box kCorridorInterior{4.45, 2.85, 40.0, 5.05};
