@@ -25,7 +25,8 @@ bags="tracking  building  1
       small     small     4
       reverse   building  5     --unsigned-odometry
       crowd     building  6
-      sparse    building  7     --scan-period 2"
+      sparse    building  7     --scan-period 2
+      corridor  corridor  8     --scan-period 2.5"
 
 check=false
 case "${1:-}" in
@@ -59,6 +60,7 @@ done <<<"$bags"
 if $check; then
   status=0
   for f in maps/building.yaml maps/building.pgm maps/small.yaml maps/small.pgm \
+           maps/corridor.yaml maps/corridor.pgm \
            $(awk '{print "bags/" $1 ".bag"}' <<<"$bags"); do
     want=$(sha256sum <"$repo/$f" 2>/dev/null | cut -d' ' -f1 || true)
     got=$(sha256sum <"$out/$f" | cut -d' ' -f1)

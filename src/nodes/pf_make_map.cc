@@ -1,4 +1,4 @@
-// pf_make_map: writes the package's own maps (building and small, see
+// pf_make_map: writes the package's own maps (building, small and corridor, see
 // pf_localization/sim/building_map.h) in the map_server format.
 //
 //   pf_make_map --out-dir maps
@@ -16,7 +16,7 @@ namespace {
 
 constexpr char kUsage[] =
     "usage: pf_make_map [--out-dir DIR]   (default: maps)\n"
-    "writes DIR/building.yaml/.pgm and DIR/small.yaml/.pgm\n";
+    "writes DIR/building.yaml/.pgm, DIR/small.yaml/.pgm and DIR/corridor.yaml/.pgm\n";
 
 }  // namespace
 
@@ -37,10 +37,12 @@ int main(int argc, char** argv) {
   try {
     pf::saveMap(pf::sim::makeBuildingMap(), out_dir + "/building.yaml");
     pf::saveMap(pf::sim::makeSmallMap(), out_dir + "/small.yaml");
+    pf::saveMap(pf::sim::makeCorridorMap(), out_dir + "/corridor.yaml");
   } catch (const std::exception& e) {
     std::cerr << "pf_make_map: " << e.what() << "\n";
     return 1;
   }
-  std::cout << "wrote " << out_dir << "/building.yaml and " << out_dir << "/small.yaml\n";
+  std::cout << "wrote " << out_dir << "/building.yaml, " << out_dir << "/small.yaml and " << out_dir
+            << "/corridor.yaml\n";
   return 0;
 }

@@ -76,6 +76,10 @@ BUNDLED = {
     # metric's error, not the filter's).
     'sim_sparse': dict(dir='{repo}', bag='bags/sparse.bag', map='maps/building.yaml', pose=(1.5, 7.6, 0.0),
                        ref=('--bag', 'bags/sparse.bag'), eval_args=('--max-gap', '0.1')),
+    # A 35.6 m corridor with 16.2 m of plain walls, one scan every 2.5 s: compared at the scans
+    # only, as sim_sparse.
+    'sim_corridor': dict(dir='{repo}', bag='bags/corridor.bag', map='maps/corridor.yaml', pose=(2.5, 3.95, 0.0),
+                         ref=('--bag', 'bags/corridor.bag'), eval_args=('--max-gap', '0.1')),
 }
 SKIPPED = {
     'comprobo_mac_first_floor_take_2': 'no ground truth (its scan-match TUM is derived from the map itself, '

@@ -154,4 +154,87 @@ OccupancyGrid makeSmallMap() {
   return c.grid();
 }
 
+namespace {
+
+// The corridor map's side rooms: interior x range and north or south of the
+// corridor, with the door's x range in the wall between.
+struct SideRoom {
+  double x0, x1;
+  bool north;
+  double door_x0, door_x1;
+};
+
+constexpr SideRoom kCorridorRooms[] = {
+    {5.2, 8.4, true, 7.2, 8.1},       // N1
+    {7.9, 11.2, false, 9.9, 10.8},    // S1
+    {14.8, 18.0, true, 15.1, 16.0},   // N2
+    {19.5, 22.6, false, 20.1, 21.0},  // S2
+};
+
+// Closed doors set 0.2 m into the 0.3 m walls (x range, north or south).
+struct Recess {
+  double x0, x1;
+  bool north;
+  double depth;
+};
+
+constexpr Recess kCorridorRecesses[] = {
+    {5.8, 6.7, false, 0.2},   {10.4, 11.3, true, 0.2},   {12.5, 13.4, true, 0.2},
+    {13.7, 14.6, false, 0.2}, {17.2, 18.6, false, 0.25},  // alcove (a vending machine's)
+    {19.6, 20.5, true, 0.2},
+};
+
+// Walls 0.3 m thick, unknown behind them (as in a map built by SLAM: a solid
+// block would look like a room full of walls to a likelihood field).
+void drawCorridorDoorsStretch(MapCanvas* c) {
+  const Box& corridor = kCorridorInterior;
+  c->fill({corridor.x0, corridor.y0 - 0.3, kCorridorFeaturelessFrom, corridor.y1 + 0.3}, kWall);
+  for (const SideRoom& r : kCorridorRooms) {
+    const double wall_y0 = r.north ? corridor.y1 : corridor.y0 - 0.3;
+    const Box room =
+        r.north ? Box{r.x0, corridor.y1 + 0.3, r.x1, 7.7} : Box{r.x0, 0.3, r.x1, corridor.y0 - 0.3};
+    c->fill({room.x0 - 0.3, room.y0 - 0.3, room.x1 + 0.3, room.y1 + 0.3}, kWall);
+    c->fill(room, kFree);
+    c->fill({r.door_x0, wall_y0, r.door_x1, wall_y0 + 0.3}, kFree);
+  }
+  for (const Recess& r : kCorridorRecesses) {
+    if (r.north) {
+      c->fill({r.x0, kCorridorInterior.y1, r.x1, kCorridorInterior.y1 + r.depth}, kFree);
+    } else {
+      c->fill({r.x0, kCorridorInterior.y0 - r.depth, r.x1, kCorridorInterior.y0}, kFree);
+    }
+  }
+  // A closed door flush with the north wall in a frame whose jambs stand
+  // 0.1 m out, and a radiator along the south wall.
+  c->fill({22.3, kCorridorInterior.y1 - 0.1, 22.45, kCorridorInterior.y1}, kWall);
+  c->fill({23.35, kCorridorInterior.y1 - 0.1, 23.5, kCorridorInterior.y1}, kWall);
+  c->fill({15.6, kCorridorInterior.y0, 16.8, kCorridorInterior.y0 + 0.1}, kWall);
+}
+
+}  // namespace
+
+OccupancyGrid makeCorridorMap() {
+  MapCanvas c(kCorridorExtent, kResolution);
+  const Box& corridor = kCorridorInterior;
+  // West end: a room the corridor opens into, with a table, a cabinet and a
+  // column.
+  c.fill({0.0, 0.0, corridor.x0 + 0.3, 8.0}, kWall);
+  c.fill({0.3, 0.3, corridor.x0, 7.7}, kFree);
+  c.fill({1.2, 5.5, 2.4, 6.3}, kWall);
+  c.fill({0.3, 1.0, 0.8, 2.2}, kWall);
+  c.disc(2.6, 1.8, 0.25, kWall);
+
+  drawCorridorDoorsStretch(&c);
+
+  // The featureless stretch: two plain walls, unknown behind them.
+  c.fill({kCorridorFeaturelessFrom, corridor.y0 - 0.3, corridor.x1, corridor.y1 + 0.3}, kWall);
+
+  // East end: a T-junction, its arms closed 3.5 m from the corridor's axis.
+  c.fill({corridor.x1 - 0.3, 0.0, corridor.x1 + 2.5, 8.0}, kWall);
+  c.fill({corridor.x1, 0.3, corridor.x1 + 2.2, 7.7}, kFree);
+
+  c.fill(corridor, kFree);
+  return c.grid();
+}
+
 }  // namespace pf::sim

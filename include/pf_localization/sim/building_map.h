@@ -79,4 +79,34 @@ OccupancyGrid makeBuildingMap();
 /// (0.05 m cells), for fast tests.
 OccupancyGrid makeSmallMap();
 
+/// The corridor map: a straight corridor 2.2 m wide along x, 35.55 m long
+/// between a room at its west end and a T-junction at its east end (42.5 m
+/// in all); walls 0.3 m thick with unknown space behind them, as in a map
+/// built by SLAM. From its west end to x = kCorridorFeaturelessFrom the walls
+/// have doors at irregular spacing: four open into small rooms, five closed
+/// ones and an alcove are recesses in the walls, one closed door stands in a
+/// frame, a radiator stands out 0.1 m; from there to the T-junction (16.2 m,
+/// over three times a Neato's 5 m range) the two walls are plain and
+/// parallel, so that a lidar there sees nothing that says how far along the
+/// corridor it is.
+///
+///   y=8 +------+ +-N1-+    +-N2-+                                    +---+
+///       | room | |    |    |    |                                    |   |
+///       |      +-+-  -+-[]-+-  -+-[]--+------------------------------+   |
+///       |        doors stretch        |  featureless stretch         | T |
+///       |      +--[]-+-  -+--[]--+-  -+------------------------------+   |
+///       |      |     | S1 |      | S2 |                              |   |
+///   y=0 +------+     +----+      +----+                              +---+
+///      x=0   4.45                   23.8                          40.0  42.5
+///   ("-  -": an open door, "[]": a closed one in a recess)
+inline constexpr Box kCorridorExtent{-0.2, -0.2, 42.7, 8.2};
+/// The corridor's own free space, from the west room to the T-junction.
+inline constexpr Box kCorridorInterior{4.45, 2.85, 40.0, 5.05};
+/// Where the featureless stretch begins; it ends at kCorridorInterior.x1.
+inline constexpr double kCorridorFeaturelessFrom = 23.8;
+
+/// The corridor map (0.05 m cells), for sliding along a corridor whose walls
+/// constrain the pose across it but not along it.
+OccupancyGrid makeCorridorMap();
+
 }  // namespace pf::sim
