@@ -1,9 +1,10 @@
-// OdometryFaultTracker: the fault share follows the weight the faulty
-// particles win, within its bounds.
+// OdometryFaultTracker: the fault share follows the scan's evidence for a
+// fault, within its bounds, and falls back to the floor without any.
 #include "pf_localization/core/odometry_fault_tracker.h"
 
 #include <gtest/gtest.h>
 
+#include <random>
 #include <vector>
 
 namespace pf {
@@ -18,23 +19,54 @@ OdometryMotionParams bounds() {
   return p;
 }
 
-TEST(OdometryFaultTracker, FollowsTheWeightTheFaultyParticlesWinWithinBounds) {
+// `n` particles, the first `faulty` flagged, which together win `won` of
+// the weight.
+void adapt(OdometryFaultTracker* tracker, std::size_t n, std::size_t faulty, double won,
+           const OdometryMotionParams& p) {
+  tracker->flags()->assign(n, 0);
+  std::vector<double> w(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    (*tracker->flags())[i] = i < faulty ? 1 : 0;
+    w[i] = i < faulty ? won / faulty : (1.0 - won) / (n - faulty);
+  }
+  tracker->adapt(w, p);
+}
+
+TEST(OdometryFaultTracker, FollowsTheScansEvidenceWithinBounds) {
   const OdometryMotionParams p = bounds();
   OdometryFaultTracker tracker;
   tracker.restart(p);
   EXPECT_EQ(0.05, tracker.fraction());
   EXPECT_FALSE(tracker.suspect(p));
 
-  *tracker.flags() = {1, 0, 1, 0};
-  tracker.adapt({0.2, 0.4, 0.2, 0.2}, p);  // the faulty ones won 0.4
-  EXPECT_DOUBLE_EQ(0.4, tracker.fraction());
+  // Given 0.05 of the particles, the faulty ones won 0.3: a likelihood ratio
+  // of (0.3 / 0.05) / (0.7 / 0.95) = 8.14, so 0.05 * 8.14 / (0.05 * 8.14 + 0.95).
+  adapt(&tracker, 20, 1, 0.3, p);
+  EXPECT_NEAR(0.3, tracker.fraction(), 1e-12);
   EXPECT_TRUE(tracker.suspect(p));
-
-  tracker.adapt({0.45, 0.05, 0.45, 0.05}, p);  // 0.9: capped
+  // Given 0.3, they won 0.95 (the others are all wrong): capped.
+  adapt(&tracker, 20, 6, 0.95, p);
   EXPECT_EQ(0.5, tracker.fraction());
-  tracker.adapt({0.0, 0.5, 0.0, 0.5}, p);  // none: back to the floor
+  // None won: back to the floor.
+  adapt(&tracker, 20, 10, 0.0, p);
   EXPECT_EQ(0.05, tracker.fraction());
   EXPECT_FALSE(tracker.suspect(p));
+}
+
+TEST(OdometryFaultTracker, AScanThatCannotTellThemApartKeepsTheFloor) {
+  // Plain corridor walls: the faulty particles win what they were given,
+  // give or take chance. Taking the share won as the next share ratcheted it
+  // up to the maximum; as evidence it stays at the floor.
+  const OdometryMotionParams p = bounds();
+  OdometryFaultTracker tracker;
+  tracker.restart(p);
+  std::mt19937 random(1);
+  for (int step = 0; step < 50; ++step) {
+    const double chance = random() % 2 == 0 ? 1.35 : 1.0 / 1.35;  // won a third more or less
+    const double given = tracker.fraction();
+    adapt(&tracker, 100, static_cast<std::size_t>(given * 100 + 0.5), chance * given, p);
+    EXPECT_LT(tracker.fraction(), 0.08) << "step " << step;
+  }
 }
 
 TEST(OdometryFaultTracker, NewBoundsClampTheShare) {

@@ -1,13 +1,15 @@
 // The share of particles that assume an odometry fault in the next motion
 // update (OdometryMotionParams::fault_fraction: a reversal or a stall instead
-// of the odometry's step), adapted to the evidence: the share of the
-// posterior weight the faulty particles won on the last scan, clamped to
+// of the odometry's step), adapted to the evidence: the probability of a
+// fault given the last scan's likelihood ratio between the faulty particles
+// and the others (per particle), with fault_fraction as the prior, clamped to
 // [fault_fraction, fault_fraction_max].
 //
 // Odometry faults come in runs (a robot reverses for a while, wheels spin on
-// a threshold for a while), so the weight the faulty particles just won is
-// the best guess of how many the next step needs: it rises while a fault
-// lasts and falls back to the floor as soon as the odometry is right again.
+// a threshold for a while), so the last scan's verdict is the best guess of
+// how many the next step needs: it rises while a fault lasts and falls back
+// to the floor as soon as the odometry is right again, or when the scan
+// cannot tell (plain corridor walls).
 // A mixture proposal in the sense of Thrun, Fox, Burgard & Dellaert, "Robust
 // Monte Carlo localization for mobile robots" (AIJ 128, 2001). See
 // docs/design.md, "Odometry faults are observed, not assumed".
@@ -47,8 +49,9 @@ class OdometryFaultTracker {
   /// Which particles took a fault in the last motion update (1) and which
   /// the odometry's step (0), written by OdometryMotionModel::apply.
   std::vector<uint8_t>* flags() { return &faulty_; }
-  /// The new share: the posterior weight of the flagged particles
-  /// (`weights` normalised, in the order of the flags), clamped.
+  /// The new share from the posterior weight of the flagged particles
+  /// (`weights` normalised, in the order of the flags) against the share
+  /// they were given, clamped.
   void adapt(const std::vector<double>& weights, const OdometryMotionParams& params);
 
   /// Prefaults room for `n` particles' flags.
