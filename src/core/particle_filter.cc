@@ -1,6 +1,8 @@
 #include "pf_localization/core/particle_filter.h"
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -170,6 +172,26 @@ UpdateReport gateReport(GateDecision* gate, std::size_t particles) {
 
 }  // namespace
 
+namespace {
+
+// Whether a scan fit with covariance `fit` (zero where the scan says
+// nothing) pins the position along heading `yaw` to within `margin` (m):
+// the fit's information along it, with the other directions given.
+bool pinsAlong(const Eigen::Matrix3d& fit, double yaw, double margin) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(fit);
+  const Eigen::Vector3d u(std::cos(yaw), std::sin(yaw), 0.0);
+  double information = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const double lambda = eig.eigenvalues()(i);
+    if (!(lambda > 0.0)) continue;
+    const double along = eig.eigenvectors().col(i).dot(u);
+    information += along * along / lambda;
+  }
+  return information * margin * margin >= 1.0;
+}
+
+}  // namespace
+
 UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
   GateDecision gate = gate_.decide(odom, scan, sensor_.get(), isInitialized(), estimate_.pose,
                                    motion_.faults().suspect(params_.motion), params_);
@@ -197,6 +219,10 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
   report.refinement = refinement_.atUpdate(sensor_.model(), scan, odom,
                                            confidence_.confidence().state, params_, &estimate_);
   if (report.refinement.accepted) confidence_.addFit(report.refinement.covariance);
+  // Without an accepted fit nothing says what the scan pinned: keep hedging.
+  motion_.faults().setAlongTrackObservable(
+      !report.refinement.accepted ||
+      pinsAlong(report.refinement.covariance, estimate_.pose.yaw, params_.motion.fault_margin));
   resample(&report);
   confidence_.demoteAfterLowFit(recovery_.lowFitUpdates(), params_.recovery.patience);
   report.updated = true;

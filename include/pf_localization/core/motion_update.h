@@ -26,7 +26,7 @@ class MotionUpdate {
   /// Moves every particle by the noisy odometry motion from `from` to `to`,
   /// the tracker's share of them assuming a fault (and flagged so).
   void apply(const Pose2& from, const Pose2& to, ParticleSet* particles, Random* random) {
-    model_.apply(from, to, faults_.fraction(), particles, random, faults_.flags());
+    model_.apply(from, to, faults_.sampledFraction(), particles, random, faults_.flags());
   }
 
   const OdometryMotionParams& params() const { return model_.params(); }

@@ -26,12 +26,25 @@ namespace pf {
 class OdometryFaultTracker {
  public:
   /// Back to the floor, fault_fraction (after an initialisation).
-  void restart(const OdometryMotionParams& params) { fraction_ = params.fault_fraction; }
+  void restart(const OdometryMotionParams& params) {
+    fraction_ = params.fault_fraction;
+    along_track_observable_ = true;
+  }
   /// Keeps the share within new bounds (the parameters changed).
   void clampTo(const OdometryMotionParams& params);
 
-  /// The share for the next motion update.
+  /// The share the evidence gives (reported, and what suspect() judges).
   double fraction() const { return fraction_; }
+  /// The share the next motion update samples: none while the last scan
+  /// could not tell a fault along the direction of travel (see
+  /// setAlongTrackObservable), else fraction().
+  double sampledFraction() const { return along_track_observable_ ? fraction_ : 0.0; }
+  /// Whether the last scan pinned the position along the direction of
+  /// travel. Along a featureless corridor it does not: a stalled or reversed
+  /// particle fits there as well as the others, so sampling faults would only
+  /// grow a tail of particles behind the robot that drags the estimate back.
+  /// Odometry then carries the cloud along, as it must.
+  void setAlongTrackObservable(bool observable) { along_track_observable_ = observable; }
   /// Whether the faulty particles win (fault_suspect_fraction): the odometry
   /// itself is then in doubt.
   bool suspect(const OdometryMotionParams& params) const {
@@ -59,6 +72,7 @@ class OdometryFaultTracker {
 
  private:
   double fraction_ = 0.0;
+  bool along_track_observable_ = true;
   std::vector<uint8_t> faulty_;
 };
 

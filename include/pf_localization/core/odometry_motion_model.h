@@ -32,10 +32,11 @@
 // noise) and the other half no translation (uniform within +-fault_margin).
 // The scans decide which particles were right; when the odometry was, the
 // faulty ones die at the next resampling. Faults come in runs (a robot
-// reverses for a while), so the filter sets the next step's share to the
-// weight the faulty particles won on this scan, between fault_fraction and
-// fault_fraction_max (ParticleFilter::adaptFaultFraction): a small share
-// while the odometry is right, and many particles in the fault while it lasts. A uniform spread
+// reverses for a while), so the filter sets the next step's share from this
+// scan's evidence for a fault, between fault_fraction and fault_fraction_max
+// (OdometryFaultTracker): a small share while the odometry is right, many
+// particles in the fault while it lasts, and none while the scan cannot pin
+// the position along the direction of travel. A uniform spread
 // over every translation in between was tried: in long corridors, where the scans say little about
 // the position along them, it smeared the estimate along the corridor (Intel lab) more than the two
 // discrete faults do.
