@@ -1,15 +1,61 @@
 #include "pf_localization/core/estimate_refinement.h"
 
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <cmath>
 
 namespace pf {
 
+namespace {
+
+// chi-square with 1 degree of freedom at 99.9 %: how far (squared, in the
+// cloud's standard deviations) the odometry's prediction may lie from the
+// cloud's mean along an open direction and still be believed.
+constexpr double kPredictionGate = 10.83;
+
+Eigen::Vector3d difference(const Pose2& to, const Pose2& from) {
+  return {to.x - from.x, to.y - from.y, angleDiff(to.yaw, from.yaw)};
+}
+
+// `from` moved to `to` along the directions of projector `open`, when that
+// move lies within the cloud's spread (`cloud`, its covariance).
+Pose2 alongOpen(const Eigen::Matrix3d& open, const Pose2& from, const Pose2& to,
+                const Eigen::Matrix3d& cloud) {
+  if (open.isZero()) return from;
+  const Eigen::Vector3d d = open * difference(to, from);
+  const Eigen::Matrix3d information = (cloud + 1e-9 * Eigen::Matrix3d::Identity()).inverse();
+  if (!information.allFinite() || d.dot(information * d) > kPredictionGate) return from;
+  return {from.x + d(0), from.y + d(1), normalizeAngle(from.yaw + d(2))};
+}
+
+// The projector onto the directions a fit's covariance leaves at zero, the
+// ones its scan did not constrain (ScanRefinement::covariance).
+Eigen::Matrix3d openDirections(const Eigen::Matrix3d& fit) {
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (fit + fit.transpose()));
+  Eigen::Matrix3d open = Eigen::Matrix3d::Zero();
+  const double largest = eig.eigenvalues()(2);
+  for (int i = 0; i < 3; ++i) {
+    if (eig.eigenvalues()(i) > 1e-12 * largest) continue;
+    const Eigen::Vector3d v = eig.eigenvectors().col(i);
+    open += v * v.transpose();
+  }
+  return open;
+}
+
+}  // namespace
+
 ScanRefinement EstimateRefinement::atUpdate(const SensorModel& model, const LaserScan& scan,
-                                            const Pose2& odom, LocalizationState state,
+                                            const Pose2& odom,
+                                            const std::optional<Pose2>& predicted,
+                                            LocalizationState state,
                                             const ParticleFilterParams& params,
                                             PoseEstimate* estimate) {
   refined_.reset();
+  const Eigen::Matrix3d open_before = open_;
+  const bool carried_before = carried_;
+  open_.setZero();
+  carried_ = false;
   ScanRefinement r;
   r.pose = estimate->pose;
   if (!params.refine_estimate) {
@@ -17,15 +63,29 @@ ScanRefinement EstimateRefinement::atUpdate(const SensorModel& model, const Lase
     return r;
   }
   // A lost filter's estimate is nowhere near the robot: a fit from there
-  // would only polish a wrong pose.
-  if (state == LocalizationState::kLost) {
+  // would only polish a wrong pose. But when the last published pose was
+  // carried by the odometry along a corridor, the cloud may be lost only
+  // because it spread along it: the odometry's prediction is then the start.
+  const bool lost = state == LocalizationState::kLost;
+  if (lost && !(predicted && carried_before)) {
     r.rejection = ScanRejection::kFilterLost;
     return r;
   }
+  // Where the last fit left the pose open, the odometry says where it is.
+  Pose2 start = estimate->pose;
+  if (lost) {
+    start = *predicted;
+  } else if (predicted) {
+    start = alongOpen(open_before, estimate->pose, *predicted, estimate->covariance);
+  }
   r = ScanRefiner(model.field(), params.refiner)
-          .refine(model.prepare(scan, params.refiner.max_beams), estimate->pose,
-                  estimate->covariance);
+          .refine(model.prepare(scan, params.refiner.max_beams), start, estimate->covariance);
   if (!r.accepted) return r;
+  open_ = openDirections(r.covariance);
+  const Pose2 fitted = r.pose;
+  if (predicted) r.pose = alongOpen(open_, r.pose, *predicted, estimate->covariance);
+  carried_ =
+      lost || !open_before.isZero() || !open_.isZero() || difference(fitted, r.pose).norm() > 0.0;
   refined_ = Fit{compose(r.pose, inverse(odom)), odom, odom};
   // The cloud was the fit's prior: what is known of the pose is both.
   estimate->pose = r.pose;

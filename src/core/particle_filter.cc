@@ -216,7 +216,7 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
   report.fault_fraction = motion_.faults().fraction();
   report.ess = effectiveSampleSize(particles_.weight);
   estimateAndJudge(*gate.scan, predicted);
-  report.refinement = refinement_.atUpdate(sensor_.model(), scan, odom,
+  report.refinement = refinement_.atUpdate(sensor_.model(), scan, odom, predicted,
                                            confidence_.confidence().state, params_, &estimate_);
   if (report.refinement.accepted) confidence_.addFit(report.refinement.covariance);
   // Without an accepted fit nothing says what the scan pinned: keep hedging.

@@ -7,6 +7,7 @@
 #include "expect_pose.h"
 #include "pf_localization/core/likelihood_field_model.h"
 #include "small_world.h"
+#include "support/grid_from_rows.h"
 
 namespace pf {
 namespace {
@@ -33,8 +34,9 @@ class EstimateRefinementTest : public ::testing::Test {
 
 TEST_F(EstimateRefinementTest, AtAnUpdateTheFitMovesTheEstimateOntoTheScan) {
   const PoseEstimate cloud = estimate_;
-  const ScanRefinement r = refinement_.atUpdate(model_, castScan(grid_, kTruth), odom_,
-                                                LocalizationState::kLocalized, params_, &estimate_);
+  const ScanRefinement r =
+      refinement_.atUpdate(model_, castScan(grid_, kTruth), odom_, std::nullopt,
+                           LocalizationState::kLocalized, params_, &estimate_);
   ASSERT_TRUE(r.accepted) << r.rejection_detail;
   EXPECT_LT(std::hypot(estimate_.pose.x - kTruth.x, estimate_.pose.y - kTruth.y), 0.01);
   // What the cloud (the prior) and the fit know together: sharper than either.
@@ -47,12 +49,12 @@ TEST_F(EstimateRefinementTest, AtAnUpdateTheFitMovesTheEstimateOntoTheScan) {
 TEST_F(EstimateRefinementTest, OffOrLostKeepsTheCloudsEstimate) {
   const Pose2 before = estimate_.pose;
   params_.refine_estimate = false;
-  ScanRefinement r = refinement_.atUpdate(model_, castScan(grid_, kTruth), odom_,
+  ScanRefinement r = refinement_.atUpdate(model_, castScan(grid_, kTruth), odom_, std::nullopt,
                                           LocalizationState::kLocalized, params_, &estimate_);
   EXPECT_EQ(ScanRejection::kRefinementOff, r.rejection);
   params_.refine_estimate = true;
-  r = refinement_.atUpdate(model_, castScan(grid_, kTruth), odom_, LocalizationState::kLost,
-                           params_, &estimate_);
+  r = refinement_.atUpdate(model_, castScan(grid_, kTruth), odom_, std::nullopt,
+                           LocalizationState::kLost, params_, &estimate_);
   EXPECT_EQ(ScanRejection::kFilterLost, r.rejection);
   expectPoseNear(before, estimate_.pose, 0.0);
   expectPoseNear(before, r.pose, 0.0);
@@ -61,8 +63,8 @@ TEST_F(EstimateRefinementTest, OffOrLostKeepsTheCloudsEstimate) {
 
 TEST_F(EstimateRefinementTest, BetweenUpdatesAFitFollowsTheMapAndStandingStillKeepsIt) {
   ASSERT_TRUE(refinement_
-                  .atUpdate(model_, castScan(grid_, kTruth), odom_, LocalizationState::kLocalized,
-                            params_, &estimate_)
+                  .atUpdate(model_, castScan(grid_, kTruth), odom_, std::nullopt,
+                            LocalizationState::kLocalized, params_, &estimate_)
                   .accepted);
   // The robot went 5 cm, the odometry says 6 cm.
   const Pose2 truth = compose(kTruth, {0.05, 0.0, 0.0});
@@ -86,8 +88,8 @@ TEST_F(EstimateRefinementTest, BetweenUpdatesAFitFollowsTheMapAndStandingStillKe
 
 TEST_F(EstimateRefinementTest, AFitOfAnotherUpdateIsStale) {
   ASSERT_TRUE(refinement_
-                  .atUpdate(model_, castScan(grid_, kTruth), odom_, LocalizationState::kLocalized,
-                            params_, &estimate_)
+                  .atUpdate(model_, castScan(grid_, kTruth), odom_, std::nullopt,
+                            LocalizationState::kLocalized, params_, &estimate_)
                   .accepted);
   const Pose2 other = compose(odom_, {10.0, 0.0, 0.0});  // an odometry jump
   expectPoseNear(compose(estimate_.pose, inverse(other)),
@@ -95,6 +97,65 @@ TEST_F(EstimateRefinementTest, AFitOfAnotherUpdateIsStale) {
   refinement_.reset();
   expectPoseNear(compose(estimate_.pose, inverse(odom_)),
                  refinement_.mapToOdom(estimate_.pose, odom_), 1e-12);
+}
+
+// 12 m of plain corridor, 2 m wide, in 0.1 m cells: a scan with a 5 m
+// range sees two parallel walls and nothing that says how far along it is.
+OccupancyGrid plainCorridor() {
+  std::vector<std::string> rows(22, std::string(120, '.'));
+  rows.front() = rows.back() = std::string(120, '#');
+  return test::gridFromRows(rows, 0.1);
+}
+
+LaserScan shortScan(const OccupancyGrid& grid, const Pose2& at) {
+  LaserScan scan = castScan(grid, at);
+  for (float& r : scan.ranges) {
+    if (r > 5.0f) r = 0.0f;  // beyond the range: no reading
+  }
+  return scan;
+}
+
+TEST(EstimateRefinementCorridor, AlongAPlainCorridorTheOdometryCarriesTheEstimate) {
+  const OccupancyGrid grid = plainCorridor();
+  const LikelihoodFieldModel model(grid, LikelihoodFieldModelParams());
+  ParticleFilterParams params;
+  params.refine_estimate = true;
+  const Pose2 truth{6.0, 1.05, 0.0};
+  PoseEstimate estimate;
+  // The cloud is 1 m long along the corridor and its mean 0.8 m behind.
+  estimate.pose = {5.2, 1.08, 0.02};
+  estimate.covariance = Eigen::Vector3d(1.0, 0.01, 0.004).asDiagonal();
+  const Pose2 predicted{6.03, 1.0, 0.01};  // the odometry, a few cm off
+  EstimateRefinement refinement;
+  const ScanRefinement r = refinement.atUpdate(model, shortScan(grid, truth), Pose2(), predicted,
+                                               LocalizationState::kUncertain, params, &estimate);
+  ASSERT_TRUE(r.accepted) << r.rejection_detail;
+  // Across and in yaw the scan decides, along the corridor the odometry.
+  EXPECT_NEAR(predicted.x, estimate.pose.x, 1e-9);
+  EXPECT_NEAR(truth.y, estimate.pose.y, 0.01);
+  EXPECT_NEAR(truth.yaw, estimate.pose.yaw, 0.005);
+  // And the covariance says so: the cloud's length along, sharp across.
+  EXPECT_NEAR(1.0, estimate.covariance(0, 0), 1e-6);
+  EXPECT_LT(estimate.covariance(1, 1), 0.01 * 0.01);
+}
+
+TEST(EstimateRefinementCorridor, APredictionBeyondTheCloudsSpreadIsNotBelieved) {
+  const OccupancyGrid grid = plainCorridor();
+  const LikelihoodFieldModel model(grid, LikelihoodFieldModelParams());
+  ParticleFilterParams params;
+  params.refine_estimate = true;
+  PoseEstimate estimate;
+  estimate.pose = {6.0, 1.05, 0.0};
+  estimate.covariance = Eigen::Vector3d(0.04, 0.01, 0.004).asDiagonal();
+  // 4 m off along the corridor, 20 of the cloud's std devs: an odometry
+  // fault or a kidnapping, not drift.
+  const Pose2 predicted{10.0, 1.05, 0.0};
+  EstimateRefinement refinement;
+  const ScanRefinement r =
+      refinement.atUpdate(model, shortScan(grid, estimate.pose), Pose2(), predicted,
+                          LocalizationState::kUncertain, params, &estimate);
+  ASSERT_TRUE(r.accepted) << r.rejection_detail;
+  EXPECT_NEAR(6.0, estimate.pose.x, 1e-6);
 }
 
 }  // namespace

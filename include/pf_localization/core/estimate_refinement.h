@@ -28,15 +28,26 @@ namespace pf {
 class EstimateRefinement {
  public:
   /// Forgets the last fit (a new map, an initialisation).
-  void reset() { refined_.reset(); }
+  void reset() {
+    refined_.reset();
+    open_.setZero();
+    carried_ = false;
+  }
 
   /// At an update whose odometry is `odom`: fits `scan` from `*estimate`
   /// with its covariance as the prior and, when accepted, moves the estimate
-  /// there and widens its covariance to cover the fit's. Not when
-  /// refine_estimate is off or `state` is lost. Forgets the previous fit.
+  /// there and fuses its covariance with the fit's. Not when refine_estimate
+  /// is off or `state` is lost. Forgets the previous fit.
+  ///
+  /// Along the directions a fit leaves open (a featureless corridor's
+  /// length) the estimate is `predicted`, the last published pose carried by
+  /// the odometry, instead of the cloud's mean: the cloud is metres long
+  /// there and its mean wanders, while the odometry drifts by centimetres.
+  /// Not when `predicted` lies beyond the cloud's spread along them (an
+  /// odometry fault, a kidnapping): the cloud knows better then.
   ScanRefinement atUpdate(const SensorModel& model, const LaserScan& scan, const Pose2& odom,
-                          LocalizationState state, const ParticleFilterParams& params,
-                          PoseEstimate* estimate);
+                          const std::optional<Pose2>& predicted, LocalizationState state,
+                          const ParticleFilterParams& params, PoseEstimate* estimate);
 
   /// On a scan between updates at odometry `odom`, the last update's
   /// `estimate` at `odom_at_update`: fits the scan from where the odometry
@@ -61,6 +72,11 @@ class EstimateRefinement {
     Pose2 odom_at_fit;     // the odometry at the scan that was fitted
   };
   std::optional<Fit> refined_;
+  // Projector onto the directions (x, y, yaw) the last accepted update fit
+  // left open; zero when it pinned all three.
+  Eigen::Matrix3d open_ = Eigen::Matrix3d::Zero();
+  // Whether the last accepted update fit took a direction from the odometry.
+  bool carried_ = false;
 };
 
 }  // namespace pf
