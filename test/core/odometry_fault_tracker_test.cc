@@ -56,7 +56,8 @@ TEST(OdometryFaultTracker, FollowsTheScansEvidenceWithinBounds) {
 TEST(OdometryFaultTracker, AScanThatCannotTellThemApartKeepsTheFloor) {
   // Plain corridor walls: the faulty particles win what they were given,
   // give or take chance. Taking the share won as the next share ratcheted it
-  // up to the maximum; as evidence it stays at the floor.
+  // up to the maximum; as evidence it stays near the floor (the last
+  // verdict's memory, kFaultMemory, lets chance lift it to about 0.1 at most).
   const OdometryMotionParams p = bounds();
   OdometryFaultTracker tracker;
   tracker.restart(p);
@@ -65,7 +66,7 @@ TEST(OdometryFaultTracker, AScanThatCannotTellThemApartKeepsTheFloor) {
     const double chance = random() % 2 == 0 ? 1.35 : 1.0 / 1.35;  // won a third more or less
     const double given = tracker.fraction();
     adapt(&tracker, 100, static_cast<std::size_t>(given * 100 + 0.5), chance * given, p);
-    EXPECT_LT(tracker.fraction(), 0.08) << "step " << step;
+    EXPECT_LT(tracker.fraction(), 0.12) << "step " << step;
   }
 }
 
