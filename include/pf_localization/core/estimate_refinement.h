@@ -37,7 +37,9 @@ class EstimateRefinement {
   /// At an update whose odometry is `odom`: fits `scan` from `*estimate`
   /// with its covariance as the prior and, when accepted, moves the estimate
   /// there and fuses its covariance with the fit's. Not when refine_estimate
-  /// is off or `state` is lost. Forgets the previous fit.
+  /// is off, nor when `state` is lost, unless the last published pose was
+  /// carried by the odometry (below): the fit then starts from `predicted`.
+  /// Forgets the previous fit.
   ///
   /// Along the directions a fit leaves open (a featureless corridor's
   /// length) the estimate is `predicted`, the last published pose carried by
