@@ -1,7 +1,6 @@
 #include "pf_localization/core/estimate_refinement.h"
 
 #include <Eigen/Core>
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <cmath>
 
@@ -27,20 +26,6 @@ Pose2 alongOpen(const Eigen::Matrix3d& open, const Pose2& from, const Pose2& to,
   const Eigen::Matrix3d information = (cloud + 1e-9 * Eigen::Matrix3d::Identity()).inverse();
   if (!information.allFinite() || d.dot(information * d) > kPredictionGate) return from;
   return {from.x + d(0), from.y + d(1), normalizeAngle(from.yaw + d(2))};
-}
-
-// The projector onto the directions a fit's covariance leaves at zero, the
-// ones its scan did not constrain (ScanRefinement::covariance).
-Eigen::Matrix3d openDirections(const Eigen::Matrix3d& fit) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (fit + fit.transpose()));
-  Eigen::Matrix3d open = Eigen::Matrix3d::Zero();
-  const double largest = eig.eigenvalues()(2);
-  for (int i = 0; i < 3; ++i) {
-    if (eig.eigenvalues()(i) > 1e-12 * largest) continue;
-    const Eigen::Vector3d v = eig.eigenvectors().col(i);
-    open += v * v.transpose();
-  }
-  return open;
 }
 
 }  // namespace
@@ -81,11 +66,10 @@ ScanRefinement EstimateRefinement::atUpdate(const SensorModel& model, const Lase
   r = ScanRefiner(model.field(), params.refiner)
           .refine(model.prepare(scan, params.refiner.max_beams), start, estimate->covariance);
   if (!r.accepted) return r;
-  open_ = openDirections(r.covariance);
-  const Pose2 fitted = r.pose;
+  open_ = fitInformation(r.covariance).open;
   if (predicted) r.pose = alongOpen(open_, r.pose, *predicted, estimate->covariance);
-  carried_ =
-      lost || !open_before.isZero() || !open_.isZero() || difference(fitted, r.pose).norm() > 0.0;
+  // Whether a direction came from the odometry: at the start or at the end.
+  carried_ = lost || !open_before.isZero() || !open_.isZero();
   refined_ = Fit{compose(r.pose, inverse(odom)), odom, odom};
   // The cloud was the fit's prior: what is known of the pose is both.
   estimate->pose = r.pose;

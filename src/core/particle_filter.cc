@@ -170,10 +170,6 @@ UpdateReport gateReport(GateDecision* gate, std::size_t particles) {
   return report;
 }
 
-}  // namespace
-
-namespace {
-
 // Whether a scan fit with covariance `fit` (zero where the scan says
 // nothing) pins the position along heading `yaw` to within `margin` (m):
 // the fit's information along it, with the other directions given.

@@ -294,16 +294,24 @@ ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start,
   return out;
 }
 
-Eigen::Matrix3d fusedCovariance(const Eigen::Matrix3d& fit, const Eigen::Matrix3d& prior) {
+FitInformation fitInformation(const Eigen::Matrix3d& fit) {
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(0.5 * (fit + fit.transpose()));
   const Eigen::Vector3d lambda = eig.eigenvalues();
-  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+  FitInformation out;
   for (int i = 0; i < 3; ++i) {
-    // Zero (or rounding-negative) variance: a direction the fit leaves open.
-    if (!(lambda(i) > 1e-12 * std::max(1e-12, lambda(2)))) continue;
     const Eigen::Vector3d v = eig.eigenvectors().col(i);
-    information += v * v.transpose() / lambda(i);
+    // Zero (or rounding-negative) variance: a direction the fit leaves open.
+    if (lambda(i) > 1e-12 * std::max(1e-12, lambda(2))) {
+      out.information += v * v.transpose() / lambda(i);
+    } else {
+      out.open += v * v.transpose();
+    }
   }
+  return out;
+}
+
+Eigen::Matrix3d fusedCovariance(const Eigen::Matrix3d& fit, const Eigen::Matrix3d& prior) {
+  const Eigen::Matrix3d information = fitInformation(fit).information;
   // The ridge keeps a flat prior (zero variance somewhere) from making the
   // sum singular; it is far below any variance a pose can have.
   const Eigen::Matrix3d prior_information = (prior + 1e-12 * Eigen::Matrix3d::Identity()).inverse();

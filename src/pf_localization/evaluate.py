@@ -288,11 +288,16 @@ def rigid_fit(src, dst):
     return angle, md - rot @ ms
 
 
+def rigid_move(xy, angle, shift):
+    """The points xy (N, 2) turned by angle (rad) about the origin, then shifted by shift (2,)."""
+    c, s = np.cos(angle), np.sin(angle)
+    return np.c_[c * xy[:, 0] - s * xy[:, 1], s * xy[:, 0] + c * xy[:, 1]] + shift
+
+
 def aligned_ate(est_xy, ref_xy):
     """ATE RMSE after rigid_fit of the estimates onto the reference: (rmse, angle rad, (tx, ty))."""
     angle, shift = rigid_fit(est_xy, ref_xy)
-    c, s = np.cos(angle), np.sin(angle)
-    moved = np.c_[c * est_xy[:, 0] - s * est_xy[:, 1], s * est_xy[:, 0] + c * est_xy[:, 1]] + shift
+    moved = rigid_move(est_xy, angle, shift)
     return float(np.sqrt(np.mean(np.sum((moved - ref_xy) ** 2, axis=1)))), angle, shift
 
 
@@ -381,9 +386,9 @@ def covariance_metrics(cov, match, max_gap=0.5, ref_std=0.0, aligned=False):
     est = match['est'][:, :2]
     if aligned:
         angle, shift = match['alignment']
-        c, s = np.cos(angle), np.sin(angle)
-        est = np.c_[c * est[:, 0] - s * est[:, 1], s * est[:, 0] + c * est[:, 1]] + shift
+        est = rigid_move(est, angle, shift)
         # The covariance turns with the estimate.
+        c, s = np.cos(angle), np.sin(angle)
         xx, xy, yy = s_xy[:, 0], s_xy[:, 1], s_xy[:, 2]
         s_xy = np.c_[c * c * xx - 2 * c * s * xy + s * s * yy,
                      c * s * (xx - yy) + (c * c - s * s) * xy,

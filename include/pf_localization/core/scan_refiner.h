@@ -150,6 +150,16 @@ class ScanRefiner {
   ScanRefinerParams params_;
 };
 
+/// What a scan fit's covariance (ScanRefinement::covariance: zero in the
+/// directions the scan does not constrain) says: its information, the
+/// pseudo-inverse, in which those directions carry none, and the projector
+/// onto them (zero when the scan pinned all three).
+struct FitInformation {
+  Eigen::Matrix3d information = Eigen::Matrix3d::Zero();
+  Eigen::Matrix3d open = Eigen::Matrix3d::Zero();
+};
+FitInformation fitInformation(const Eigen::Matrix3d& fit);
+
 /// The covariance of the pose that `fit` (a scan fit's: zero in the
 /// directions the scan does not constrain, which carry no information) and
 /// `prior` (the cloud's) give together: their informations added, the
