@@ -1,7 +1,6 @@
 #include "pf_localization/core/particle_filter.h"
 
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -174,16 +173,8 @@ UpdateReport gateReport(GateDecision* gate, std::size_t particles) {
 // nothing) pins the position along heading `yaw` to within `margin` (m):
 // the fit's information along it, with the other directions given.
 bool pinsAlong(const Eigen::Matrix3d& fit, double yaw, double margin) {
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(fit);
   const Eigen::Vector3d u(std::cos(yaw), std::sin(yaw), 0.0);
-  double information = 0.0;
-  for (int i = 0; i < 3; ++i) {
-    const double lambda = eig.eigenvalues()(i);
-    if (!(lambda > 0.0)) continue;
-    const double along = eig.eigenvectors().col(i).dot(u);
-    information += along * along / lambda;
-  }
-  return information * margin * margin >= 1.0;
+  return u.dot(fitInformation(fit).information * u) * margin * margin >= 1.0;
 }
 
 }  // namespace
