@@ -2,7 +2,7 @@
 
 #include <gtest/gtest.h>
 
-#include <queue>
+#include "support/closed_region.h"
 
 namespace pf::sim {
 namespace {
@@ -20,33 +20,7 @@ TEST(MapCanvasTest, PaintsCellsWhoseCentresAreInside) {
   EXPECT_EQ(g.data(), expected);
 }
 
-// Free cells reachable from (x, y) through 4-connected free cells, or -1
-// when one of them touches an unknown cell or the edge of the map: a ray
-// crosses cells 4-connectedly, so a leak like that would let it out.
-int closedRegionSize(const OccupancyGrid& g, double x, double y) {
-  std::vector<bool> seen(g.data().size(), false);
-  std::queue<CellIndex> todo;
-  const CellIndex start = g.worldToCell(x, y);
-  if (g.state(start) != CellState::kFree) return 0;
-  todo.push(start);
-  seen[g.linearIndex(start)] = true;
-  int count = 0;
-  while (!todo.empty()) {
-    const CellIndex c = todo.front();
-    todo.pop();
-    ++count;
-    for (const CellIndex n : {CellIndex{c.x + 1, c.y}, CellIndex{c.x - 1, c.y},
-                              CellIndex{c.x, c.y + 1}, CellIndex{c.x, c.y - 1}}) {
-      const CellState s = g.state(n);
-      if (s == CellState::kUnknown) return -1;
-      if (s == CellState::kFree && !seen[g.linearIndex(n)]) {
-        seen[g.linearIndex(n)] = true;
-        todo.push(n);
-      }
-    }
-  }
-  return count;
-}
+using test::closedRegionSize;
 
 TEST(BuildingMapTest, Geometry) {
   const OccupancyGrid g = makeBuildingMap();

@@ -6,12 +6,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <queue>
 #include <set>
 #include <vector>
 
 #include "pf_localization/sim/building_map.h"
 #include "pf_localization/sim/ray_caster.h"
+#include "support/closed_region.h"
 
 namespace pf::sim {
 namespace {
@@ -167,27 +167,10 @@ TEST(CorridorMapTest, ClosedAndAllOneSpace) {
   const OccupancyGrid g = makeCorridorMap();
   // Every free cell is reachable from the west room through free cells, and
   // none touches unknown space or the edge (a ray would leave the map).
-  std::vector<bool> seen(g.data().size(), false);
-  std::queue<CellIndex> todo;
-  todo.push(g.worldToCell(2.5, 3.95));
   ASSERT_TRUE(g.isFreeAt(2.5, 3.95));
-  seen[g.linearIndex(todo.front())] = true;
-  std::size_t reached = 0;
-  while (!todo.empty()) {
-    const CellIndex c = todo.front();
-    todo.pop();
-    ++reached;
-    for (const CellIndex n : {CellIndex{c.x + 1, c.y}, CellIndex{c.x - 1, c.y},
-                              CellIndex{c.x, c.y + 1}, CellIndex{c.x, c.y - 1}}) {
-      ASSERT_TRUE(g.contains(n)) << "free space reaches the edge";
-      ASSERT_NE(g.state(n), CellState::kUnknown) << "free space leaks at " << n.x << ", " << n.y;
-      if (g.state(n) == CellState::kFree && !seen[g.linearIndex(n)]) {
-        seen[g.linearIndex(n)] = true;
-        todo.push(n);
-      }
-    }
-  }
-  EXPECT_EQ(reached, g.freeCells().size());
+  const int reached = test::closedRegionSize(g, 2.5, 3.95);
+  ASSERT_GT(reached, 0) << "the free space leaks into unknown space or off the map";
+  EXPECT_EQ(reached, static_cast<int>(g.freeCells().size()));
 }
 
 }  // namespace
