@@ -297,7 +297,7 @@ void Replay::run(const rosbag::Bag& bag) {
   const double t_begin = view.getBeginTime().toSec(), t_end = view.getEndTime().toSec();
   ProgressBar progress(!opt_.quiet);
   // pf_node publishes the estimate once it has the map, as the filter starts.
-  published_ = localizer_.estimate(ros::Time(t_begin));
+  if (outputs_.cov) published_ = localizer_.estimate(ros::Time(t_begin));
   try {
     for (const rosbag::MessageInstance& m : view) {
       const double now = m.getTime().toSec();
@@ -353,7 +353,7 @@ void Replay::process(const sensor_msgs::LaserScan& scan) {
     return;
   }
   if (r.report.updated) {
-    published_ = localizer_.estimate(scan.header.stamp);
+    if (outputs_.cov) published_ = localizer_.estimate(scan.header.stamp);
     ++counts_.updates;
     counts_.update_cpu.add(cpu);
     if (outputs_.log) logUpdate(t, r, cpu);
@@ -370,17 +370,18 @@ void Replay::process(const sensor_msgs::LaserScan& scan) {
   ++counts_.written;
 }
 
-// One line of the covariance file: the published message's x, y, yaw terms
-// (ROS's 6 x 6 row-major order: x 0, y 1, yaw 5).
+// One line of the covariance file: the published message's x, y, yaw terms.
 void Replay::writeCovariance(double t) {
   outputs_.cov << std::fixed << std::setprecision(6) << t;
   if (!published_) {
     outputs_.cov << ",nan,nan,nan,nan,nan,nan\n";
     return;
   }
-  const auto& c = published_->pose.covariance;
+  const Eigen::Matrix3d c = pf_ros::fromRosCovariance(published_->pose.covariance);
   outputs_.cov << std::scientific << std::setprecision(9);
-  for (const int i : {0, 1, 7, 35, 5, 11}) outputs_.cov << "," << c[i];
+  for (const double v : {c(0, 0), c(0, 1), c(1, 1), c(2, 2), c(0, 2), c(1, 2)}) {
+    outputs_.cov << "," << v;
+  }
   outputs_.cov << "\n";
 }
 
