@@ -3,6 +3,7 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 #include <cmath>
+#include <limits>
 
 namespace pf {
 
@@ -17,15 +18,34 @@ Eigen::Vector3d difference(const Pose2& to, const Pose2& from) {
   return {to.x - from.x, to.y - from.y, angleDiff(to.yaw, from.yaw)};
 }
 
+// The squared Mahalanobis length of `d` in the cloud's spread (`cloud`, its
+// covariance); +inf when the covariance cannot be inverted.
+double inCloudSpread(const Eigen::Vector3d& d, const Eigen::Matrix3d& cloud) {
+  const Eigen::Matrix3d information = (cloud + 1e-9 * Eigen::Matrix3d::Identity()).inverse();
+  return information.allFinite() ? d.dot(information * d) : std::numeric_limits<double>::infinity();
+}
+
 // `from` moved to `to` along the directions of projector `open`, when that
-// move lies within the cloud's spread (`cloud`, its covariance).
+// move lies within the cloud's spread.
 Pose2 alongOpen(const Eigen::Matrix3d& open, const Pose2& from, const Pose2& to,
                 const Eigen::Matrix3d& cloud) {
   if (open.isZero()) return from;
   const Eigen::Vector3d d = open * difference(to, from);
-  const Eigen::Matrix3d information = (cloud + 1e-9 * Eigen::Matrix3d::Identity()).inverse();
-  if (!information.allFinite() || d.dot(information * d) > kPredictionGate) return from;
+  if (inCloudSpread(d, cloud) > kPredictionGate) return from;
   return {from.x + d(0), from.y + d(1), normalizeAngle(from.yaw + d(2))};
+}
+
+// chi-square with 3 degrees of freedom at 99.9 %: how far (squared, in the
+// cloud's standard deviations) the odometry's prediction may lie from the
+// cloud's mean and still be a start for a fit.
+constexpr double kPredictionStartGate = 16.27;
+
+// Whether a fit from `b` would end where the one that ended at `a` did: the
+// robust cost's basins are a Cauchy scale or two wide (0.05 m; 0.03 rad
+// moves an end point 5 m away by 0.15 m), so a second fit from this close
+// would only spend the time to find the same minimum.
+bool sameBasin(const Pose2& a, const Pose2& b) {
+  return std::hypot(a.x - b.x, a.y - b.y) < 0.05 && std::fabs(angleDiff(a.yaw, b.yaw)) < 0.03;
 }
 
 }  // namespace
@@ -63,8 +83,20 @@ ScanRefinement EstimateRefinement::atUpdate(const SensorModel& model, const Lase
   } else if (predicted) {
     start = alongOpen(open_before, estimate->pose, *predicted, estimate->covariance);
   }
-  r = ScanRefiner(model.field(), params.refiner)
-          .refine(model.prepare(scan, params.refiner.max_beams), start, estimate->covariance);
+  const ScanRefiner refiner(model.field(), params.refiner);
+  const PreparedScan prepared = model.prepare(scan, params.refiner.max_beams);
+  r = refiner.refine(prepared, start, estimate->covariance);
+  // The cloud's mean can sit on a wrong door pattern while the odometry's
+  // prediction is where the robot is: fitted from both, the scan decides.
+  if (predicted && !lost && !(r.accepted && sameBasin(r.pose, *predicted)) &&
+      inCloudSpread(difference(*predicted, estimate->pose), estimate->covariance) <=
+          kPredictionStartGate) {
+    const ScanRefinement from_prediction =
+        refiner.refine(prepared, *predicted, estimate->covariance);
+    if (from_prediction.accepted && (!r.accepted || from_prediction.scan_cost < r.scan_cost)) {
+      r = from_prediction;
+    }
+  }
   if (!r.accepted) return r;
   open_ = fitInformation(r.covariance).open;
   if (predicted) r.pose = alongOpen(open_, r.pose, *predicted, estimate->covariance);

@@ -289,6 +289,7 @@ ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start,
   }
   out.covariance = fitCovariance(eig, e.sum_weight, e.sum_weighted_sq, params_);
   out.rms_distance = std::sqrt(e.sum_sq / e.matched);
+  out.scan_cost = e.cost;
   out.pose = pose;
   out.accepted = true;
   return out;

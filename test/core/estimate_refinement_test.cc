@@ -158,5 +158,75 @@ TEST(EstimateRefinementCorridor, APredictionBeyondTheCloudsSpreadIsNotBelieved) 
   EXPECT_NEAR(6.0, estimate.pose.x, 1e-6);
 }
 
+// 12 m of corridor, 2 m wide, in 0.1 m cells, with doorways at irregular
+// spacing in both walls: where along it the robot is shows only in where
+// the doorways are.
+OccupancyGrid corridorWithDoors() {
+  std::vector<std::string> rows(22, std::string(120, '.'));
+  rows.front() = rows.back() = std::string(120, '#');
+  const auto doorway = [&](std::string* wall, double x0, double x1) {
+    for (int i = static_cast<int>(x0 * 10); i < static_cast<int>(x1 * 10); ++i) (*wall)[i] = '.';
+  };
+  doorway(&rows.front(), 3.0, 3.9);
+  doorway(&rows.front(), 5.2, 6.1);
+  doorway(&rows.front(), 8.9, 9.8);
+  doorway(&rows.back(), 4.3, 5.0);
+  doorway(&rows.back(), 7.6, 8.4);
+  return test::gridFromRows(rows, 0.1);
+}
+
+// A fit at an update starts from the cloud's mean and, when the odometry's
+// prediction lies elsewhere within the cloud's spread, from there too; the
+// one whose end points lie better on the map wins.
+class EstimateRefinementDoors : public ::testing::Test {
+ protected:
+  EstimateRefinementDoors()
+      : grid_(corridorWithDoors()), model_(grid_, LikelihoodFieldModelParams()) {
+    params_.refine_estimate = true;
+  }
+
+  // The estimate that atUpdate makes of a cloud at `cloud_mean` (1 m long
+  // along the corridor) with the odometry predicting `predicted`.
+  PoseEstimate fitted(const Pose2& cloud_mean, const Pose2& predicted) {
+    PoseEstimate estimate;
+    estimate.pose = cloud_mean;
+    estimate.covariance = Eigen::Vector3d(0.25, 0.01, 0.004).asDiagonal();
+    EstimateRefinement refinement;
+    const ScanRefinement r =
+        refinement.atUpdate(model_, shortScan(grid_, kTruth), Pose2(), predicted,
+                            LocalizationState::kUncertain, params_, &estimate);
+    EXPECT_TRUE(r.accepted) << r.rejection_detail;
+    return estimate;
+  }
+
+  const Pose2 kTruth{6.0, 1.05, 0.0};
+  OccupancyGrid grid_;
+  LikelihoodFieldModel model_;
+  ParticleFilterParams params_;
+};
+
+TEST_F(EstimateRefinementDoors, TheOdometrysPredictionFindsTheRightDoorways) {
+  // 0.9 m ahead the doorways line up again, if worse: a fit from there stays.
+  const Pose2 wrong{kTruth.x + 0.9, kTruth.y, 0.0};
+  const ScanRefinement alone =
+      ScanRefiner(model_.field(), params_.refiner)
+          .refine(model_.prepare(shortScan(grid_, kTruth), params_.refiner.max_beams), wrong,
+                  Eigen::Matrix3d(Eigen::Vector3d(0.25, 0.01, 0.004).asDiagonal()));
+  ASSERT_TRUE(alone.accepted) << alone.rejection_detail;
+  ASSERT_GT(alone.pose.x - kTruth.x, 0.8);
+  // With the odometry 2 cm off as a second start, the fit finds the robot.
+  const PoseEstimate estimate = fitted(wrong, {kTruth.x + 0.02, kTruth.y - 0.01, 0.005});
+  EXPECT_NEAR(kTruth.x, estimate.pose.x, 0.02);
+  EXPECT_NEAR(kTruth.y, estimate.pose.y, 0.02);
+}
+
+TEST_F(EstimateRefinementDoors, AWrongPredictionLosesToTheCloud) {
+  // The odometry ran 0.9 m too far (a wheel slipped): its start fits worse.
+  const PoseEstimate estimate =
+      fitted({kTruth.x + 0.05, kTruth.y, 0.0}, {kTruth.x + 0.9, kTruth.y, 0.0});
+  EXPECT_NEAR(kTruth.x, estimate.pose.x, 0.02);
+  EXPECT_NEAR(kTruth.y, estimate.pose.y, 0.02);
+}
+
 }  // namespace
 }  // namespace pf

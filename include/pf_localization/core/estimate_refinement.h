@@ -47,6 +47,12 @@ class EstimateRefinement {
   /// there and its mean wanders, while the odometry drifts by centimetres.
   /// Not when `predicted` lies beyond the cloud's spread along them (an
   /// odometry fault, a kidnapping): the cloud knows better then.
+  ///
+  /// The cloud's mean can also sit on the wrong one of two door patterns a
+  /// metre apart, where the motion noise spread the cloud over both: when
+  /// `predicted` lies elsewhere within the cloud's spread (chi-square, 3 dof,
+  /// 99.9 %), the scan is fitted from there too, and the fit whose end
+  /// points lie better on the map (ScanRefinement::scan_cost) is taken.
   ScanRefinement atUpdate(const SensorModel& model, const LaserScan& scan, const Pose2& odom,
                           const std::optional<Pose2>& predicted, LocalizationState state,
                           const ParticleFilterParams& params, PoseEstimate* estimate);

@@ -112,8 +112,12 @@ struct ScanRefinement {
   int iterations = 0;
   int matched_beams = 0;      // ending within outlier_distance, at the final pose
   double rms_distance = 0.0;  // m, of the matched beams, at the final pose
-  double translation = 0.0;   // m moved from the start
-  double rotation = 0.0;      // rad turned from the start
+  // m^2: the scan's robust cost at the final pose (the sum of rho over the
+  // beams, truncated ones included), without the prior. Two fits of the same
+  // prepared scan compare by it: the lower lies better on the map.
+  double scan_cost = 0.0;
+  double translation = 0.0;  // m moved from the start
+  double rotation = 0.0;     // rad turned from the start
 };
 
 class ScanRefiner {
