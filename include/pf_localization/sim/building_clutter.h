@@ -5,7 +5,8 @@
 // the floor, the ceiling and all of these but the table's legs:
 //
 //   what                                     where (map, m)         height (m)
-//   two parcels on the corridor's south side x 4.6-5.2, 5.8-6.2     0-0.2
+//   two parcels on the corridor's south side x 4.6-5.0, 5.2-5.8     0-0.2
+//                                            y 6.7-7.1
 //   a pallet in the lobby                    x 7.2-8.4, y 3.8-4.6   0-0.15
 //   a standing table in the lobby: a top     x 11.2-12.4, y 4.2-5.0 1.0-1.04
 //     on four 0.04 m legs at its corners                            0-1.0
