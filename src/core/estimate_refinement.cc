@@ -51,7 +51,7 @@ bool sameBasin(const Pose2& a, const Pose2& b) {
 
 }  // namespace
 
-ScanRefinement EstimateRefinement::atUpdate(const SensorModel& model, const LaserScan& scan,
+ScanRefinement EstimateRefinement::atUpdate(const SensorModel& model, const ScanGroup& scans,
                                             const Pose2& odom,
                                             const std::optional<Pose2>& predicted,
                                             LocalizationState state,
@@ -85,7 +85,8 @@ ScanRefinement EstimateRefinement::atUpdate(const SensorModel& model, const Lase
     start = alongOpen(open_before, estimate->pose, *predicted, estimate->covariance);
   }
   const ScanRefiner refiner(model.field(), params.refiner);
-  const PreparedScan prepared = model.prepare(scan, params.refiner.max_beams);
+  const PreparedScan prepared =
+      joinedEndPoints(prepareScans(model, scans, params.refiner.max_beams));
   r = refiner.refine(prepared, start, estimate->covariance);
   // The cloud's mean can sit on a wrong door pattern while the odometry's
   // prediction is where the robot is: fitted from both, the scan decides.
@@ -110,7 +111,7 @@ ScanRefinement EstimateRefinement::atUpdate(const SensorModel& model, const Lase
   return r;
 }
 
-ScanRefinement EstimateRefinement::betweenUpdates(const SensorModel& model, const LaserScan& scan,
+ScanRefinement EstimateRefinement::betweenUpdates(const SensorModel& model, const ScanGroup& scans,
                                                   const Pose2& odom, const Pose2& odom_at_update,
                                                   const PoseEstimate& estimate,
                                                   LocalizationState state,
@@ -130,7 +131,9 @@ ScanRefinement EstimateRefinement::betweenUpdates(const SensorModel& model, cons
       estimate.clusters.empty() ? std::nullopt
                                 : std::optional<Eigen::Matrix3d>(estimate.clusters[0].covariance);
   r = ScanRefiner(model.field(), params.refiner)
-          .refine(model.prepare(scan, params.refiner.max_beams_between_updates), predicted, prior);
+          .refine(
+              joinedEndPoints(prepareScans(model, scans, params.refiner.max_beams_between_updates)),
+              predicted, prior);
   if (r.accepted) refined_ = Fit{compose(r.pose, inverse(odom)), odom_at_update, odom};
   return r;
 }

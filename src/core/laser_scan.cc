@@ -16,6 +16,10 @@ std::optional<std::string> validateScan(const LaserScan& scan) {
            ") must be finite and above range_min (" + std::to_string(scan.range_min) + ")";
   }
   if (!scan.sensor_pose.isFinite()) return "the laser's pose on the robot is not finite";
+  if (!scan.robot_offset.isFinite()) return "the robot's pose at the scan's stamp is not finite";
+  if (!(scan.weight > 0.0 && scan.weight <= 1.0)) {
+    return "the sensor's weight (" + std::to_string(scan.weight) + ") is not in (0, 1]";
+  }
   if (!std::isfinite(scan.sweep.first_beam_time) || !std::isfinite(scan.sweep.time_increment) ||
       !scan.sweep.base_velocity.isFinite()) {
     return "the sweep's beam times or the robot's velocity during it are not finite";

@@ -162,9 +162,9 @@ UpdateReport gateReport(GateDecision* gate, std::size_t particles) {
   report.skip_reason = gate->skip;
   report.skip_detail = std::move(gate->detail);
   report.fit_dropped = gate->fit_dropped;
-  if (gate->scan) {
-    report.beams_used = static_cast<int>(gate->scan->size());
-    report.beams_dropped = gate->scan->dropped;
+  if (gate->scans) {
+    report.beams_used = static_cast<int>(beamCount(*gate->scans));
+    report.beams_dropped = droppedBeams(*gate->scans);
   }
   return report;
 }
@@ -179,13 +179,13 @@ bool pinsAlong(const Eigen::Matrix3d& fit, double yaw, double margin) {
 
 }  // namespace
 
-UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
-  GateDecision gate = gate_.decide(odom, scan, sensor_.get(), isInitialized(), estimate_.pose,
+UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& scans) {
+  GateDecision gate = gate_.decide(odom, scans, sensor_.get(), isInitialized(), estimate_.pose,
                                    motion_.faults().suspect(params_.motion), params_);
   UpdateReport report = gateReport(&gate, particles_.size());
   if (gate.skip == SkipReason::kNotMoved) {
     report.refinement =
-        refinement_.betweenUpdates(sensor_.model(), scan, odom, *gate_.odomAtUpdate(), estimate_,
+        refinement_.betweenUpdates(sensor_.model(), scans, odom, *gate_.odomAtUpdate(), estimate_,
                                    confidence_.confidence().state, params_);
   }
   if (!gate.runs()) return report;
@@ -196,14 +196,14 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
     predicted = compose(refinement_.mapToOdom(estimate_.pose, *gate.from), odom);
     motion_.apply(*gate.from, odom, &particles_, &random_);
   }
-  weigh(*gate.scan, &report);
+  weigh(*gate.scans, &report);
   if (gate.from && OdometryFaultTracker::observable(gate.step, params_.motion)) {
     motion_.faults().adapt(particles_.weight, params_.motion);
   }
   report.fault_fraction = motion_.faults().fraction();
   report.ess = effectiveSampleSize(particles_.weight);
-  estimateAndJudge(*gate.scan, predicted);
-  report.refinement = refinement_.atUpdate(sensor_.model(), scan, odom, predicted,
+  estimateAndJudge(*gate.scans, predicted);
+  report.refinement = refinement_.atUpdate(sensor_.model(), scans, odom, predicted,
                                            confidence_.confidence().state, params_, &estimate_);
   if (report.refinement.accepted) confidence_.addFit(report.refinement.covariance);
   // Without an accepted fit nothing says what the scan pinned: keep hedging.
@@ -217,26 +217,26 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const LaserScan& scan) {
   return report;
 }
 
-void ParticleFilter::estimateAndJudge(const PreparedScan& scan,
+void ParticleFilter::estimateAndJudge(const std::vector<PreparedScan>& scans,
                                       const std::optional<Pose2>& predicted) {
   // The estimate comes from the weighted cloud, before resampling: resampling
   // only adds noise, and the random particles recovery injects must not count.
   estimate_ = estimatePose(particles_, params_.clusters);
   const SensorModel& model = sensor_.model();
   confidence_.assess(particles_, estimate_,
-                     model.hitFraction(scan, estimate_.pose, params_.confidence.hit_distance),
+                     hitFraction(model, scans, estimate_.pose, params_.confidence.hit_distance),
                      params_.confidence);
-  gate_.recordFit(model, scan, estimate_.pose, params_);
+  gate_.recordFit(model, scans, estimate_.pose, params_);
   // Tempering and recovery follow the evidence of this scan (fitState());
   // only the published verdict waits for a jumped estimate to be confirmed.
   confidence_.holdAfterJump(predicted, estimate_.pose, params_.confidence);
 }
 
-void ParticleFilter::weigh(const PreparedScan& scan, UpdateReport* report) {
+void ParticleFilter::weigh(const std::vector<PreparedScan>& scans, UpdateReport* report) {
   const double ess_fraction =
       temperingEssFraction(confidence_.fitState(), confidence_.confidence(), params_);
   const Weighing w =
-      sensor_.weigh(scan, ess_fraction, params_.sensor.likelihood_exponent, &particles_);
+      sensor_.weigh(scans, ess_fraction, params_.sensor.likelihood_exponent, &particles_);
   report->tempering = w.tempering;
   report->beams_skipped = w.beams_skipped;
   report->mean_beam_likelihood = w.mean_beam_likelihood;

@@ -12,16 +12,22 @@ PreparedScan prepareScan(const LaserScan& scan, int max_beams, double range_min,
   PreparedScan out;
   out.range_max = range_max > 0.0 ? std::min(range_max, scan.range_max) : scan.range_max;
   out.dropped = static_cast<int>(scan.ranges.size() - valid);
-  out.sensor_x = scan.sensor_pose.x;
-  out.sensor_y = scan.sensor_pose.y;
+  out.weight = scan.weight;
+  // A scan of another sensor taken before the update: every beam from where
+  // the robot was then (scan_group.h).
+  const bool offset = !scan.robot_offset.isIdentity();
+  const Pose2 sensor = offset ? compose(scan.robot_offset, scan.sensor_pose) : scan.sensor_pose;
+  out.sensor_x = sensor.x;
+  out.sensor_y = sensor.y;
   out.x.reserve(beams.size());
   out.y.reserve(beams.size());
   out.range.reserve(beams.size());
   out.angle.reserve(beams.size());
   const bool skewed = !scan.sweep.isStill();
   for (const Beam& b : beams) {
-    const Pose2 from =
+    const Pose2 at_beam =
         skewed ? sensorPoseAtBeam(scan.sensor_pose, scan.sweep, b.index) : scan.sensor_pose;
+    const Pose2 from = offset ? compose(scan.robot_offset, at_beam) : at_beam;
     const Pose2 end =
         compose(from, {b.range * std::cos(b.bearing), b.range * std::sin(b.bearing), 0.0});
     // Ranges of 1e38 m pass the scan's own limits when range_max is absurd;
@@ -36,12 +42,12 @@ PreparedScan prepareScan(const LaserScan& scan, int max_beams, double range_min,
     if (skewed) {
       // The beam model casts every ray from the sensor's reference position:
       // the moved beam becomes the ray from there to its de-skewed end point.
-      const double dx = end.x - scan.sensor_pose.x, dy = end.y - scan.sensor_pose.y;
+      const double dx = end.x - sensor.x, dy = end.y - sensor.y;
       out.range.push_back(static_cast<float>(std::hypot(dx, dy)));
       out.angle.push_back(static_cast<float>(std::atan2(dy, dx)));
     } else {
       out.range.push_back(b.range);
-      out.angle.push_back(static_cast<float>(normalizeAngle(scan.sensor_pose.yaw + b.bearing)));
+      out.angle.push_back(static_cast<float>(normalizeAngle(sensor.yaw + b.bearing)));
     }
   }
   return out;

@@ -8,23 +8,47 @@ namespace pf {
 
 Weighing SensorUpdate::weigh(const PreparedScan& scan, double min_ess_fraction,
                              double likelihood_exponent, ParticleSet* particles) {
-  Weighing w;
   const std::size_t beams_counted = model_->logLikelihoods(scan, *particles, &log_likelihood_);
+  return finish(scan.size(), beams_counted, min_ess_fraction, likelihood_exponent, particles);
+}
+
+Weighing SensorUpdate::weigh(const std::vector<PreparedScan>& scans, double min_ess_fraction,
+                             double likelihood_exponent, ParticleSet* particles) {
+  if (scans.size() == 1) {
+    return weigh(scans.front(), min_ess_fraction, likelihood_exponent, particles);
+  }
+  log_likelihood_.assign(particles->size(), 0.0);
+  std::size_t beams = 0, beams_counted = 0;
+  for (const PreparedScan& scan : scans) {
+    beams += scan.size();
+    if (scan.size() == 0) continue;
+    beams_counted += model_->logLikelihoods(scan, *particles, &sensor_log_likelihood_);
+    for (std::size_t i = 0; i < log_likelihood_.size(); ++i) {
+      log_likelihood_[i] += scan.weight * sensor_log_likelihood_[i];
+    }
+  }
+  return finish(beams, beams_counted, min_ess_fraction, likelihood_exponent, particles);
+}
+
+Weighing SensorUpdate::finish(std::size_t beams, std::size_t beams_counted, double min_ess_fraction,
+                              double likelihood_exponent, ParticleSet* particles) {
+  Weighing w;
   w.tempering = applyLikelihood(log_likelihood_, min_ess_fraction, &particles->weight, &scratch_);
-  w.beams_skipped = static_cast<int>(scan.size() - beams_counted);
+  w.beams_skipped = static_cast<int>(beams - beams_counted);
   // The per-beam geometric mean is independent of the beam count, so
   // comparable across scans and robots. Weighted with the posterior, not the
   // prior, so that a few particles that found the robot count for what they
   // are worth, and a cloud salted with random particles is not judged by
   // them. Over the beams the model counted: beam skipping may leave some out.
-  const double beams =
+  const double counted =
       static_cast<double>(std::max<std::size_t>(beams_counted, 1)) * likelihood_exponent;
-  w.mean_beam_likelihood = meanBeamLikelihood(particles->weight, log_likelihood_, beams);
+  w.mean_beam_likelihood = meanBeamLikelihood(particles->weight, log_likelihood_, counted);
   return w;
 }
 
 void SensorUpdate::reserve(std::size_t n) {
-  for (std::vector<double>* v : {&scratch_.log_prior, &scratch_.log_posterior, &log_likelihood_}) {
+  for (std::vector<double>* v :
+       {&scratch_.log_prior, &scratch_.log_posterior, &log_likelihood_, &sensor_log_likelihood_}) {
     prefault(v, n);
   }
 }

@@ -15,13 +15,19 @@ GateDecision skipped(SkipReason reason, std::string detail = "") {
 
 }  // namespace
 
-GateDecision UpdateGate::decide(const Pose2& odom, const LaserScan& scan, const SensorModel* model,
+GateDecision UpdateGate::decide(const Pose2& odom, const ScanGroup& scans, const SensorModel* model,
                                 bool initialized, const Pose2& estimate, bool odometry_suspect,
                                 const ParticleFilterParams& params) {
   if (!model) return skipped(SkipReason::kNoMap);
   if (!initialized) return skipped(SkipReason::kNotInitialized);
   if (!odom.isFinite()) return skipped(SkipReason::kOdometryNotFinite);
-  if (auto error = validateScan(scan)) return skipped(SkipReason::kBadScan, std::move(*error));
+  if (scans.size() == 0) return skipped(SkipReason::kBadScan, "no scan");
+  for (std::size_t i = 0; i < scans.size(); ++i) {
+    if (auto error = validateScan(scans[i])) {
+      if (scans.size() > 1) *error = "scan " + std::to_string(i + 1) + " of the group: " + *error;
+      return skipped(SkipReason::kBadScan, std::move(*error));
+    }
+  }
 
   GateDecision d;
   const bool first = first_pending_ || !odom_at_update_;
@@ -46,18 +52,20 @@ GateDecision UpdateGate::decide(const Pose2& odom, const LaserScan& scan, const 
     // update_min_d.
     if (!force_ && !odometry_suspect && d.step < params.update_min_d &&
         std::fabs(delta.yaw) < params.update_min_a) {
-      d.scan = fitDropped(*model, scan, estimate, delta, params);
-      if (!d.scan) return skipped(SkipReason::kNotMoved);
+      d.scans = fitDropped(*model, scans, estimate, delta, params);
+      if (!d.scans) return skipped(SkipReason::kNotMoved);
       d.fit_dropped = true;
     }
   }
-  if (!d.scan) d.scan = model->prepare(scan);
-  if (d.scan->size() == 0) {
+  if (!d.scans) d.scans = prepareScans(*model, scans);
+  if (beamCount(*d.scans) == 0) {
     // Without evidence the cloud would only be moved; the odometry reference
     // stays, so the motion is applied once a usable scan comes.
     d.skip = SkipReason::kNoValidBeam;
-    d.detail = std::to_string(d.scan->dropped) + " of " + std::to_string(scan.ranges.size()) +
-               " beams invalid";
+    std::size_t ranges = 0;
+    for (const LaserScan& scan : scans) ranges += scan.ranges.size();
+    d.detail =
+        std::to_string(droppedBeams(*d.scans)) + " of " + std::to_string(ranges) + " beams invalid";
     d.fit_dropped = false;
     return d;
   }
@@ -68,21 +76,21 @@ GateDecision UpdateGate::decide(const Pose2& odom, const LaserScan& scan, const 
   return d;
 }
 
-void UpdateGate::recordFit(const SensorModel& model, const PreparedScan& scan,
+void UpdateGate::recordFit(const SensorModel& model, const std::vector<PreparedScan>& scans,
                            const Pose2& estimate, const ParticleFilterParams& params) {
   fit_at_update_ = params.update_fit_drop > 0.0
-                       ? model.hitFraction(scan, estimate, params.update_fit_distance)
+                       ? hitFraction(model, scans, estimate, params.update_fit_distance)
                        : 0.0;
 }
 
-std::optional<PreparedScan> UpdateGate::fitDropped(const SensorModel& model, const LaserScan& scan,
-                                                   const Pose2& estimate, const Pose2& since_update,
-                                                   const ParticleFilterParams& params) const {
+std::optional<std::vector<PreparedScan>> UpdateGate::fitDropped(
+    const SensorModel& model, const ScanGroup& scans, const Pose2& estimate,
+    const Pose2& since_update, const ParticleFilterParams& params) const {
   if (!(params.update_fit_drop > 0.0)) return std::nullopt;
-  PreparedScan prepared = model.prepare(scan);
-  if (prepared.size() == 0) return std::nullopt;
+  std::vector<PreparedScan> prepared = prepareScans(model, scans);
+  if (beamCount(prepared) == 0) return std::nullopt;
   const Pose2 predicted = compose(estimate, since_update);
-  const double fit = model.hitFraction(prepared, predicted, params.update_fit_distance);
+  const double fit = hitFraction(model, prepared, predicted, params.update_fit_distance);
   if (fit >= fit_at_update_ - params.update_fit_drop) return std::nullopt;
   return prepared;
 }

@@ -16,10 +16,10 @@
 #include <optional>
 
 #include "pf_localization/core/confidence.h"
-#include "pf_localization/core/laser_scan.h"
 #include "pf_localization/core/particle_filter_params.h"
 #include "pf_localization/core/pose2.h"
 #include "pf_localization/core/pose_estimator.h"
+#include "pf_localization/core/scan_group.h"
 #include "pf_localization/core/scan_refiner.h"
 #include "pf_localization/core/sensor_model.h"
 
@@ -53,7 +53,7 @@ class EstimateRefinement {
   /// `predicted` lies elsewhere within the cloud's spread (chi-square, 3 dof,
   /// 99.9 %), the scan is fitted from there too, and the fit whose end
   /// points lie better on the map (ScanRefinement::scan_cost) is taken.
-  ScanRefinement atUpdate(const SensorModel& model, const LaserScan& scan, const Pose2& odom,
+  ScanRefinement atUpdate(const SensorModel& model, const ScanGroup& scans, const Pose2& odom,
                           const std::optional<Pose2>& predicted, LocalizationState state,
                           const ParticleFilterParams& params, PoseEstimate* estimate);
 
@@ -61,7 +61,7 @@ class EstimateRefinement {
   /// `estimate` at `odom_at_update`: fits the scan from where the odometry
   /// puts that estimate now, the heaviest cluster's covariance as the prior.
   /// An accepted fit becomes the map -> odom; a rejected one leaves the last.
-  ScanRefinement betweenUpdates(const SensorModel& model, const LaserScan& scan, const Pose2& odom,
+  ScanRefinement betweenUpdates(const SensorModel& model, const ScanGroup& scans, const Pose2& odom,
                                 const Pose2& odom_at_update, const PoseEstimate& estimate,
                                 LocalizationState state, const ParticleFilterParams& params);
 

@@ -19,12 +19,19 @@ struct LaserScan {
   double range_max = 0.0;        // m
   Pose2 sensor_pose;             // the laser frame in the robot's base frame
   SweepMotion sweep;             // when each beam was taken (default: all at once)
+  // The robot's pose at this scan's stamp in its frame at the update that
+  // uses it: the identity, but for the earlier scans of other sensors in a
+  // group (scan_group.h), whose beams start where their sensor was then.
+  Pose2 robot_offset;
+  // How much this sensor's evidence counts: its log-likelihood is multiplied
+  // by it. 1, but for a sensor known to be worse than the others. (0, 1]
+  double weight = 1.0;
 };
 
 /// Why a scan cannot be used at all (as opposed to single bad beams, which are
 /// dropped quietly): an empty range array, a zero or non-finite angle
-/// increment, non-finite angles, range_max <= range_min, or a non-finite
-/// sensor pose or sweep. Empty when the scan is usable.
+/// increment, non-finite angles, range_max <= range_min, a non-finite
+/// sensor pose, robot offset or sweep, or a weight outside (0, 1]. Empty when the scan is usable.
 std::optional<std::string> validateScan(const LaserScan& scan);
 
 /// One usable beam: its measured range, its bearing in the sensor frame and

@@ -115,11 +115,13 @@ class ParticleFilter {
   void initializeUniform();
   bool isInitialized() const { return !particles_.empty(); }
 
-  /// Feeds the odometry pose at the scan's time and the scan. Runs a filter
+  /// Feeds the odometry pose at the scan's time and the scan, or the scans
+  /// of several sensors placed on the robot at that time (scan_group.h).
+  /// Runs a filter
   /// update when the robot moved enough, when the scan stopped fitting the
   /// pose the odometry predicts (update_fit_drop), on the first scan after
   /// an initialisation, or after requestNoMotionUpdate().
-  UpdateReport update(const Pose2& odom, const LaserScan& scan);
+  UpdateReport update(const Pose2& odom, const ScanGroup& scans);
 
   /// The next update() runs even without motion.
   void requestNoMotionUpdate() { gate_.requestUpdate(); }
@@ -138,10 +140,11 @@ class ParticleFilter {
   std::optional<Pose2> mapToOdom() const;
 
  private:
-  void weigh(const PreparedScan& scan, UpdateReport* report);
+  void weigh(const std::vector<PreparedScan>& scans, UpdateReport* report);
   // The estimate of the weighted cloud and the verdict on it; `predicted`:
   // the last estimate moved by the odometry since (none on a first update).
-  void estimateAndJudge(const PreparedScan& scan, const std::optional<Pose2>& predicted);
+  void estimateAndJudge(const std::vector<PreparedScan>& scans,
+                        const std::optional<Pose2>& predicted);
   void resample(UpdateReport* report);
   void restartAfterInitialization();
   void reserveStorage(std::size_t max_particles);

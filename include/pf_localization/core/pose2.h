@@ -33,6 +33,7 @@ struct Pose2 {
   double yaw = 0.0;
 
   bool isFinite() const { return std::isfinite(x) && std::isfinite(y) && std::isfinite(yaw); }
+  bool isIdentity() const { return x == 0.0 && y == 0.0 && yaw == 0.0; }
 };
 
 /// a (+) b: the pose b, given in frame a, expressed in a's parent frame.

@@ -29,6 +29,7 @@ struct PreparedScan {
   double sensor_x = 0.0;     // m, where the beams start, in the robot frame
   double sensor_y = 0.0;     // m
   double range_max = 0.0;    // the range_max that scales z_rand
+  double weight = 1.0;       // LaserScan::weight: the log-likelihood's factor
   int dropped = 0;           // invalid beams dropped before subsampling
   std::size_t size() const { return x.size(); }
 };

@@ -39,13 +39,23 @@ class SensorUpdate {
   /// model's: the mean beam likelihood undoes it. Precondition: hasModel().
   Weighing weigh(const PreparedScan& scan, double min_ess_fraction, double likelihood_exponent,
                  ParticleSet* particles);
+  /// The same for the scans of several sensors (scan_group.h): their
+  /// log-likelihoods, each times its PreparedScan::weight, add up. One scan
+  /// weighs exactly as weigh() does.
+  Weighing weigh(const std::vector<PreparedScan>& scans, double min_ess_fraction,
+                 double likelihood_exponent, ParticleSet* particles);
 
   /// Prefaults the scratch for `n` particles.
   void reserve(std::size_t n);
 
  private:
+  // Tempers and normalises log_likelihood_ into the weights; the report.
+  Weighing finish(std::size_t beams, std::size_t beams_counted, double min_ess_fraction,
+                  double likelihood_exponent, ParticleSet* particles);
+
   std::unique_ptr<SensorModel> model_;
   std::vector<double> log_likelihood_;
+  std::vector<double> sensor_log_likelihood_;  // one sensor's, while a group is summed
   WeightingScratch scratch_;
 };
 

@@ -22,6 +22,7 @@
 #include "pf_localization/core/laser_scan.h"
 #include "pf_localization/core/particle_filter_params.h"
 #include "pf_localization/core/pose2.h"
+#include "pf_localization/core/scan_group.h"
 #include "pf_localization/core/sensor_model.h"
 #include "pf_localization/core/skip_reason.h"
 
@@ -36,9 +37,9 @@ struct GateDecision {
   std::optional<Pose2> from;
   double step = 0.0;         // m of odometry travelled since the last update
   bool fit_dropped = false;  // runs before the thresholds: the scan stopped fitting
-  // The scan, prepared by the sensor model: when the update runs, and for
+  // The scans, prepared by the sensor model: when the update runs, and for
   // kNoValidBeam (to count the dropped beams).
-  std::optional<PreparedScan> scan;
+  std::optional<std::vector<PreparedScan>> scans;
 
   bool runs() const { return skip == SkipReason::kNone; }
 };
@@ -51,20 +52,21 @@ class UpdateGate {
   /// The next scan that passes the input checks runs an update, moved or not.
   void requestUpdate() { force_ = true; }
 
-  /// Decides on one scan. `model` is null without a map; `estimate` is the
+  /// Decides on the scans of one update (one per sensor; one for most
+  /// robots). `model` is null without a map; `estimate` is the
   /// last update's, where the fit-drop check predicts the robot from; and
   /// `odometry_suspect` says the faulty particles win (every scan updates).
   /// When the update runs, the gate takes `odom` as the last update's
   /// odometry (and forgets a requested update); on an odometry jump too.
-  GateDecision decide(const Pose2& odom, const LaserScan& scan, const SensorModel* model,
+  GateDecision decide(const Pose2& odom, const ScanGroup& scans, const SensorModel* model,
                       bool initialized, const Pose2& estimate, bool odometry_suspect,
                       const ParticleFilterParams& params);
 
-  /// Records how well the update's scan fits its estimate: the share of the
+  /// Records how well the update's scans fit its estimate: the share of the
   /// beams ending within update_fit_distance of an obstacle, the reference
   /// of the fit-drop check.
-  void recordFit(const SensorModel& model, const PreparedScan& scan, const Pose2& estimate,
-                 const ParticleFilterParams& params);
+  void recordFit(const SensorModel& model, const std::vector<PreparedScan>& scans,
+                 const Pose2& estimate, const ParticleFilterParams& params);
 
   /// Whether an update ran since the last initialisation (restart()).
   bool hasUpdated() const { return !first_pending_ && odom_at_update_.has_value(); }
@@ -72,12 +74,13 @@ class UpdateGate {
   const std::optional<Pose2>& odomAtUpdate() const { return odom_at_update_; }
 
  private:
-  // The scan, prepared, when it fits the pose predicted `since_update` after
-  // `estimate` clearly worse than the last update's scan fitted its
+  // The scans, prepared, when they fit the pose predicted `since_update`
+  // after `estimate` clearly worse than the last update's scans fitted its
   // estimate; nothing otherwise.
-  std::optional<PreparedScan> fitDropped(const SensorModel& model, const LaserScan& scan,
-                                         const Pose2& estimate, const Pose2& since_update,
-                                         const ParticleFilterParams& params) const;
+  std::optional<std::vector<PreparedScan>> fitDropped(const SensorModel& model,
+                                                      const ScanGroup& scans, const Pose2& estimate,
+                                                      const Pose2& since_update,
+                                                      const ParticleFilterParams& params) const;
 
   std::optional<Pose2> odom_at_update_;
   bool first_pending_ = false;
