@@ -56,8 +56,8 @@ TEST_F(UpdateGateTest, TheFirstScanRunsWithoutMotionThenOnlyAfterMotion) {
   GateDecision d = decide(odom0, kTruth);
   ASSERT_TRUE(d.runs()) << toString(d.skip);
   EXPECT_FALSE(d.from.has_value());
-  ASSERT_TRUE(d.scan.has_value());
-  EXPECT_GT(d.scan->size(), 0u);
+  ASSERT_TRUE(d.scans.has_value());
+  EXPECT_GT(beamCount(*d.scans), 0u);
   EXPECT_TRUE(gate_.hasUpdated());
 
   EXPECT_EQ(SkipReason::kNotMoved, decide(odom0, kTruth).skip);
@@ -104,8 +104,8 @@ TEST_F(UpdateGateTest, AScanWithoutValidBeamKeepsTheReference) {
   const Pose2 moved = compose(odom, {0.5, 0.0, 0.0});
   const GateDecision d = gate_.decide(moved, blind, &model_, true, kTruth, false, params_);
   EXPECT_EQ(SkipReason::kNoValidBeam, d.skip);
-  ASSERT_TRUE(d.scan.has_value());
-  EXPECT_EQ(180, d.scan->dropped);
+  ASSERT_TRUE(d.scans.has_value());
+  EXPECT_EQ(180, droppedBeams(*d.scans));
   EXPECT_EQ(odom.x, gate_.odomAtUpdate()->x);
   // The motion is applied with the next usable scan, from the old reference.
   const GateDecision next = decide(moved, kTruth);
@@ -118,7 +118,7 @@ TEST_F(UpdateGateTest, AScanThatStopsFittingRunsBeforeTheThresholds) {
   const Pose2 odom{1.0, 2.0, 0.0};
   ASSERT_TRUE(decide(odom, kTruth).runs());
   const LaserScan at_truth = castScan(grid_, kTruth);
-  gate_.recordFit(model_, model_.prepare(at_truth), kTruth, params_);
+  gate_.recordFit(model_, {model_.prepare(at_truth)}, kTruth, params_);
   // 5 cm of odometry, and the scan still fits the predicted pose: waits.
   const Pose2 step{0.05, 0.0, 0.0};
   EXPECT_EQ(SkipReason::kNotMoved,
