@@ -169,12 +169,11 @@ TEST(SelectBeams, DropsEveryKindOfInvalidRange) {
   scan.ranges = {kNaN, kInf, -kInf, 0.0f, -2.0f, 0.25f, 0.5f, 8.0f, 9.0f, 7.5f};
   std::size_t valid = 0;
   const std::vector<Beam> beams = selectBeams(scan, 0, 0.0, 0.0, &valid);
-  EXPECT_EQ(2u, valid);
-  ASSERT_EQ(2u, beams.size());
-  EXPECT_EQ(0.5f, beams[0].range);  // range_min itself is a reading
-  EXPECT_FLOAT_EQ(0.6f, beams[0].bearing);
-  EXPECT_EQ(7.5f, beams[1].range);
-  EXPECT_FLOAT_EQ(0.9f, beams[1].bearing);
+  // range_min itself is a driver's "too close", as amcl takes it.
+  EXPECT_EQ(1u, valid);
+  ASSERT_EQ(1u, beams.size());
+  EXPECT_EQ(7.5f, beams[0].range);
+  EXPECT_FLOAT_EQ(0.9f, beams[0].bearing);
 }
 
 TEST(SelectBeams, AllInvalidGivesNothing) {
@@ -203,9 +202,9 @@ TEST(SelectBeams, RangeOverridesOnlyNarrowTheScanLimits) {
     for (const Beam& b : selectBeams(scan, 0, lo, hi)) out.push_back(b.range);
     return out;
   };
-  EXPECT_EQ((std::vector<float>{3, 4, 5, 6}), ranges(2.5, 0.0));     // tighter minimum
-  EXPECT_EQ((std::vector<float>{2, 3, 4, 5, 6}), ranges(2.0, 0.0));  // 2.0 itself kept
-  EXPECT_EQ((std::vector<float>{1, 2, 3, 4}), ranges(0.0, 5.0));     // 5.0 is at the max
+  EXPECT_EQ((std::vector<float>{3, 4, 5, 6}), ranges(2.5, 0.0));  // tighter minimum
+  EXPECT_EQ((std::vector<float>{3, 4, 5, 6}), ranges(2.0, 0.0));  // 2.0 itself is "too close"
+  EXPECT_EQ((std::vector<float>{1, 2, 3, 4}), ranges(0.0, 5.0));  // 5.0 is at the max
   EXPECT_EQ((std::vector<float>{3, 4}), ranges(2.5, 4.5));
   // Looser than the scan's: the scan's own limits stay.
   LaserScan narrow = scan;

@@ -44,7 +44,7 @@ struct Beam {
 
 /// The usable beams of a scan, evenly subsampled to at most `max_beams`.
 ///
-/// Invalid beams (NaN, inf, <= 0, below range_min, at or above range_max) are
+/// Invalid beams (NaN, inf, <= 0, at or below range_min, at or above range_max) are
 /// dropped *before* subsampling: on a Neato a third of the beams can be
 /// dropouts, and subsampling first would waste the beam budget on them.
 /// `range_min`/`range_max` narrow the scan's own limits when they are tighter
