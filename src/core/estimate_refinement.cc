@@ -49,6 +49,15 @@ bool sameBasin(const Pose2& a, const Pose2& b) {
   return std::hypot(a.x - b.x, a.y - b.y) < 0.1 && std::fabs(angleDiff(a.yaw, b.yaw)) < 0.05;
 }
 
+// Each scan's share of the fit's beam budget `max_beams` (<= 0: all): the
+// fit's cost grows with its beams, and every sensor's end points lie on the
+// same map, so several sensors share one budget.
+int shareOf(int max_beams, const ScanGroup& scans) {
+  if (max_beams <= 0 || scans.size() <= 1) return max_beams;
+  const int n = static_cast<int>(scans.size());
+  return (max_beams + n - 1) / n;
+}
+
 }  // namespace
 
 ScanRefinement EstimateRefinement::atUpdate(const SensorModel& model, const ScanGroup& scans,
@@ -86,7 +95,7 @@ ScanRefinement EstimateRefinement::atUpdate(const SensorModel& model, const Scan
   }
   const ScanRefiner refiner(model.field(), params.refiner);
   const PreparedScan prepared =
-      joinedEndPoints(prepareScans(model, scans, params.refiner.max_beams));
+      joinedEndPoints(prepareScans(model, scans, shareOf(params.refiner.max_beams, scans)));
   r = refiner.refine(prepared, start, estimate->covariance);
   // The cloud's mean can sit on a wrong door pattern while the odometry's
   // prediction is where the robot is: fitted from both, the scan decides.
@@ -131,9 +140,9 @@ ScanRefinement EstimateRefinement::betweenUpdates(const SensorModel& model, cons
       estimate.clusters.empty() ? std::nullopt
                                 : std::optional<Eigen::Matrix3d>(estimate.clusters[0].covariance);
   r = ScanRefiner(model.field(), params.refiner)
-          .refine(
-              joinedEndPoints(prepareScans(model, scans, params.refiner.max_beams_between_updates)),
-              predicted, prior);
+          .refine(joinedEndPoints(prepareScans(
+                      model, scans, shareOf(params.refiner.max_beams_between_updates, scans))),
+                  predicted, prior);
   if (r.accepted) refined_ = Fit{compose(r.pose, inverse(odom)), odom_at_update, odom};
   return r;
 }
