@@ -17,6 +17,7 @@
 #include <tf2_msgs/TFMessage.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <ctime>
 #include <deque>
@@ -44,7 +45,8 @@ constexpr char kUsage[] =
     "         [--initial-pose X Y YAW]   start here (global localization without it)\n"
     "         [--particles N]            maximum particle count\n"
     "         [--max-beams B] [--seed S] [--params FILE.yaml]\n"
-    "         [--scan-topic /scan] [--odom-topic /odom]\n"
+    "         [--scan-topic /scan]...        once per lidar: several are fused\n"
+    "         [--odom-topic /odom]\n"
     "         [--log UPDATES.csv]        one line per filter update\n"
     "         [--particles-out P.csv]    every particle of every update in the first 30 s\n"
     "         [--covariance COV.csv]     t,xx,xy,yy,yawyaw,xyaw,yyaw: pf_pose's covariance\n"
@@ -58,7 +60,8 @@ constexpr double kParticleDumpSeconds = 30.0;
 
 struct Options {
   std::string bag, map, out, params, log, particles_out, covariance;
-  std::string scan_topic = "/scan", odom_topic = "/odom";
+  std::vector<std::string> scan_topics;  // empty: /scan
+  std::string odom_topic = "/odom";
   std::optional<pf::Pose2> initial_pose;
   int particles = 0, max_beams = 0;
   long seed = -1;
@@ -81,6 +84,7 @@ double number(const std::string& flag, const char* text) {
 
 Options parse(int argc, char** argv) {
   Options o;
+
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     auto value = [&](int k = 1) -> const char* {
@@ -102,7 +106,7 @@ Options parse(int argc, char** argv) {
     else if (a == "--covariance")
       o.covariance = value(), ++i;
     else if (a == "--scan-topic")
-      o.scan_topic = value(), ++i;
+      o.scan_topics.push_back(value()), ++i;
     else if (a == "--odom-topic")
       o.odom_topic = value(), ++i;
     else if (a == "--particles")
@@ -123,6 +127,7 @@ Options parse(int argc, char** argv) {
   }
   if (o.bag.empty() || o.map.empty() || o.out.empty())
     fail(std::string("--bag, --map and --out are required\n") + kUsage);
+  if (o.scan_topics.empty()) o.scan_topics.push_back("/scan");
   return o;
 }
 
@@ -184,7 +189,9 @@ void openBag(const Options& opt, rosbag::Bag* bag) {
   rosbag::View all(*bag);
   std::set<std::string> topics;
   for (const rosbag::ConnectionInfo* c : all.getConnections()) topics.insert(c->topic);
-  for (const std::string& needed : {opt.scan_topic, std::string("/tf")}) {
+  std::vector<std::string> needed_topics = opt.scan_topics;
+  needed_topics.push_back("/tf");
+  for (const std::string& needed : needed_topics) {
     if (!topics.count(needed)) {
       std::string have;
       for (const auto& t : topics) have += " " + t;
@@ -270,10 +277,16 @@ class Replay {
 
   void run(const rosbag::Bag& bag);
   const RunCounts& counts() const { return counts_; }
+  // What the replay reads: the scans, the odometry and tf.
+  std::vector<std::string> topics() const {
+    std::vector<std::string> t = opt_.scan_topics;
+    t.insert(t.end(), {opt_.odom_topic, "/tf", "/tf_static"});
+    return t;
+  }
 
  private:
   void handle(const rosbag::MessageInstance& m);
-  void process(const sensor_msgs::LaserScan& scan);
+  void process(const sensor_msgs::LaserScan& scan, std::size_t sensor);
   void logUpdate(double t, const pf_ros::ScanResult& r, double cpu);
   void dumpParticles(double t);
   void writeCovariance(double t);
@@ -284,7 +297,8 @@ class Replay {
   tf2::BufferCore& tf_;
   pf_ros::ScanLocalizer& localizer_;
   Outputs& outputs_;
-  std::deque<sensor_msgs::LaserScan::ConstPtr> pending_;
+  // The scans waiting for their odometry, with their sensor (--scan-topic's index).
+  std::deque<std::pair<sensor_msgs::LaserScan::ConstPtr, std::size_t>> pending_;
   // What pf_node last published on pf_pose (it publishes at each update).
   std::optional<geometry_msgs::PoseWithCovarianceStamped> published_;
   RunCounts counts_;
@@ -292,8 +306,7 @@ class Replay {
 };
 
 void Replay::run(const rosbag::Bag& bag) {
-  rosbag::View view(bag,
-                    rosbag::TopicQuery({opt_.scan_topic, opt_.odom_topic, "/tf", "/tf_static"}));
+  rosbag::View view(bag, rosbag::TopicQuery(topics()));
   const double t_begin = view.getBeginTime().toSec(), t_end = view.getEndTime().toSec();
   ProgressBar progress(!opt_.quiet);
   // pf_node publishes the estimate once it has the map, as the filter starts.
@@ -305,14 +318,14 @@ void Replay::run(const rosbag::Bag& bag) {
       // A scan is used once odometry reaches its stamp, as pf_node's tf
       // message filter would, or when it has waited too long.
       while (!pending_.empty()) {
-        const auto& s = pending_.front();
+        const auto& s = pending_.front().first;
         const bool ready =
             tf_.canTransform(config_.odom_frame, config_.base_frame, s->header.stamp) &&
             tf_.canTransform(config_.base_frame, s->header.frame_id, ros::Time(0));
         if (!ready && now - s->header.stamp.toSec() < kMaxTfWait) {
           break;
         }
-        process(*s);
+        process(*s, pending_.front().second);
         pending_.pop_front();
       }
       progress.show((now - t_begin) / std::max(1e-9, t_end - t_begin), now - t_begin);
@@ -320,7 +333,7 @@ void Replay::run(const rosbag::Bag& bag) {
   } catch (const rosbag::BagException& e) {
     fail(opt_.bag + ": error while reading: " + e.what());
   }
-  for (const auto& s : pending_) process(*s);
+  for (const auto& [s, sensor] : pending_) process(*s, sensor);
   progress.done();
 }
 
@@ -335,14 +348,16 @@ void Replay::handle(const rosbag::MessageInstance& m) {
     const auto odom = m.instantiate<nav_msgs::Odometry>();
     if (odom && !odom_on_tf_) tf_.setTransform(pf_ros::odometryToTransform(*odom), "odom_topic");
   } else if (const auto scan = m.instantiate<sensor_msgs::LaserScan>()) {
+    const auto topic = std::find(opt_.scan_topics.begin(), opt_.scan_topics.end(), m.getTopic());
+    if (topic == opt_.scan_topics.end()) return;
     ++counts_.scans;
-    pending_.push_back(scan);
+    pending_.emplace_back(scan, static_cast<std::size_t>(topic - opt_.scan_topics.begin()));
   }
 }
 
-void Replay::process(const sensor_msgs::LaserScan& scan) {
+void Replay::process(const sensor_msgs::LaserScan& scan, std::size_t sensor) {
   const double cpu0 = threadCpuSeconds();
-  const pf_ros::ScanResult r = localizer_.processScan(scan);
+  const pf_ros::ScanResult r = localizer_.processScan(scan, sensor);
   const double cpu = threadCpuSeconds() - cpu0;
   counts_.cpu_total += cpu;
   const double t = scan.header.stamp.toSec();
@@ -423,7 +438,7 @@ void summarize(const Options& opt, const RunCounts& c) {
   for (const auto& e : c.errors) {
     std::cerr << "pf_bag_runner: " << e.second << " scans not used: " << e.first << "\n";
   }
-  if (c.scans == 0) fail(opt.bag + ": no scans on " + opt.scan_topic);
+  if (c.scans == 0) fail(opt.bag + ": no scans on " + opt.scan_topics.front());
   if (c.written == 0) fail("no pose could be estimated (see the warnings above)", 3);
 }
 

@@ -129,7 +129,7 @@ std::string ScanLocalizer::restart() {
   return "";
 }
 
-ScanResult ScanLocalizer::processScan(const sensor_msgs::LaserScan& scan) {
+ScanResult ScanLocalizer::processScan(const sensor_msgs::LaserScan& scan, std::size_t sensor) {
   ScanResult result;
   if (!filter_.hasMap()) {
     result.error = ScanError::kNoMap;
@@ -165,9 +165,26 @@ ScanResult ScanLocalizer::processScan(const sensor_msgs::LaserScan& scan) {
   }
   result.warning = scanInconsistency(scan);
   result.odom = toPose2(odom.transform);
-  pf::LaserScan core_scan = toCore(scan, toPose2(laser.transform));
-  core_scan.sweep = sweepMotion(scan, *tf_, config_, *result.odom);
-  result.report = filter_.update(*result.odom, core_scan);
+  group_.clear();
+  group_.push_back(toCore(scan, toPose2(laser.transform)));
+  group_.front().sweep = sweepMotion(scan, *tf_, config_, *result.odom);
+  if (latest_.size() <= sensor) latest_.resize(sensor + 1);
+  // The other sensors' latest scans since the last update, each where the
+  // robot was at its stamp.
+  for (std::size_t other = 0; other < latest_.size(); ++other) {
+    const std::optional<SensorScan>& s = latest_[other];
+    if (other == sensor || !s || s->used) continue;
+    if (std::fabs((scan.header.stamp - s->stamp).toSec()) > kMaxSensorScanAge) continue;
+    group_.push_back(s->scan);
+    group_.back().robot_offset = pf::between(*result.odom, s->odom);
+  }
+  result.report = filter_.update(*result.odom, group_);
+  latest_[sensor] = SensorScan{std::move(group_.front()), *result.odom, scan.header.stamp, false};
+  if (result.report.updated) {
+    for (std::optional<SensorScan>& s : latest_) {
+      if (s) s->used = true;
+    }
+  }
   return result;
 }
 

@@ -338,5 +338,56 @@ TEST_F(ScanLocalizerTest, DeskewingRemovesTheSpinsYawBias) {
   EXPECT_LT(std::fabs(deskewed), 0.02);
 }
 
+// Two lidars: the update on one sensor's scan takes the other's latest scan
+// since the last update, where the robot was when it was taken; not one an
+// update took already, nor one older than kMaxSensorScanAge.
+TEST_F(ScanLocalizerTest, AnUpdateTakesTheOtherSensorsLatestScan) {
+  const pf::Pose2 rear_mount{-0.2, 0.1, M_PI / 2};
+  tf_.setTransform(transform("base_link", "rear_laser", rear_mount, ros::Time(0)), "test", true);
+  pf::test::ScanSimulator rear{grid_, laserSpec(rear_mount)};
+  config_.filter.update_min_d = 0.1;
+  config_.filter.update_min_a = 1.0;
+  config_.initial_pose = pf::Pose2{0.98, 1.0, 0.0};
+  config_.initial_cov = Eigen::Vector3d(0.0025, 0.0025, 0.001).asDiagonal();
+  ScanLocalizer localizer(config_, &tf_);
+  ASSERT_EQ(localizer.setMap(map_), "");
+  // The robot drives along x; the odometry is the truth.
+  auto at = [&](double x, double t) {
+    const pf::Pose2 pose{x, 1.0, 0.0};
+    tf_.setTransform(transform("odom", "base_link", pose, ros::Time(t)), "test");
+    tf_.setTransform(transform("odom", "base_link", pose, ros::Time(t + 0.01)), "test");
+    return pose;
+  };
+  auto rearScan = [&](double x, double t) {
+    sensor_msgs::LaserScan msg = scanMsg(rear.scanFrom(at(x, t)), ros::Time(t));
+    msg.header.frame_id = "rear_laser";
+    return localizer.processScan(msg, 1);
+  };
+  auto frontScan = [&](double x, double t) {
+    return localizer.processScan(scanMsg(scans_.scanFrom(at(x, t)), ros::Time(t)), 0);
+  };
+  const ScanResult first = rearScan(0.98, 10.0);  // the first update after the initialisation
+  ASSERT_TRUE(first.report.updated) << pf::skipMessage(first.report);
+  const int one_scan = first.report.beams_used;
+  EXPECT_FALSE(frontScan(1.0, 10.04).report.updated);  // 2 cm: not moved enough
+  EXPECT_FALSE(rearScan(1.06, 10.1).report.updated);
+  // 12 cm: the update takes the front scan and the rear one of 50 ms before.
+  const ScanResult both = frontScan(1.1, 10.15);
+  ASSERT_TRUE(both.report.updated) << pf::skipMessage(both.report);
+  EXPECT_EQ(2 * one_scan, both.report.beams_used);
+  EXPECT_LT(std::hypot(localizer.filter().estimate().pose.x - 1.1,
+                       localizer.filter().estimate().pose.y - 1.0),
+            0.02);
+  // Both were used: the next update on a front scan comes alone.
+  const ScanResult after = frontScan(1.22, 10.3);
+  ASSERT_TRUE(after.report.updated) << pf::skipMessage(after.report);
+  EXPECT_EQ(one_scan, after.report.beams_used);
+  // A rear scan older than kMaxSensorScanAge is left out.
+  EXPECT_FALSE(rearScan(1.25, 10.35).report.updated);
+  const ScanResult stale = frontScan(1.35, 10.35 + kMaxSensorScanAge + 0.05);
+  ASSERT_TRUE(stale.report.updated) << pf::skipMessage(stale.report);
+  EXPECT_EQ(one_scan, stale.report.beams_used);
+}
+
 }  // namespace
 }  // namespace pf_ros

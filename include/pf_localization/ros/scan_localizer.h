@@ -15,6 +15,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "pf_localization/core/particle_filter.h"
 #include "pf_localization/ros/localizer_config.h"
@@ -76,9 +77,14 @@ class ScanLocalizer {
   /// message (empty on success); on error nothing changed.
   std::string reconfigure(const LocalizerConfig& config);
 
-  /// Uses one scan: odometry and laser pose from tf at the scan's stamp (and,
-  /// to de-skew it, the odometry one sweep earlier), then the filter update.
-  ScanResult processScan(const sensor_msgs::LaserScan& scan);
+  /// Uses one scan of sensor `sensor` (0 for the only one; an index per scan
+  /// topic): odometry and laser pose from tf at the scan's stamp (and, to
+  /// de-skew it, the odometry one sweep earlier), then the filter update.
+  /// With several sensors the update also takes the latest scan of each
+  /// other sensor that arrived since the last update and is at most
+  /// kMaxSensorScanAge older, placed where the robot was at its stamp by the
+  /// odometry (core/scan_group.h): two half views score as one full view.
+  ScanResult processScan(const sensor_msgs::LaserScan& scan, std::size_t sensor = 0);
 
   /// map -> odom to publish, stamped `stamp` (the caller adds transform_tolerance).
   std::optional<geometry_msgs::TransformStamped> mapToOdom(const ros::Time& stamp) const;
@@ -91,13 +97,28 @@ class ScanLocalizer {
   geometry_msgs::PoseArray particleCloud(const ros::Time& stamp, std::size_t max_poses) const;
 
  private:
+  // A sensor's latest scan, as the filter takes it, and the odometry at its stamp.
+  struct SensorScan {
+    pf::LaserScan scan;
+    pf::Pose2 odom;
+    ros::Time stamp;
+    bool used = false;  // by an update already: the next one does not take it again
+  };
+
   LocalizerConfig config_;
   const std::optional<pf::Pose2> configured_pose_;
   const Eigen::Matrix3d configured_cov_;
   const tf2::BufferCore* tf_;
   pf::ParticleFilter filter_;
   bool had_map_ = false;
+  std::vector<std::optional<SensorScan>> latest_;  // per sensor
+  std::vector<pf::LaserScan> group_;               // the scans of the current update
 };
+
+/// s: a scan of another sensor older than this is not used (a sensor that
+/// fell silent). The odometry carries it over that time to within
+/// millimetres; two of the slowest lidars' periods (5 Hz) still fit.
+constexpr double kMaxSensorScanAge = 0.5;
 
 /// The log line for a scan that was not used: the error and its detail.
 std::string errorMessage(const ScanResult& result);
