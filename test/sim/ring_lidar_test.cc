@@ -11,21 +11,13 @@
 #include "pf_localization/sim/amr_rig.h"
 #include "pf_localization/sim/building_clutter.h"
 #include "pf_localization/sim/building_map.h"
+#include "support/rooms.h"
 
 namespace pf::sim {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
 constexpr double kInf = std::numeric_limits<double>::infinity();
-
-OccupancyGrid room(bool walls = true) {
-  const int n = 200;
-  std::vector<int8_t> data(n * n, 0);
-  for (int i = 0; walls && i < n; ++i) {
-    data[i] = data[(n - 1) * n + i] = data[i * n] = data[i * n + n - 1] = 100;
-  }
-  return OccupancyGrid(n, n, 0.05, {}, data);
-}
 
 RingLidar noiseless() {
   RingLidar l = amrRingLidar({100'000'000, 0});
@@ -52,7 +44,7 @@ TEST(RingLidarTest, SixteenRingsOf1800ColumnsInOrder) {
   EXPECT_NEAR(l.elevation(1), -13 * kDeg, 1e-12);
   EXPECT_NEAR(l.elevation(15), 15 * kDeg, 1e-12);
   EXPECT_NEAR(l.azimuth(1), 0.2 * kDeg, 1e-15);
-  const Scene3D scene(room(), 2.5, {}, {});
+  const Scene3D scene(test::tenMetreRoom(), 2.5, {}, {});
   SimRandom random(1);
   const auto points = ringSweep(l, scene, {5.0, 5.0, 0.3}, 0.0, &random);
   ASSERT_EQ(points.size(), 16u * 1800u);
@@ -71,7 +63,7 @@ TEST(RingLidarTest, PointsLieOnTheFloorTheCeilingAndTheWalls) {
   // A low ceiling (1.5 m), so that the upper rings meet it before the walls
   // 4-6 m away: ring 15 at 3.4 m, ring 13 at 4.6 m.
   const RingLidar l = noiseless();
-  const Scene3D scene(room(), 1.5, {}, {});
+  const Scene3D scene(test::tenMetreRoom(), 1.5, {}, {});
   SimRandom random(2);
   const Pose2 base{4.0, 6.0, 2.0};
   const auto points = ringSweep(l, scene, base, 0.0, &random);
@@ -103,7 +95,7 @@ TEST(RingLidarTest, PointsLieOnTheFloorTheCeilingAndTheWalls) {
 
 TEST(RingLidarTest, NoReturnIsNaNAndTooCloseToo) {
   RingLidar l = noiseless();
-  const Scene3D open(room(false), kInf, {}, {});
+  const Scene3D open(test::tenMetreRoom(false), kInf, {}, {});
   SimRandom random(3);
   const auto points = ringSweep(l, open, {5.0, 5.0, 0.0}, 0.0, &random);
   for (int r = 0; r < l.rings; ++r) {
@@ -123,7 +115,7 @@ TEST(RingLidarTest, NoReturnIsNaNAndTooCloseToo) {
 
 TEST(RingLidarTest, NoiseIsAlongTheRayAndDropoutsAreFew) {
   const RingLidar l = amrRingLidar({100'000'000, 0});
-  const Scene3D scene(room(), 2.5, {}, {});
+  const Scene3D scene(test::tenMetreRoom(), 2.5, {}, {});
   SimRandom random(4);
   const auto points = ringSweep(l, scene, {5.0, 5.0, 0.0}, 0.0, &random);
   int nan = 0;

@@ -6,22 +6,13 @@
 #include <limits>
 #include <vector>
 
+#include "support/rooms.h"
+
 namespace pf::sim {
 namespace {
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr double kDeg = M_PI / 180.0;
-
-// A 10 x 10 m room of 0.05 m cells, walls' inner faces at 0.05 and 9.95;
-// without walls when `walls` is false.
-OccupancyGrid room(bool walls = true) {
-  const int n = 200;
-  std::vector<int8_t> data(n * n, 0);
-  for (int i = 0; walls && i < n; ++i) {
-    data[i] = data[(n - 1) * n + i] = data[i * n] = data[i * n + n - 1] = 100;
-  }
-  return OccupancyGrid(n, n, 0.05, {}, data);
-}
 
 TEST(CastToBoxTest, EntersThroughTheNearestFace) {
   const Box3 box{2.0, -1.0, 0.0, 3.0, 1.0, 0.5};
@@ -35,7 +26,7 @@ TEST(CastToBoxTest, EntersThroughTheNearestFace) {
 }
 
 TEST(Scene3DTest, FloorCeilingAndWallsAtTheirHeights) {
-  const Scene3D scene(room(), 2.5, {}, {});
+  const Scene3D scene(test::tenMetreRoom(), 2.5, {}, {});
   // From the room's centre, 0.6 m up, looking along +x.
   const Hit floor = scene.cast(5.0, 5.0, 0.6, 0.0, -30 * kDeg, 100.0, 0.0);
   EXPECT_EQ(floor.surface, Surface::kFloor);
@@ -63,7 +54,7 @@ TEST(Scene3DTest, FloorCeilingAndWallsAtTheirHeights) {
 }
 
 TEST(Scene3DTest, WithoutCeilingOrWallsARayUpFindsNothing) {
-  const Scene3D scene(room(false), kInf, {}, {});
+  const Scene3D scene(test::tenMetreRoom(false), kInf, {}, {});
   EXPECT_EQ(scene.cast(5.0, 5.0, 0.6, 0.0, 10 * kDeg, 100.0, 0.0).surface, Surface::kNothing);
   EXPECT_EQ(scene.cast(5.0, 5.0, 0.6, 0.0, -10 * kDeg, 100.0, 0.0).surface, Surface::kFloor);
 }
@@ -71,7 +62,7 @@ TEST(Scene3DTest, WithoutCeilingOrWallsARayUpFindsNothing) {
 TEST(Scene3DTest, ObjectsAreSeenAtTheirHeightsOnly) {
   const Box3 parcel{6.0, 4.8, 0.0, 6.5, 5.2, 0.2};
   const Box3 table_top{7.0, 4.0, 1.0, 8.0, 6.0, 1.04};
-  const Scene3D scene(room(), 2.5, {parcel, table_top}, {});
+  const Scene3D scene(test::tenMetreRoom(), 2.5, {parcel, table_top}, {});
   // A level ray at 0.6 m passes over the parcel and under the table.
   EXPECT_EQ(scene.cast(5.0, 5.0, 0.6, 0.0, 0.0, 100.0, 0.0).surface, Surface::kWall);
   // Aimed at the middle of the parcel's top.
@@ -89,7 +80,7 @@ TEST(Scene3DTest, ObjectsAreSeenAtTheirHeightsOnly) {
 TEST(Scene3DTest, PeopleAreUprightCylindersThatMove) {
   Person p;
   p.x1 = 7.0, p.y1 = 5.0, p.x2 = 7.0, p.y2 = 8.0, p.speed = 1.0;
-  const Scene3D scene(room(), 2.5, {}, {p}, 1.7);
+  const Scene3D scene(test::tenMetreRoom(), 2.5, {}, {p}, 1.7);
   const Hit hit = scene.cast(5.0, 5.0, 0.6, 0.0, 0.0, 100.0, 0.0);
   EXPECT_EQ(hit.surface, Surface::kPerson);
   EXPECT_NEAR(hit.range, 1.8, 1e-12);

@@ -23,6 +23,11 @@ OccupancyGrid room(double width, double height, double resolution, const std::ve
   return OccupancyGrid(w, h, resolution, origin, data);
 }
 
+OccupancyGrid tenMetreRoom(bool walls) {
+  if (walls) return room(10.0, 10.0, 0.05);
+  return OccupancyGrid(200, 200, 0.05, {}, std::vector<int8_t>(200 * 200, 0));
+}
+
 OccupancyGrid asymmetricRoom() {
   return room(4.0, 3.0, 0.05, {{2.5, 0.5, 3.0, 1.2}, {0.6, 2.0, 1.0, 2.4}});
 }

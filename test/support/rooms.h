@@ -19,6 +19,11 @@ struct Box {
 OccupancyGrid room(double width, double height, double resolution,
                    const std::vector<Box>& boxes = {}, const Pose2& origin = {});
 
+/// 10 m x 10 m in 0.05 m cells, the simulator tests' floor: walled like
+/// room() (the walls' inner faces at 0.05 and 9.95 m), or free everywhere
+/// (`walls` false) for rays that find nothing.
+OccupancyGrid tenMetreRoom(bool walls = true);
+
 /// A 4 m x 3 m room in 0.05 m cells with a box near its lower right
 /// (x 2.5-3.0, y 0.5-1.2) and a smaller one near its upper left (x 0.6-1.0,
 /// y 2.0-2.4), so that no rotation or mirror image of it looks the same.
