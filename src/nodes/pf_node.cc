@@ -17,7 +17,6 @@
 // dropped; map -> odom is republished by a MapToOdomRepublisher on a thread
 // that never waits for the filter. filter_mutex_ protects the filter and
 // everything that goes with it (live_).
-#include <message_filters/subscriber.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/SetMap.h>
@@ -37,6 +36,7 @@
 #include <string>
 #include <thread>
 #include <utility>
+#include <vector>
 
 #include "pf_localization/ros/inline_callback_queue.h"
 #include "pf_localization/ros/latest_scan_slot.h"
@@ -48,6 +48,7 @@
 #include "pf_localization/ros/pose_transform.h"
 #include "pf_localization/ros/reconfigure_server.h"
 #include "pf_localization/ros/scan_drop.h"
+#include "pf_localization/ros/scan_inputs.h"
 #include "pf_localization/ros/startup_config.h"
 
 namespace pf_ros {
@@ -74,29 +75,29 @@ class PfNode {
         pnh_(pnh),
         buffer_(ros::Duration(30.0)),
         inline_queue_(ros::getGlobalCallbackQueue()),
-        // tf as it arrives, with no thread of the listener's own and no
-        // spinner: a transform that completes a waiting scan hands it to the
-        // filter thread directly (docs/performance.md, "Wake-ups: tf and scans on the poll
-        // thread").
+        // tf as it arrives, with no thread or spinner of the listener's own: a
+        // transform that completes a waiting scan hands it to the filter thread
+        // directly (docs/performance.md, "Wake-ups: tf and scans on the poll thread").
         listener_(buffer_, withQueue(nh_, &inline_queue_), false),
         republisher_(std::make_unique<MapToOdomRepublisher>(
             MapToOdomRepublisherOptions{config.tf_publish_rate, config.transform_tolerance,
                                         config.tf_broadcast},
             [this](const ros::Time& now) { onTfTick(now); })),
         live_(config, std::move(saved), &buffer_, republisher_.get(), &warn_, nh_),
-        scan_filter_(buffer_, config.odom_frame, 20, &inline_queue_),
-        odometry_(config.odom_frame, config.base_frame, nh_.resolveName("odom")) {
-    scan_filter_.connectInput(scan_sub_);
-    scan_filter_.registerCallback(&PfNode::onScan, this);
-    // A dropped scan may restart the filter (a bag that starts over), which
-    // takes filter_mutex_; the thread that dropped it may hold that mutex
-    // (its map -> odom reached tf), so the main spinner handles it.
-    scan_filter_.registerFailureCallback(
-        [this](const sensor_msgs::LaserScanConstPtr& scan,
-               tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-          postCallback(ros::getGlobalCallbackQueue(), reinterpret_cast<uint64_t>(this),
-                       [this, scan, reason] { onScanDropped(scan, reason); });
-        });
+        odometry_(config.odom_frame, config.base_frame, nh_.resolveName("odom")),
+        // A dropped scan may restart the filter (a bag that starts over),
+        // which takes filter_mutex_; the thread that dropped it may hold that
+        // mutex (its map -> odom reached tf), so the main spinner handles it.
+        scan_inputs_(
+            scanTopics(config), buffer_, config.odom_frame, &inline_queue_,
+            [this](const sensor_msgs::LaserScanConstPtr& scan, std::size_t sensor) {
+              onScan(scan, sensor);
+            },
+            [this](const sensor_msgs::LaserScanConstPtr& scan,
+                   tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+              postCallback(ros::getGlobalCallbackQueue(), reinterpret_cast<uint64_t>(this),
+                           [this, scan, reason] { onScanDropped(scan, reason); });
+            }) {
     odom_sub_ = nh_.subscribe("odom", 50, &PfNode::onOdom, this);
     tf_watch_sub_ = nh_.subscribe("/tf", 100, &PfNode::onTf, this);
     map_sub_ = nh_.subscribe("map", 1, &PfNode::onMap, this);
@@ -113,12 +114,12 @@ class PfNode {
         pnh_, config, [this](const LocalizerConfig& c) { return reconfigure(c); }, "pf_node");
     republisher_->start();
     filter_thread_ = std::thread([this] { filterLoop(); });
-    // Last: its callbacks may run at once, on roscpp's poll thread.
-    scan_sub_.subscribe(nh_, "scan", 20, ros::TransportHints(), &inline_queue_);
+    // Last: their callbacks may run at once, on roscpp's poll thread.
+    scan_inputs_.subscribe(nh_);
   }
 
   ~PfNode() {
-    scan_sub_.unsubscribe();
+    scan_inputs_.unsubscribe();
     ros::getGlobalCallbackQueue()->removeByID(reinterpret_cast<uint64_t>(this));
     slot_.close();
     filter_thread_.join();
@@ -185,8 +186,8 @@ class PfNode {
   // Once tf has the scan's stamp, on whichever thread brought the scan or
   // the transform that completed it (InlineCallbackQueue): only hands the
   // scan to the filter thread, so that no thread waits here for an update.
-  void onScan(const sensor_msgs::LaserScanConstPtr& scan) {
-    if (!slot_.put(PendingScan{scan, ros::WallTime::now(), ros::Time::now()})) return;
+  void onScan(const sensor_msgs::LaserScanConstPtr& scan, std::size_t sensor) {
+    if (!slot_.put(PendingScan{scan, ros::WallTime::now(), ros::Time::now(), sensor})) return;
     const std::uint64_t dropped = slot_.dropped();
     warn_.warn("overload",
                "the filter cannot keep up: a scan waiting for it was dropped for a newer one (" +
@@ -317,10 +318,9 @@ class PfNode {
   std::mutex filter_mutex_;
   LiveLocalizer live_;
   LatestScanSlot slot_;
-  message_filters::Subscriber<sensor_msgs::LaserScan> scan_sub_;
-  tf2_ros::MessageFilter<sensor_msgs::LaserScan> scan_filter_;
   ros::Subscriber odom_sub_, map_sub_, initial_pose_sub_, tf_watch_sub_;
   OdometrySource odometry_;  // main spinner only
+  ScanInputs scan_inputs_;   // after slot_ and live_, which its callbacks use
   ros::ServiceServer global_srv_, nomotion_srv_, set_map_srv_;
   ros::Timer save_timer_;
   std::unique_ptr<ReconfigureServer> reconfigure_;

@@ -1,5 +1,6 @@
 #include "pf_localization/ros/latest_scan_slot.h"
 
+#include <algorithm>
 #include <chrono>
 #include <utility>
 
@@ -9,9 +10,14 @@ bool LatestScanSlot::put(PendingScan scan) {
   bool replaced = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    replaced = waiting_.has_value();
-    if (replaced) ++dropped_;
-    waiting_ = std::move(scan);
+    const auto same = std::find_if(waiting_.begin(), waiting_.end(),
+                                   [&](const PendingScan& w) { return w.sensor == scan.sensor; });
+    replaced = same != waiting_.end();
+    if (replaced) {
+      ++dropped_;
+      waiting_.erase(same);
+    }
+    waiting_.push_back(std::move(scan));
   }
   ready_.notify_one();
   return replaced;
@@ -20,10 +26,10 @@ bool LatestScanSlot::put(PendingScan scan) {
 std::optional<PendingScan> LatestScanSlot::take(ros::WallDuration timeout) {
   std::unique_lock<std::mutex> lock(mutex_);
   ready_.wait_for(lock, std::chrono::nanoseconds(timeout.toNSec()),
-                  [this] { return closed_ || waiting_.has_value(); });
-  if (closed_ || !waiting_) return std::nullopt;
-  std::optional<PendingScan> out = std::move(waiting_);
-  waiting_.reset();
+                  [this] { return closed_ || !waiting_.empty(); });
+  if (closed_ || waiting_.empty()) return std::nullopt;
+  std::optional<PendingScan> out = std::move(waiting_.front());
+  waiting_.erase(waiting_.begin());
   return out;
 }
 

@@ -128,7 +128,7 @@ void LiveLocalizer::processScan(const PendingScan& pending, const LatestScanSlot
   if (fromBeforeTheJump(scan.header.stamp)) return;
   if (timeJumpedBack(scan.header.stamp)) return;
   const ros::WallTime start = ros::WallTime::now();
-  const ScanResult result = localizer_.processScan(scan);
+  const ScanResult result = localizer_.processScan(scan, pending.sensor);
   const double update_s = (ros::WallTime::now() - start).toSec();
   if (result.error != ScanError::kNone) {
     warn_->warn(toString(result.error), errorMessage(result));

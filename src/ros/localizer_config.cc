@@ -298,8 +298,31 @@ pf::ParameterTable<C> scanParameters() {
                    "place each beam from where the laser was when it took it (time_increment)")),
       pf::member(&C::scan_stamp,
                  I("scan_stamp", "", "which beam a scan's stamp is the time of, for deskew_scans")
-                     .oneOf({"first_beam", "last_beam"}))};
+                     .oneOf({"first_beam", "last_beam"})),
+      pf::member(&C::scan_topics,
+                 I("scan_topics", "topic names",
+                   "the lidars' scan topics, separated by spaces: several are weighed together, "
+                   "each scan from where its lidar was")
+                     .withNote("e.g. \"scan_front scan_rear\"; one: amcl's scan"))};
 }
+
+}  // namespace
+
+std::vector<std::string> scanTopics(const LocalizerConfig& config) {
+  std::vector<std::string> topics;
+  std::string word;
+  for (const char c : config.scan_topics + " ") {
+    if (c == ' ' || c == ',' || c == '\t') {
+      if (!word.empty()) topics.push_back(word);
+      word.clear();
+    } else {
+      word += c;
+    }
+  }
+  return topics;
+}
+
+namespace {
 
 // The rows of LocalizerConfig's own members (the filter's are particleFilterParameters()).
 const pf::ParameterTable<C>& ownParameters() {
@@ -583,6 +606,10 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
 
 void validate(const LocalizerConfig& c) {
   checkRanges(ownParameters(), c);
+  if (scanTopics(c).empty()) {
+    throw std::invalid_argument(pf::invalidParameterMessage(
+        "scan_topics", "\"" + c.scan_topics + "\"", "at least one topic name"));
+  }
   pf::validate(c.filter);
 }
 

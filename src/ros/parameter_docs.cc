@@ -62,7 +62,7 @@ std::string rangeText(const Row& p) {
   if (std::holds_alternative<pf::Field<LocalizerConfig, bool>>(p.field)) return "true or false";
   if (std::holds_alternative<pf::Field<LocalizerConfig, std::string>>(p.field) &&
       p.info.choices.empty()) {
-    return "a frame name";
+    return p.info.unit.empty() ? "a frame name" : p.info.unit;
   }
   return pf::allowedText(p.info);
 }

@@ -16,10 +16,10 @@
 namespace pf_ros {
 namespace {
 
-PendingScan scanStamped(double t) {
+PendingScan scanStamped(double t, std::size_t sensor = 0) {
   auto scan = boost::make_shared<sensor_msgs::LaserScan>();
   scan->header.stamp = ros::Time(t);
-  return PendingScan{scan, ros::WallTime(t), ros::Time(t)};
+  return PendingScan{scan, ros::WallTime(t), ros::Time(t), sensor};
 }
 
 TEST(LatestScanSlot, TheNewestScanWinsAndTheOlderOneIsCounted) {
@@ -35,6 +35,23 @@ TEST(LatestScanSlot, TheNewestScanWinsAndTheOlderOneIsCounted) {
   EXPECT_FALSE(slot.take(ros::WallDuration(0.0)).has_value());
   EXPECT_FALSE(slot.put(scanStamped(4.0)));
   EXPECT_EQ(slot.dropped(), 2u);
+}
+
+TEST(LatestScanSlot, EachSensorKeepsItsNewestScanAndTheFirstToArriveGoesFirst) {
+  LatestScanSlot slot;
+  EXPECT_FALSE(slot.put(scanStamped(1.0, 0)));
+  EXPECT_FALSE(slot.put(scanStamped(1.05, 1)));  // the other lidar: nothing dropped
+  EXPECT_TRUE(slot.put(scanStamped(1.1, 0)));    // the first lidar's 1.0 is
+  EXPECT_EQ(slot.dropped(), 1u);
+  auto taken = slot.take(ros::WallDuration(0.0));
+  ASSERT_TRUE(taken.has_value());
+  EXPECT_EQ(taken->sensor, 1u);
+  EXPECT_EQ(taken->scan->header.stamp, ros::Time(1.05));
+  taken = slot.take(ros::WallDuration(0.0));
+  ASSERT_TRUE(taken.has_value());
+  EXPECT_EQ(taken->sensor, 0u);
+  EXPECT_EQ(taken->scan->header.stamp, ros::Time(1.1));
+  EXPECT_FALSE(slot.take(ros::WallDuration(0.0)).has_value());
 }
 
 TEST(LatestScanSlot, TakeWaitsForAScanFromAnotherThreadAndCloseWakesIt) {

@@ -55,7 +55,12 @@ TEST(ParameterDocs, TheReadmesTableIsTheTables) {
       << "README.md's parameter table is stale" << kRegenerate;
 }
 
-TEST(ParameterDocs, EachNameIsDeclaredOnceAndThereAreAtMostFifty) {
+// Issue 26 cut the public surface to 50: what an amcl user knows and what a
+// robot or a building needs. Issue 29's sensors add theirs: the scan topics,
+// and for point clouds their topics and height band.
+constexpr std::size_t kMaxParameters = 55;
+
+TEST(ParameterDocs, EachNameIsDeclaredOnceAndThereAreAtMostFiftyFive) {
   std::set<std::string> names;
   for (const auto& p : localizerParameters()) {
     EXPECT_TRUE(names.insert(p.info.name).second) << p.info.name << " declared twice";
@@ -65,7 +70,7 @@ TEST(ParameterDocs, EachNameIsDeclaredOnceAndThereAreAtMostFifty) {
     EXPECT_FALSE(p.info.group.empty()) << p.info.name << " is in no group";
     EXPECT_FALSE(p.info.description.empty()) << p.info.name;
   }
-  EXPECT_LE(localizerParameters().size(), 50u);
+  EXPECT_LE(localizerParameters().size(), kMaxParameters);
 }
 
 TEST(ParameterDocs, EveryDefaultIsValidAndReadsBackFromPfYaml) {

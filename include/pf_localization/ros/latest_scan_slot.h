@@ -1,7 +1,8 @@
-// The hand-over of scans from pf_node's subscription to its filter thread,
-// holding at most one waiting scan: under overload (a filter update slower
+// The hand-over of scans from pf_node's subscriptions to its filter thread,
+// holding at most one waiting scan per sensor: under overload (a filter update slower
 // than the scan period, another process taking the CPU) the newest scan wins
-// and the older waiting one is dropped and counted, so that the delay between
+// and the older waiting one of that sensor is dropped and counted (another
+// sensor's is not: it is the other half of the view), so that the delay between
 // a scan and its map -> odom stays bounded by about one update instead of
 // growing with a queue, as amcl's does.
 #pragma once
@@ -13,6 +14,7 @@
 #include <cstdint>
 #include <mutex>
 #include <optional>
+#include <vector>
 
 namespace pf_ros {
 
@@ -21,16 +23,18 @@ struct PendingScan {
   sensor_msgs::LaserScanConstPtr scan;
   ros::WallTime arrival_wall;  // for the latency (scan arrival -> its map -> odom)
   ros::Time arrival_clock;     // the node's clock (sim time in a bag), for the scan's age
+  std::size_t sensor = 0;      // which scan topic it came on (scanTopics()' index)
 };
 
 class LatestScanSlot {
  public:
-  /// Leaves `scan` for take(). Returns true when it replaced a scan that was
-  /// still waiting (that one is dropped, and counted in dropped()).
+  /// Leaves `scan` for take(). Returns true when it replaced a scan of the
+  /// same sensor that was still waiting (that one is dropped, and counted in
+  /// dropped()).
   bool put(PendingScan scan);
 
-  /// The waiting scan, waiting up to `timeout` for one; nothing on time-out or
-  /// once close() was called.
+  /// The waiting scan that arrived first, waiting up to `timeout` for one;
+  /// nothing on time-out or once close() was called.
   std::optional<PendingScan> take(ros::WallDuration timeout);
 
   /// Wakes take() for good (shutdown).
@@ -44,7 +48,7 @@ class LatestScanSlot {
  private:
   mutable std::mutex mutex_;
   std::condition_variable ready_;
-  std::optional<PendingScan> waiting_;
+  std::vector<PendingScan> waiting_;  // at most one per sensor, in arrival order
   std::uint64_t dropped_ = 0;
   bool closed_ = false;
 };

@@ -40,6 +40,10 @@ struct LocalizerConfig {
   // convention, sensor_msgs/LaserScan) or "last_beam" (drivers that stamp a
   // scan when it is complete).
   std::string scan_stamp = "first_beam";
+  // The topics of the lidars, separated by spaces or commas (scanTopics()):
+  // one, amcl's `scan`, or several, whose scans one update weighs together
+  // (ScanLocalizer::processScan).
+  std::string scan_topics = "scan";
   std::optional<pf::Pose2> initial_pose;  // none: global localization
   Eigen::Matrix3d initial_cov = Eigen::Vector3d(0.25, 0.25, 0.0685).asDiagonal();
   pf::ParticleFilterParams filter;
@@ -58,8 +62,11 @@ struct LocalizerConfig {
   bool first_map_only = false;  // keep the first map; ignore later ones on the map topic
 };
 
+/// config.scan_topics as a list: the words between spaces and commas.
+std::vector<std::string> scanTopics(const LocalizerConfig& config);
+
 /// Every parameter of LocalizerConfig, the filter's included, in the order of
-/// config/pf.yaml: at most 50, amcl's and what a robot or a building needs.
+/// config/pf.yaml: amcl's and what a robot, its sensors or a building needs.
 const pf::ParameterTable<LocalizerConfig>& localizerParameters();
 
 /// Where pf_node saves the signature of the map its saved pose is on (state
