@@ -3,6 +3,8 @@
 #include <Eigen/LU>  // determinant()
 #include <cmath>
 #include <limits>
+#include <utility>
+#include <vector>
 #include <stdexcept>
 
 #include "pf_localization/core/fast_atan2.h"
@@ -17,6 +19,13 @@ constexpr double kRotationTolerance = 1e-6;
 
 // Below this length the sensor's x axis is vertical and has no heading.
 constexpr double kMinAxisProjection = 1e-9;
+
+// m: a bin's range is the mean over its points within this of its nearest.
+// The nearest alone is the one whose noise is most negative: with a 16-ring
+// lidar's 1.5 cm noise and up to 40 points a bin it read 3.2 cm short of a
+// 2D lidar at the same place (cloud.bag, median over the bins). 0.1 m keeps
+// a table leg in front of a wall from being averaged with the wall.
+constexpr double kSurfaceDepth = 0.1;
 
 }  // namespace
 
@@ -109,6 +118,9 @@ CloudScan CloudScanReducer::reduce(const std::vector<CloudPoint>& points,
   const double bins_per_rad = 1.0 / width;
   constexpr double kEmpty = std::numeric_limits<double>::infinity();
   std::vector<double> nearest_d2(bins_, kEmpty);
+  // Each kept point's bin and horizontal distance, for the second pass.
+  std::vector<std::pair<int, double>> kept;
+  kept.reserve(points.size());
 
   CloudScan out;
   CloudScanCounts& n = out.counts;
@@ -145,6 +157,17 @@ CloudScan CloudScanReducer::reduce(const std::vector<CloudPoint>& points,
     int k = static_cast<int>((fastAtan2(v, u) + M_PI) * bins_per_rad + 0.5);
     if (k >= bins_) k -= bins_;
     if (d2 < nearest_d2[k]) nearest_d2[k] = d2;
+    kept.emplace_back(k, d2);
+  }
+  // The mean distance of the points of each bin's nearest surface.
+  std::vector<double> sum(bins_, 0.0);
+  std::vector<int> count(bins_, 0);
+  for (const auto& [k, d2] : kept) {
+    const double d = std::sqrt(d2);
+    if (d <= std::sqrt(nearest_d2[k]) + kSurfaceDepth) {
+      sum[k] += d;
+      ++count[k];
+    }
   }
 
   LaserScan& scan = out.scan;
@@ -158,7 +181,7 @@ CloudScan CloudScanReducer::reduce(const std::vector<CloudPoint>& points,
     if (nearest_d2[k] == kEmpty) {
       scan.ranges[k] = std::numeric_limits<float>::quiet_NaN();
     } else {
-      scan.ranges[k] = static_cast<float>(std::sqrt(nearest_d2[k]));
+      scan.ranges[k] = static_cast<float>(sum[k] / count[k]);
       ++n.bins_filled;
     }
   }

@@ -17,18 +17,18 @@
 //   5. put it in the angular bin of its bearing: bin k is centred on
 //      -pi + k * w and w = 2 pi / bins wide, bins = ceil(2 pi / bin_width)
 //      (the bins close the circle, so the width is bin_width or slightly
-//      less); a bin's range is the nearest of its points' d, the first
-//      obstacle in that direction, as a 2D lidar would see it.
+//      less); a bin's range is the mean d of its points within
+//      kSurfaceDepth (0.1 m) of its nearest: the first obstacle in that
+//      direction, as a 2D lidar would see it.
 // The scan's sensor_pose is the sensor's place and heading projected onto
 // the floor plane (the base frame's heading if the sensor's x axis is
 // vertical), so each beam starts where the sensor really is. A bin
 // without a point reads NaN, "no reading" (laser_scan.h): the band may
 // have removed what was there, so it does not say the direction is free.
 //
-// The nearest point is the first obstacle, but also the one whose range
-// noise is most negative: with the simulator's 1.5 cm noise and up to 16
-// rings x 3 columns in a bin, bins read a median 3 cm short of a 2D lidar
-// at the same place (point_cloud_test.cc, CloudBag).
+// The nearest point alone is the first obstacle, but also the one whose
+// range noise is most negative; the mean of that surface's points is not
+// (point_cloud_test.cc, CloudBag, compares with a 2D lidar at the same place).
 //
 // The bearing is measured by fastAtan2 (fast_atan2.h): with std::atan2 a
 // 28 800-point sweep whose points all lie in the band took 523 us instead
