@@ -13,6 +13,7 @@
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
+#include <sensor_msgs/PointCloud2.h>
 #include <tf2/buffer_core.h>
 #include <tf2_msgs/TFMessage.h>
 #include <unistd.h>
@@ -46,6 +47,7 @@ constexpr char kUsage[] =
     "         [--particles N]            maximum particle count\n"
     "         [--max-beams B] [--seed S] [--params FILE.yaml]\n"
     "         [--scan-topic /scan]...        once per lidar: several are fused\n"
+    "         [--cloud-topic /points]...     once per 3D lidar or depth camera (PointCloud2)\n"
     "         [--odom-topic /odom]\n"
     "         [--log UPDATES.csv]        one line per filter update\n"
     "         [--particles-out P.csv]    every particle of every update in the first 30 s\n"
@@ -60,7 +62,8 @@ constexpr double kParticleDumpSeconds = 30.0;
 
 struct Options {
   std::string bag, map, out, params, log, particles_out, covariance;
-  std::vector<std::string> scan_topics;  // empty: /scan
+  std::vector<std::string> scan_topics;   // empty: /scan
+  std::vector<std::string> cloud_topics;  // PointCloud2 topics, sensors after the scan topics
   std::string odom_topic = "/odom";
   std::optional<pf::Pose2> initial_pose;
   int particles = 0, max_beams = 0;
@@ -107,6 +110,8 @@ Options parse(int argc, char** argv) {
       o.covariance = value(), ++i;
     else if (a == "--scan-topic")
       o.scan_topics.push_back(value()), ++i;
+    else if (a == "--cloud-topic")
+      o.cloud_topics.push_back(value()), ++i;
     else if (a == "--odom-topic")
       o.odom_topic = value(), ++i;
     else if (a == "--particles")
@@ -127,7 +132,7 @@ Options parse(int argc, char** argv) {
   }
   if (o.bag.empty() || o.map.empty() || o.out.empty())
     fail(std::string("--bag, --map and --out are required\n") + kUsage);
-  if (o.scan_topics.empty()) o.scan_topics.push_back("/scan");
+  if (o.scan_topics.empty() && o.cloud_topics.empty()) o.scan_topics.push_back("/scan");
   return o;
 }
 
@@ -190,6 +195,7 @@ void openBag(const Options& opt, rosbag::Bag* bag) {
   std::set<std::string> topics;
   for (const rosbag::ConnectionInfo* c : all.getConnections()) topics.insert(c->topic);
   std::vector<std::string> needed_topics = opt.scan_topics;
+  needed_topics.insert(needed_topics.end(), opt.cloud_topics.begin(), opt.cloud_topics.end());
   needed_topics.push_back("/tf");
   for (const std::string& needed : needed_topics) {
     if (!topics.count(needed)) {
@@ -280,13 +286,22 @@ class Replay {
   // What the replay reads: the scans, the odometry and tf.
   std::vector<std::string> topics() const {
     std::vector<std::string> t = opt_.scan_topics;
+    t.insert(t.end(), opt_.cloud_topics.begin(), opt_.cloud_topics.end());
     t.insert(t.end(), {opt_.odom_topic, "/tf", "/tf_static"});
     return t;
   }
 
  private:
   void handle(const rosbag::MessageInstance& m);
-  void process(const sensor_msgs::LaserScan& scan, std::size_t sensor);
+  // A scan or a cloud waiting for its odometry, with its sensor: the index of
+  // its --scan-topic, or of its --cloud-topic after those.
+  struct Pending {
+    sensor_msgs::LaserScan::ConstPtr scan;
+    sensor_msgs::PointCloud2::ConstPtr cloud;
+    std::size_t sensor;
+    const std_msgs::Header& header() const { return scan ? scan->header : cloud->header; }
+  };
+  void process(const Pending& pending);
   void logUpdate(double t, const pf_ros::ScanResult& r, double cpu);
   void dumpParticles(double t);
   void writeCovariance(double t);
@@ -298,7 +313,7 @@ class Replay {
   pf_ros::ScanLocalizer& localizer_;
   Outputs& outputs_;
   // The scans waiting for their odometry, with their sensor (--scan-topic's index).
-  std::deque<std::pair<sensor_msgs::LaserScan::ConstPtr, std::size_t>> pending_;
+  std::deque<Pending> pending_;
   // What pf_node last published on pf_pose (it publishes at each update).
   std::optional<geometry_msgs::PoseWithCovarianceStamped> published_;
   RunCounts counts_;
@@ -318,14 +333,13 @@ void Replay::run(const rosbag::Bag& bag) {
       // A scan is used once odometry reaches its stamp, as pf_node's tf
       // message filter would, or when it has waited too long.
       while (!pending_.empty()) {
-        const auto& s = pending_.front().first;
-        const bool ready =
-            tf_.canTransform(config_.odom_frame, config_.base_frame, s->header.stamp) &&
-            tf_.canTransform(config_.base_frame, s->header.frame_id, ros::Time(0));
-        if (!ready && now - s->header.stamp.toSec() < kMaxTfWait) {
+        const std_msgs::Header& h = pending_.front().header();
+        const bool ready = tf_.canTransform(config_.odom_frame, config_.base_frame, h.stamp) &&
+                           tf_.canTransform(config_.base_frame, h.frame_id, ros::Time(0));
+        if (!ready && now - h.stamp.toSec() < kMaxTfWait) {
           break;
         }
-        process(*s, pending_.front().second);
+        process(pending_.front());
         pending_.pop_front();
       }
       progress.show((now - t_begin) / std::max(1e-9, t_end - t_begin), now - t_begin);
@@ -333,7 +347,7 @@ void Replay::run(const rosbag::Bag& bag) {
   } catch (const rosbag::BagException& e) {
     fail(opt_.bag + ": error while reading: " + e.what());
   }
-  for (const auto& [s, sensor] : pending_) process(*s, sensor);
+  for (const Pending& p : pending_) process(p);
   progress.done();
 }
 
@@ -351,16 +365,26 @@ void Replay::handle(const rosbag::MessageInstance& m) {
     const auto topic = std::find(opt_.scan_topics.begin(), opt_.scan_topics.end(), m.getTopic());
     if (topic == opt_.scan_topics.end()) return;
     ++counts_.scans;
-    pending_.emplace_back(scan, static_cast<std::size_t>(topic - opt_.scan_topics.begin()));
+    pending_.push_back({scan, nullptr, static_cast<std::size_t>(topic - opt_.scan_topics.begin())});
+  } else if (const auto cloud = m.instantiate<sensor_msgs::PointCloud2>()) {
+    const auto topic = std::find(opt_.cloud_topics.begin(), opt_.cloud_topics.end(), m.getTopic());
+    if (topic == opt_.cloud_topics.end()) return;
+    ++counts_.scans;
+    pending_.push_back(
+        {nullptr, cloud,
+         opt_.scan_topics.size() + static_cast<std::size_t>(topic - opt_.cloud_topics.begin())});
   }
 }
 
-void Replay::process(const sensor_msgs::LaserScan& scan, std::size_t sensor) {
+void Replay::process(const Pending& pending) {
   const double cpu0 = threadCpuSeconds();
-  const pf_ros::ScanResult r = localizer_.processScan(scan, sensor);
+  const pf_ros::ScanResult r = pending.scan
+                                   ? localizer_.processScan(*pending.scan, pending.sensor)
+                                   : localizer_.processCloud(*pending.cloud, pending.sensor);
   const double cpu = threadCpuSeconds() - cpu0;
   counts_.cpu_total += cpu;
-  const double t = scan.header.stamp.toSec();
+  const std_msgs::Header& header = pending.header();
+  const double t = header.stamp.toSec();
   if (first_stamp_ < 0) first_stamp_ = t;
   if (r.error != pf_ros::ScanError::kNone) {
     if (counts_.errors[pf_ros::toString(r.error)]++ == 0)
@@ -368,7 +392,7 @@ void Replay::process(const sensor_msgs::LaserScan& scan, std::size_t sensor) {
     return;
   }
   if (r.report.updated) {
-    if (outputs_.cov) published_ = localizer_.estimate(scan.header.stamp);
+    if (outputs_.cov) published_ = localizer_.estimate(header.stamp);
     ++counts_.updates;
     counts_.update_cpu.add(cpu);
     if (outputs_.log) logUpdate(t, r, cpu);
@@ -438,7 +462,7 @@ void summarize(const Options& opt, const RunCounts& c) {
   for (const auto& e : c.errors) {
     std::cerr << "pf_bag_runner: " << e.second << " scans not used: " << e.first << "\n";
   }
-  if (c.scans == 0) fail(opt.bag + ": no scans on " + opt.scan_topics.front());
+  if (c.scans == 0) fail(opt.bag + ": no scans or clouds on the topics asked for");
   if (c.written == 0) fail("no pose could be estimated (see the warnings above)", 3);
 }
 

@@ -332,6 +332,12 @@ const pf::ParameterTable<C>& ownParameters() {
     pf::append(&t, outputParameters(), "output");
     pf::append(&t, initialPoseParameters(), "initial_pose");
     pf::append(&t, scanParameters(), "scan");
+    // The cloud's height band; its bins and range limits are the reducer's own.
+    pf::ParameterTable<C> band;
+    for (const auto& p : pf::nested(&C::cloud, pf::cloudScanParameters())) {
+      if (p.info.name == "cloud_min_height" || p.info.name == "cloud_max_height") band.push_back(p);
+    }
+    pf::append(&t, band, "scan");
     return t;
   }();
   return table;
@@ -606,6 +612,7 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
 
 void validate(const LocalizerConfig& c) {
   checkRanges(ownParameters(), c);
+  pf::validate(c.cloud);
   if (scanTopics(c).empty()) {
     throw std::invalid_argument(pf::invalidParameterMessage(
         "scan_topics", "\"" + c.scan_topics + "\"", "at least one topic name"));

@@ -8,6 +8,7 @@
 
 #include "pf_localization/ros/conversions.h"
 #include "pf_localization/ros/live_params.h"
+#include "pf_localization/ros/point_cloud.h"
 
 namespace pf_ros {
 namespace {
@@ -33,6 +34,8 @@ const char* toString(ScanError error) {
       return "cannot place the laser on the robot";
     case ScanError::kNoOdometry:
       return "no odometry at the scan's stamp";
+    case ScanError::kBadCloud:
+      return "cannot read the point cloud";
   }
   return "unknown scan error";
 }
@@ -48,7 +51,8 @@ ScanLocalizer::ScanLocalizer(const LocalizerConfig& config, const tf2::BufferCor
       configured_pose_(config.initial_pose),
       configured_cov_(config.initial_cov),
       tf_(tf),
-      filter_(config.filter) {}
+      filter_(config.filter),
+      cloud_reducer_(config.cloud) {}
 
 std::string ScanLocalizer::setMap(const nav_msgs::OccupancyGrid& map) {
   pf::OccupancyGrid grid;
@@ -129,63 +133,97 @@ std::string ScanLocalizer::restart() {
   return "";
 }
 
-ScanResult ScanLocalizer::processScan(const sensor_msgs::LaserScan& scan, std::size_t sensor) {
-  ScanResult result;
+std::optional<geometry_msgs::TransformStamped> ScanLocalizer::lookUp(const std::string& frame,
+                                                                     const ros::Time& stamp,
+                                                                     ScanResult* result) const {
   if (!filter_.hasMap()) {
-    result.error = ScanError::kNoMap;
-    result.error_detail = "waiting for one on the map topic";
-    return result;
+    result->error = ScanError::kNoMap;
+    result->error_detail = "waiting for one on the map topic";
+    return std::nullopt;
   }
-  if (scan.header.frame_id.empty()) {
-    result.error = ScanError::kEmptyLaserFrame;
-    result.error_detail = "cannot place the laser on the robot";
-    return result;
+  if (frame.empty()) {
+    result->error = ScanError::kEmptyLaserFrame;
+    result->error_detail = "cannot place the laser on the robot";
+    return std::nullopt;
   }
   geometry_msgs::TransformStamped laser, odom;
   try {
     // The mounting is rigid: the newest transform is as good as one at the
     // stamp, and does not fail on a mount published at a low rate.
-    laser = tf_->lookupTransform(config_.base_frame, scan.header.frame_id, ros::Time(0));
+    laser = tf_->lookupTransform(config_.base_frame, frame, ros::Time(0));
   } catch (const tf2::TransformException& e) {
-    result.error = ScanError::kNoLaserMounting;
-    result.error_detail =
-        "no transform " + config_.base_frame + " -> " + scan.header.frame_id +
+    result->error = ScanError::kNoLaserMounting;
+    result->error_detail =
+        "no transform " + config_.base_frame + " -> " + frame +
         " (the laser's mounting; the odometry was not looked up yet): " + e.what();
-    return result;
+    return std::nullopt;
   }
   try {
-    odom = tf_->lookupTransform(config_.odom_frame, config_.base_frame, scan.header.stamp);
+    odom = tf_->lookupTransform(config_.odom_frame, config_.base_frame, stamp);
   } catch (const tf2::TransformException& e) {
-    result.error = ScanError::kNoOdometry;
-    result.error_detail = "no transform " + config_.odom_frame + " -> " + config_.base_frame +
-                          " at t=" + describe(scan.header.stamp) + " (the laser's mounting " +
-                          config_.base_frame + " -> " + scan.header.frame_id +
-                          " was found): " + e.what();
+    result->error = ScanError::kNoOdometry;
+    result->error_detail = "no transform " + config_.odom_frame + " -> " + config_.base_frame +
+                           " at t=" + describe(stamp) + " (the laser's mounting " +
+                           config_.base_frame + " -> " + frame + " was found): " + e.what();
+    return std::nullopt;
+  }
+  result->odom = toPose2(odom.transform);
+  return laser;
+}
+
+ScanResult ScanLocalizer::processScan(const sensor_msgs::LaserScan& scan, std::size_t sensor) {
+  ScanResult result;
+  const auto laser = lookUp(scan.header.frame_id, scan.header.stamp, &result);
+  if (!laser) return result;
+  result.warning = scanInconsistency(scan);
+  pf::LaserScan core = toCore(scan, toPose2(laser->transform));
+  core.sweep = sweepMotion(scan, *tf_, config_, *result.odom);
+  update(std::move(core), sensor, scan.header.stamp, &result);
+  return result;
+}
+
+ScanResult ScanLocalizer::processCloud(const sensor_msgs::PointCloud2& cloud, std::size_t sensor) {
+  ScanResult result;
+  const auto mount = lookUp(cloud.header.frame_id, cloud.header.stamp, &result);
+  if (!mount) return result;
+  if (const auto error = readCloud(cloud, &cloud_points_)) {
+    result.error = ScanError::kBadCloud;
+    result.error_detail = std::string(kindName(error->kind)) + ": " + error->detail;
     return result;
   }
-  result.warning = scanInconsistency(scan);
-  result.odom = toPose2(odom.transform);
+  const pf::SensorMount sensor_mount = toSensorMount(mount->transform);
+  if (const auto error = pf::validateMount(sensor_mount)) {
+    result.error = ScanError::kBadCloud;
+    result.error_detail =
+        "the mounting " + config_.base_frame + " -> " + cloud.header.frame_id + ": " + *error;
+    return result;
+  }
+  update(cloud_reducer_.reduce(cloud_points_, sensor_mount).scan, sensor, cloud.header.stamp,
+         &result);
+  return result;
+}
+
+void ScanLocalizer::update(pf::LaserScan scan, std::size_t sensor, const ros::Time& stamp,
+                           ScanResult* result) {
   group_.clear();
-  group_.push_back(toCore(scan, toPose2(laser.transform)));
-  group_.front().sweep = sweepMotion(scan, *tf_, config_, *result.odom);
+  group_.push_back(std::move(scan));
   if (latest_.size() <= sensor) latest_.resize(sensor + 1);
   // The other sensors' latest scans since the last update, each where the
   // robot was at its stamp.
   for (std::size_t other = 0; other < latest_.size(); ++other) {
     const std::optional<SensorScan>& s = latest_[other];
     if (other == sensor || !s || s->used) continue;
-    if (std::fabs((scan.header.stamp - s->stamp).toSec()) > kMaxSensorScanAge) continue;
+    if (std::fabs((stamp - s->stamp).toSec()) > kMaxSensorScanAge) continue;
     group_.push_back(s->scan);
-    group_.back().robot_offset = pf::between(*result.odom, s->odom);
+    group_.back().robot_offset = pf::between(*result->odom, s->odom);
   }
-  result.report = filter_.update(*result.odom, group_);
-  latest_[sensor] = SensorScan{std::move(group_.front()), *result.odom, scan.header.stamp, false};
-  if (result.report.updated) {
+  result->report = filter_.update(*result->odom, group_);
+  latest_[sensor] = SensorScan{std::move(group_.front()), *result->odom, stamp, false};
+  if (result->report.updated) {
     for (std::optional<SensorScan>& s : latest_) {
       if (s) s->used = true;
     }
   }
-  return result;
 }
 
 std::optional<geometry_msgs::TransformStamped> ScanLocalizer::mapToOdom(

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <iostream>
 #include <limits>
 
@@ -387,6 +388,76 @@ TEST_F(ScanLocalizerTest, AnUpdateTakesTheOtherSensorsLatestScan) {
   const ScanResult stale = frontScan(1.35, 10.35 + kMaxSensorScanAge + 0.05);
   ASSERT_TRUE(stale.report.updated) << pf::skipMessage(stale.report);
   EXPECT_EQ(one_scan, stale.report.beams_used);
+}
+
+// A 3D lidar's cloud: the room's walls at three heights inside the band and
+// the floor below it, in frame "velodyne"; reduced to a scan and weighed.
+sensor_msgs::PointCloud2 cloudOfWalls(const pf::LaserScan& scan, const ros::Time& stamp) {
+  std::vector<float> xyz;
+  for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
+    const double a = scan.angle_min + i * scan.angle_increment;
+    const float r = scan.ranges[i];
+    if (!std::isfinite(r)) continue;
+    for (const float z : {0.0f, 0.4f, 0.6f, 0.8f}) {  // the floor, then the wall
+      const float d = z == 0.0f ? 0.5f * r : r;
+      xyz.insert(xyz.end(),
+                 {static_cast<float>(d * std::cos(a)), static_cast<float>(d * std::sin(a)), z});
+    }
+  }
+  sensor_msgs::PointCloud2 cloud;
+  cloud.header.frame_id = "velodyne";
+  cloud.header.stamp = stamp;
+  cloud.height = 1;
+  cloud.width = static_cast<uint32_t>(xyz.size() / 3);
+  for (const char* name : {"x", "y", "z"}) {
+    sensor_msgs::PointField f;
+    f.name = name;
+    f.offset = static_cast<uint32_t>(4 * cloud.fields.size());
+    f.datatype = sensor_msgs::PointField::FLOAT32;
+    f.count = 1;
+    cloud.fields.push_back(f);
+  }
+  cloud.point_step = 12;
+  cloud.row_step = cloud.point_step * cloud.width;
+  cloud.is_dense = true;
+  cloud.data.resize(cloud.row_step);
+  std::memcpy(cloud.data.data(), xyz.data(), cloud.data.size());
+  return cloud;
+}
+
+TEST_F(ScanLocalizerTest, ACloudIsReducedToAScanAndWeighed) {
+  tf_.setTransform(transform("base_link", "velodyne", {0.1, 0.0, 0.0}, ros::Time(0)), "test", true);
+  pf::test::ScanSimulator lidar{grid_, laserSpec({0.1, 0.0, 0.0})};
+  const pf::Pose2 truth{1.0, 1.5, 0.2};
+  config_.initial_pose = pf::Pose2{1.05, 1.45, 0.22};
+  config_.initial_cov = Eigen::Vector3d(0.0025, 0.0025, 0.001).asDiagonal();
+  ScanLocalizer localizer(config_, &tf_);
+  ASSERT_EQ(localizer.setMap(map_), "");
+  for (int i = 0; i < 5; ++i) {
+    const ros::Time stamp(10.0 + i);
+    tf_.setTransform(transform("odom", "base_link", {}, stamp), "test");
+    tf_.setTransform(transform("odom", "base_link", {}, stamp + ros::Duration(0.01)), "test");
+    const ScanResult r = localizer.processCloud(cloudOfWalls(lidar.scanFrom(truth), stamp), 0);
+    ASSERT_EQ(r.error, ScanError::kNone) << errorMessage(r);
+    ASSERT_TRUE(r.report.updated) << pf::skipMessage(r.report);
+    EXPECT_GT(r.report.beams_used, 30);
+  }
+  const pf::Pose2 e = localizer.filter().estimate().pose;
+  EXPECT_LT(std::hypot(e.x - truth.x, e.y - truth.y), 0.02);
+  EXPECT_LT(std::fabs(pf::angleDiff(e.yaw, truth.yaw)), 0.01);
+}
+
+TEST_F(ScanLocalizerTest, ACloudWithoutZSaysSo) {
+  tf_.setTransform(transform("base_link", "velodyne", {}, ros::Time(0)), "test", true);
+  tf_.setTransform(transform("odom", "base_link", {}, ros::Time(10)), "test");
+  config_.initial_pose = pf::Pose2{1.0, 1.5, 0.0};
+  ScanLocalizer localizer(config_, &tf_);
+  ASSERT_EQ(localizer.setMap(map_), "");
+  sensor_msgs::PointCloud2 cloud = cloudOfWalls(scans_.scanFrom({1.0, 1.5, 0.0}), ros::Time(10));
+  cloud.fields.pop_back();
+  const ScanResult r = localizer.processCloud(cloud, 0);
+  EXPECT_EQ(r.error, ScanError::kBadCloud);
+  EXPECT_NE(r.error_detail.find("'z'"), std::string::npos) << r.error_detail;
 }
 
 }  // namespace

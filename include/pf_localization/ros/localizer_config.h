@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "pf_localization/core/cloud_scan.h"
 #include "pf_localization/core/parameter_table.h"
 #include "pf_localization/core/particle_filter.h"
 
@@ -44,6 +45,8 @@ struct LocalizerConfig {
   // one, amcl's `scan`, or several, whose scans one update weighs together
   // (ScanLocalizer::processScan).
   std::string scan_topics = "scan";
+  // How a 3D lidar's or depth camera's cloud becomes a scan (ScanLocalizer::processCloud).
+  pf::CloudScanParams cloud;
   std::optional<pf::Pose2> initial_pose;  // none: global localization
   Eigen::Matrix3d initial_cov = Eigen::Vector3d(0.25, 0.25, 0.0685).asDiagonal();
   pf::ParticleFilterParams filter;

@@ -11,6 +11,7 @@
 #include <nav_msgs/OccupancyGrid.h>
 #include <nav_msgs/Odometry.h>
 #include <sensor_msgs/LaserScan.h>
+#include <sensor_msgs/PointCloud2.h>
 #include <tf2/buffer_core.h>
 
 #include <optional>
@@ -29,6 +30,7 @@ enum class ScanError {
   kEmptyLaserFrame,  // the scan's frame_id is empty: nothing to place the laser by
   kNoLaserMounting,  // tf has no base -> laser transform (the laser's mounting)
   kNoOdometry,       // tf has no odom -> base transform at the scan's stamp
+  kBadCloud,         // a point cloud that cannot be read (point_cloud.h: which field, which type)
 };
 
 /// A few words for `error`, e.g. "no odometry at the scan's stamp".
@@ -86,6 +88,12 @@ class ScanLocalizer {
   /// odometry (core/scan_group.h): two half views score as one full view.
   ScanResult processScan(const sensor_msgs::LaserScan& scan, std::size_t sensor = 0);
 
+  /// The same for a 3D lidar's or a depth camera's cloud of sensor `sensor`
+  /// (an index of its own, after the scan topics'): reduced to a scan by
+  /// config().cloud (core/cloud_scan.h) from its 3D mounting in tf, then
+  /// weighed like any other sensor's scan.
+  ScanResult processCloud(const sensor_msgs::PointCloud2& cloud, std::size_t sensor);
+
   /// map -> odom to publish, stamped `stamp` (the caller adds transform_tolerance).
   std::optional<geometry_msgs::TransformStamped> mapToOdom(const ros::Time& stamp) const;
   /// The estimate with covariance, stamped `stamp`, in the global frame.
@@ -97,6 +105,14 @@ class ScanLocalizer {
   geometry_msgs::PoseArray particleCloud(const ros::Time& stamp, std::size_t max_poses) const;
 
  private:
+  // tf's mounting of `frame` on the base and the odometry at `stamp`, into
+  // `result` (its error when either is missing).
+  std::optional<geometry_msgs::TransformStamped> lookUp(const std::string& frame,
+                                                        const ros::Time& stamp,
+                                                        ScanResult* result) const;
+  // The filter update on `scan` of `sensor` with the other sensors' latest.
+  void update(pf::LaserScan scan, std::size_t sensor, const ros::Time& stamp, ScanResult* result);
+
   // A sensor's latest scan, as the filter takes it, and the odometry at its stamp.
   struct SensorScan {
     pf::LaserScan scan;
@@ -113,6 +129,8 @@ class ScanLocalizer {
   bool had_map_ = false;
   std::vector<std::optional<SensorScan>> latest_;  // per sensor
   std::vector<pf::LaserScan> group_;               // the scans of the current update
+  pf::CloudScanReducer cloud_reducer_;
+  std::vector<pf::CloudPoint> cloud_points_;  // scratch of processCloud
 };
 
 /// s: a scan of another sensor older than this is not used (a sensor that
