@@ -3,9 +3,9 @@
 #include <Eigen/LU>  // determinant()
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 #include <utility>
 #include <vector>
-#include <stdexcept>
 
 #include "pf_localization/core/fast_atan2.h"
 #include "pf_localization/core/parameter_check.h"

@@ -149,6 +149,12 @@ pf_ros::LocalizerConfig makeConfig(const Options& o) {
     }
     if (o.max_beams != 0) c.filter.sensor.max_beams = o.max_beams;
     if (o.seed >= 0) c.filter.seed = static_cast<uint64_t>(o.seed);
+    // The sensors by their topics, for the sensor health (and pf_node's names).
+    c.scan_topics.clear();
+    for (const std::string& t : o.scan_topics)
+      c.scan_topics += (c.scan_topics.empty() ? "" : " ") + t;
+    for (const std::string& t : o.cloud_topics)
+      c.scan_topics += (c.scan_topics.empty() ? "" : " ") + t;
     pf::validate(c.filter);
     return c;
   } catch (const std::exception& e) {
@@ -305,6 +311,9 @@ class Replay {
   void logUpdate(double t, const pf_ros::ScanResult& r, double cpu);
   void dumpParticles(double t);
   void writeCovariance(double t);
+  // A sensor that went missing or came back: one line on stderr, as pf_node's
+  // diagnostics name it.
+  void reportSensors(double t);
 
   const Options& opt_;
   const pf_ros::LocalizerConfig& config_;
@@ -318,6 +327,7 @@ class Replay {
   std::optional<geometry_msgs::PoseWithCovarianceStamped> published_;
   RunCounts counts_;
   double first_stamp_ = -1.0;
+  std::string missing_;  // the sensors missing as last reported
 };
 
 void Replay::run(const rosbag::Bag& bag) {
@@ -391,6 +401,7 @@ void Replay::process(const Pending& pending) {
       std::cerr << "\npf_bag_runner: warning: " << pf_ros::errorMessage(r) << "\n";
     return;
   }
+  reportSensors(t);
   if (r.report.updated) {
     if (outputs_.cov) published_ = localizer_.estimate(header.stamp);
     ++counts_.updates;
@@ -407,6 +418,15 @@ void Replay::process(const Pending& pending) {
                << std::cos(pose.yaw / 2) << "\n";
   if (outputs_.cov) writeCovariance(t);
   ++counts_.written;
+}
+
+void Replay::reportSensors(double t) {
+  const std::string missing = localizer_.sensorHealth().missing(t);
+  if (missing == missing_) return;
+  std::cerr << "\npf_bag_runner: t=" << std::fixed << std::setprecision(1) << t - first_stamp_
+            << " s: " << (missing.empty() ? "every sensor is back" : "missing: " + missing) << "\n";
+  std::cerr.unsetf(std::ios::floatfield);
+  missing_ = missing;
 }
 
 // One line of the covariance file: the published message's x, y, yaw terms.

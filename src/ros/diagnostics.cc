@@ -70,4 +70,25 @@ diagnostic_msgs::DiagnosticStatus toDiagnosticStatus(const pf::ParticleFilter& f
   return status;
 }
 
+void addSensors(diagnostic_msgs::DiagnosticStatus* status, const pf::SensorHealth& health,
+                double now) {
+  if (health.size() < 2) return;
+  for (const pf::SensorStatus& s : health.status(now)) {
+    char text[128];
+    std::snprintf(text, sizeof text, "%s, %.1f Hz, %.2f s old, %.0f %% readings, %.0f %% fit",
+                  pf::toString(s.state), s.rate_hz, s.age_s, 100.0 * s.valid_share,
+                  100.0 * s.fit_share);
+    diagnostic_msgs::KeyValue kv;
+    kv.key = "sensor " + s.name;
+    kv.value = text;
+    status->values.push_back(kv);
+  }
+  const std::string missing = health.missing(now);
+  if (missing.empty()) return;
+  status->message += "; missing: " + missing;
+  if (status->level < diagnostic_msgs::DiagnosticStatus::WARN) {
+    status->level = diagnostic_msgs::DiagnosticStatus::WARN;
+  }
+}
+
 }  // namespace pf_ros

@@ -53,6 +53,7 @@ void EstimatePublisher::publishConfidence(const ScanLocalizer& localizer, const 
   array.header.stamp = stamp;
   array.status.push_back(toDiagnosticStatus(localizer.filter(), report, name, config_generation));
   timing.addTo(&array.status.front(), dropped, cap);
+  addSensors(&array.status.front(), localizer.sensorHealth(), stamp.toSec());
   diagnostics_pub_.publish(array);
   status_pub_.publish(array.status.front());
   if (const auto line = state_log_.onConfidence(localizer.filter().confidence())) {

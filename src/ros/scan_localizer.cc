@@ -52,7 +52,8 @@ ScanLocalizer::ScanLocalizer(const LocalizerConfig& config, const tf2::BufferCor
       configured_cov_(config.initial_cov),
       tf_(tf),
       filter_(config.filter),
-      cloud_reducer_(config.cloud) {}
+      cloud_reducer_(config.cloud),
+      health_(scanTopics(config)) {}
 
 std::string ScanLocalizer::setMap(const nav_msgs::OccupancyGrid& map) {
   pf::OccupancyGrid grid;
@@ -203,6 +204,19 @@ ScanResult ScanLocalizer::processCloud(const sensor_msgs::PointCloud2& cloud, st
   return result;
 }
 
+// Only with several sensors: one has nothing to compare with, and its scans
+// need no second look.
+void ScanLocalizer::observeHealth(const pf::LaserScan& scan, std::size_t sensor,
+                                  const ros::Time& stamp) {
+  while (health_.size() <= sensor) health_.add("sensor " + std::to_string(health_.size()));
+  const pf::SensorModel* model = filter_.sensorModel();
+  const pf::PreparedScan prepared = model->prepare(scan);
+  const double fit = model->hitFraction(prepared, filter_.estimate().pose,
+                                        filter_.params().confidence.hit_distance);
+  health_.observe(sensor, stamp.toSec(), scan.ranges.size(),
+                  scan.ranges.size() - static_cast<std::size_t>(prepared.dropped), fit);
+}
+
 void ScanLocalizer::update(pf::LaserScan scan, std::size_t sensor, const ros::Time& stamp,
                            ScanResult* result) {
   group_.clear();
@@ -218,6 +232,7 @@ void ScanLocalizer::update(pf::LaserScan scan, std::size_t sensor, const ros::Ti
     group_.back().robot_offset = pf::between(*result->odom, s->odom);
   }
   result->report = filter_.update(*result->odom, group_);
+  if (latest_.size() > 1) observeHealth(group_.front(), sensor, stamp);
   latest_[sensor] = SensorScan{std::move(group_.front()), *result->odom, stamp, false};
   if (result->report.updated) {
     for (std::optional<SensorScan>& s : latest_) {

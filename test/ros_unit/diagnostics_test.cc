@@ -57,5 +57,28 @@ TEST(Diagnostics, UninitialisedFilterIsLost) {
   EXPECT_EQ(values(status).at("state"), "lost");
 }
 
+TEST(Diagnostics, SeveralSensorsAreListedAndAMissingOneNamed) {
+  diagnostic_msgs::DiagnosticStatus status;
+  status.level = diagnostic_msgs::DiagnosticStatus::OK;
+  status.message = "localized: fits";
+  pf::SensorHealth health({"scan_front", "scan_rear"});
+  for (int i = 0; i <= 10; ++i) {
+    health.observe(0, 0.1 * i, 541, 0, 0.0);  // covered
+    health.observe(1, 0.1 * i, 541, 530, 0.9);
+  }
+  addSensors(&status, health, 1.0);
+  EXPECT_EQ(diagnostic_msgs::DiagnosticStatus::WARN, status.level);
+  EXPECT_EQ("localized: fits; missing: scan_front (blocked: 0 % of its beams read)",
+            status.message);
+  std::map<std::string, std::string> values;
+  for (const auto& kv : status.values) values[kv.key] = kv.value;
+  EXPECT_EQ("ok, 10.0 Hz, 0.00 s old, 98 % readings, 90 % fit", values["sensor scan_rear"]);
+  EXPECT_EQ(1u, values.count("sensor scan_front"));
+  // One sensor: nothing to add.
+  diagnostic_msgs::DiagnosticStatus one;
+  addSensors(&one, pf::SensorHealth({"scan"}), 1.0);
+  EXPECT_TRUE(one.values.empty());
+}
+
 }  // namespace
 }  // namespace pf_ros

@@ -102,6 +102,8 @@ class ParticleFilter {
   /// Throws std::invalid_argument for an empty map.
   bool setMap(const OccupancyGrid& grid);
   bool hasMap() const { return sensor_.hasModel(); }
+  /// The sensor model on the map; null without a map.
+  const SensorModel* sensorModel() const { return sensor_.get(); }
   const OccupancyGrid* map() const {
     return sensor_.hasModel() ? &sensor_.model().field().grid() : nullptr;
   }

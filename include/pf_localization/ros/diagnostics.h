@@ -7,6 +7,7 @@
 #include <string>
 
 #include "pf_localization/core/particle_filter.h"
+#include "pf_localization/core/sensor_health.h"
 
 namespace pf_ros {
 
@@ -19,5 +20,12 @@ diagnostic_msgs::DiagnosticStatus toDiagnosticStatus(const pf::ParticleFilter& f
                                                      const pf::UpdateReport& report,
                                                      const std::string& name,
                                                      int config_generation = 0);
+
+/// With several sensors: one value per sensor ("sensor NAME": its state,
+/// rate, age, share of readings and of beams that fit) and, when one is
+/// silent or blocked, its name in the message ("; missing: ...") and at
+/// least WARN. `now` is the time of the stamps (s).
+void addSensors(diagnostic_msgs::DiagnosticStatus* status, const pf::SensorHealth& health,
+                double now);
 
 }  // namespace pf_ros

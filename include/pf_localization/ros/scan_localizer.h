@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "pf_localization/core/particle_filter.h"
+#include "pf_localization/core/sensor_health.h"
 #include "pf_localization/ros/localizer_config.h"
 
 namespace pf_ros {
@@ -54,6 +55,9 @@ class ScanLocalizer {
 
   const LocalizerConfig& config() const { return config_; }
   const pf::ParticleFilter& filter() const { return filter_; }
+  /// Each sensor's rate, age and beams: the scan topics', then any other
+  /// sensor's (a cloud's) as "sensor N" once it gave a scan.
+  const pf::SensorHealth& sensorHealth() const { return health_; }
   pf::ParticleFilter& filter() { return filter_; }
 
   /// Installs or replaces the map. On the first map the filter is initialised
@@ -113,6 +117,9 @@ class ScanLocalizer {
   // The filter update on `scan` of `sensor` with the other sensors' latest.
   void update(pf::LaserScan scan, std::size_t sensor, const ros::Time& stamp, ScanResult* result);
 
+  // Records `scan` of `sensor` in health_.
+  void observeHealth(const pf::LaserScan& scan, std::size_t sensor, const ros::Time& stamp);
+
   // A sensor's latest scan, as the filter takes it, and the odometry at its stamp.
   struct SensorScan {
     pf::LaserScan scan;
@@ -130,6 +137,7 @@ class ScanLocalizer {
   std::vector<std::optional<SensorScan>> latest_;  // per sensor
   std::vector<pf::LaserScan> group_;               // the scans of the current update
   pf::CloudScanReducer cloud_reducer_;
+  pf::SensorHealth health_;
   std::vector<pf::CloudPoint> cloud_points_;  // scratch of processCloud
 };
 
