@@ -136,6 +136,33 @@ void BM_WholeUpdate(benchmark::State& state) {
 }
 BENCHMARK(BM_WholeUpdate)->Args({5000, 60})->Unit(benchmark::kMillisecond);
 
+// The same whole update with the scans of one lidar or two (issue 29: at
+// most 1.5 times the cost of one): the second lidar's scan 50 ms older,
+// placed by its robot_offset, laser_max_beams (60) each.
+void BM_WholeUpdateLidars(benchmark::State& state) {
+  const std::size_t lidars = state.range(0);
+  const pf::OccupancyGrid grid = pillarMap(400);
+  pf::ParticleFilterParams params;
+  params.kld.min_particles = params.kld.max_particles = 5000;
+  params.sensor.max_beams = 60;
+  params.update_min_d = params.update_min_a = 0.0;
+  pf::ParticleFilter filter(params);
+  filter.setMap(grid);
+  filter.initializeGaussian({9.0, 9.0, 0.3}, Eigen::Vector3d(0.01, 0.01, 0.003).asDiagonal());
+  std::vector<pf::LaserScan> scans{castScan(grid, {9.0, 9.0, 0.3}, 360)};
+  if (lidars == 2) {
+    scans.push_back(castScan(grid, {8.99, 9.0, 0.3}, 360));
+    scans.back().robot_offset = {-0.01, 0.0, 0.0};
+  }
+  int k = 0;
+  filter.update({0.0, 0.0, 0.0}, scans);
+  for (auto _ : state) {
+    const double x = 0.02 * ((++k) % 3 - 1);
+    benchmark::DoNotOptimize(filter.update({x, 0.0, 0.0}, scans));
+  }
+}
+BENCHMARK(BM_WholeUpdateLidars)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond);
+
 // A scan of `beams` beams over a full turn, ray cast on `grid` from `pose`
 // in steps of 5 mm: every end point lies on a wall or a pillar.
 pf::LaserScan castScan(const pf::OccupancyGrid& grid, const pf::Pose2& pose, int beams) {
