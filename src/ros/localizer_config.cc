@@ -51,6 +51,17 @@ class YamlParamSource : public TypedParamSource<YamlParamSource> {
     const YAML::Node node = root_[key];
     if (!node || node.IsNull()) return false;
     try {
+      if constexpr (std::is_same_v<T, std::string>) {
+        // A list (scan_topics: [a, b]) as its elements separated by spaces.
+        if (node.IsSequence()) {
+          std::string joined;
+          for (const YAML::Node& element : node) {
+            joined += (joined.empty() ? "" : " ") + element.as<std::string>();
+          }
+          *value = joined;
+          return true;
+        }
+      }
       *value = node.as<T>();
     } catch (const YAML::Exception&) {
       throw std::invalid_argument(path_ + ": parameter " + key + " has the wrong type: expected " +
@@ -165,10 +176,34 @@ class RosParamSource : public TypedParamSource<RosParamSource> {
     *out = static_cast<bool>(v);
     return true;
   }
+  // A text; a number as it reads; a list (scan_topics: [a, b]) as its
+  // elements separated by spaces, as the list parameters take it.
   static bool convert(XmlRpc::XmlRpcValue& v, std::string* out) {
-    if (v.getType() != XmlRpc::XmlRpcValue::TypeString) return false;
-    *out = static_cast<std::string>(v);
-    return true;
+    switch (v.getType()) {
+      case XmlRpc::XmlRpcValue::TypeString:
+        *out = static_cast<std::string>(v);
+        return true;
+      case XmlRpc::XmlRpcValue::TypeInt:
+        *out = std::to_string(static_cast<int>(v));
+        return true;
+      case XmlRpc::XmlRpcValue::TypeDouble:
+        *out = pf::formatNumber(static_cast<double>(v));
+        return true;
+      case XmlRpc::XmlRpcValue::TypeArray: {
+        std::string joined;
+        for (int i = 0; i < v.size(); ++i) {
+          std::string element;
+          if (v[i].getType() == XmlRpc::XmlRpcValue::TypeArray || !convert(v[i], &element)) {
+            return false;
+          }
+          joined += (i > 0 ? " " : "") + element;
+        }
+        *out = joined;
+        return true;
+      }
+      default:
+        return false;
+    }
   }
 
   ros::NodeHandle nh_;
@@ -303,23 +338,52 @@ pf::ParameterTable<C> scanParameters() {
                  I("scan_topics", "topic names",
                    "the lidars' scan topics, separated by spaces: several are weighed together, "
                    "each scan from where its lidar was")
-                     .withNote("e.g. \"scan_front scan_rear\"; one: amcl's scan"))};
+                     .withNote("e.g. \"scan_front scan_rear\"; one: amcl's scan")),
+      pf::member(&C::scan_weights,
+                 I("scan_weights", "weights in (0, 1]",
+                   "how much each of scan_topics counts, in its order, separated by spaces: "
+                   "below 1 for a lidar known to be worse")
+                     .withNote("the last one for the topics after it; e.g. \"1 0.5\""))};
 }
 
-}  // namespace
-
-std::vector<std::string> scanTopics(const LocalizerConfig& config) {
-  std::vector<std::string> topics;
+// The words of `text` between spaces, commas and tabs.
+std::vector<std::string> words(const std::string& text) {
+  std::vector<std::string> out;
   std::string word;
-  for (const char c : config.scan_topics + " ") {
+  for (const char c : text + " ") {
     if (c == ' ' || c == ',' || c == '\t') {
-      if (!word.empty()) topics.push_back(word);
+      if (!word.empty()) out.push_back(word);
       word.clear();
     } else {
       word += c;
     }
   }
-  return topics;
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::string> scanTopics(const LocalizerConfig& config) {
+  return words(config.scan_topics);
+}
+
+std::vector<double> scanWeights(const LocalizerConfig& config) {
+  std::vector<double> weights;
+  for (const std::string& w : words(config.scan_weights)) {
+    char* end = nullptr;
+    const double v = std::strtod(w.c_str(), &end);
+    if (end == w.c_str() || *end != '\0' || !(v > 0.0 && v <= 1.0)) {
+      throw std::invalid_argument(pf::invalidParameterMessage(
+          "scan_weights", "\"" + config.scan_weights + "\"", "numbers in (0, 1], one per topic"));
+    }
+    weights.push_back(v);
+  }
+  if (weights.empty()) {
+    throw std::invalid_argument(pf::invalidParameterMessage(
+        "scan_weights", "\"" + config.scan_weights + "\"", "at least one number in (0, 1]"));
+  }
+  weights.resize(std::max(weights.size(), scanTopics(config).size()), weights.back());
+  return weights;
 }
 
 namespace {
@@ -613,6 +677,7 @@ LocalizerConfig readConfig(const ParamSource& source, const ParamSource* default
 void validate(const LocalizerConfig& c) {
   checkRanges(ownParameters(), c);
   pf::validate(c.cloud);
+  scanWeights(c);  // throws, naming scan_weights
   if (scanTopics(c).empty()) {
     throw std::invalid_argument(pf::invalidParameterMessage(
         "scan_topics", "\"" + c.scan_topics + "\"", "at least one topic name"));

@@ -53,7 +53,8 @@ ScanLocalizer::ScanLocalizer(const LocalizerConfig& config, const tf2::BufferCor
       tf_(tf),
       filter_(config.filter),
       cloud_reducer_(config.cloud),
-      health_(scanTopics(config)) {}
+      health_(scanTopics(config)),
+      weights_(scanWeights(config)) {}
 
 std::string ScanLocalizer::setMap(const nav_msgs::OccupancyGrid& map) {
   pf::OccupancyGrid grid;
@@ -179,6 +180,7 @@ ScanResult ScanLocalizer::processScan(const sensor_msgs::LaserScan& scan, std::s
   result.warning = scanInconsistency(scan);
   pf::LaserScan core = toCore(scan, toPose2(laser->transform));
   core.sweep = sweepMotion(scan, *tf_, config_, *result.odom);
+  if (sensor < weights_.size()) core.weight = weights_[sensor];
   update(std::move(core), sensor, scan.header.stamp, &result);
   return result;
 }

@@ -309,5 +309,34 @@ restore_defaults: false
   }
 }
 
+TEST(AmclParams, ScanTopicsAndTheirWeights) {
+  ConfigNotes notes;
+  const LocalizerConfig c = readConfig(
+      *yaml("scan_topics: \"scan_front, scan_rear scan_top\"\nscan_weights: \"1 0.5\"\n"), nullptr,
+      &notes);
+  EXPECT_EQ((std::vector<std::string>{"scan_front", "scan_rear", "scan_top"}), scanTopics(c));
+  // The last weight goes on for the topics after it.
+  EXPECT_EQ((std::vector<double>{1.0, 0.5, 0.5}), scanWeights(c));
+  // YAML lists, as a ROS user writes them.
+  const LocalizerConfig listed = readConfig(
+      *yaml("scan_topics: [scan_front, scan_rear]\nscan_weights: [1, 0.5]\n"), nullptr, &notes);
+  EXPECT_EQ((std::vector<std::string>{"scan_front", "scan_rear"}), scanTopics(listed));
+  EXPECT_EQ((std::vector<double>{1.0, 0.5}), scanWeights(listed));
+  // amcl's single scan, and a weight that does not count.
+  EXPECT_EQ((std::vector<std::string>{"scan"}), scanTopics(LocalizerConfig()));
+  EXPECT_EQ((std::vector<double>{1.0}), scanWeights(LocalizerConfig()));
+  for (const char* bad : {"scan_weights: \"1 0\"\n", "scan_weights: \"1 x\"\n",
+                          "scan_weights: \"1.5\"\n", "scan_topics: \" , \"\n"}) {
+    try {
+      readConfig(*yaml(bad), nullptr, &notes);
+      ADD_FAILURE() << "accepted " << bad;
+    } catch (const std::invalid_argument& e) {
+      const std::string what = e.what();
+      const std::string name = std::string(bad).substr(0, std::string(bad).find(':'));
+      EXPECT_NE(std::string::npos, what.find("invalid parameter " + name + " = ")) << what;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace pf_ros

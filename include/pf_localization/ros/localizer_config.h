@@ -45,6 +45,8 @@ struct LocalizerConfig {
   // one, amcl's `scan`, or several, whose scans one update weighs together
   // (ScanLocalizer::processScan).
   std::string scan_topics = "scan";
+  // How much each of those counts (scanWeights()): the log-likelihood's factor.
+  std::string scan_weights = "1";
   // How a 3D lidar's or depth camera's cloud becomes a scan (ScanLocalizer::processCloud).
   pf::CloudScanParams cloud;
   std::optional<pf::Pose2> initial_pose;  // none: global localization
@@ -67,6 +69,11 @@ struct LocalizerConfig {
 
 /// config.scan_topics as a list: the words between spaces and commas.
 std::vector<std::string> scanTopics(const LocalizerConfig& config);
+
+/// config.scan_weights, one per scan topic (the last given repeated). Throws
+/// std::invalid_argument naming scan_weights for a word that is not a number
+/// in (0, 1], or none.
+std::vector<double> scanWeights(const LocalizerConfig& config);
 
 /// Every parameter of LocalizerConfig, the filter's included, in the order of
 /// config/pf.yaml: amcl's and what a robot, its sensors or a building needs.

@@ -138,6 +138,7 @@ class ScanLocalizer {
   std::vector<pf::LaserScan> group_;               // the scans of the current update
   pf::CloudScanReducer cloud_reducer_;
   pf::SensorHealth health_;
+  std::vector<double> weights_;               // of the scan topics' sensors (scan_weights)
   std::vector<pf::CloudPoint> cloud_points_;  // scratch of processCloud
 };
 
