@@ -121,6 +121,12 @@ std::optional<CloudReadError> readCloud(const sensor_msgs::PointCloud2& msg,
                      std::to_string(msg.row_step) + " need");
   }
 
+  // An empty cloud has no data for an iterator to point into (UBSan: a
+  // reference bound to a null pointer).
+  if (width * height == 0) {
+    points->clear();
+    return std::nullopt;
+  }
   points->resize(width * height);
   const int points_per_row = static_cast<int>(msg.row_step / msg.point_step);
   sensor_msgs::PointCloud2ConstIterator<float> row_x(msg, "x"), row_y(msg, "y"), row_z(msg, "z");

@@ -35,6 +35,7 @@ sensor_msgs::PointCloud2 xyziCloud(uint32_t width, uint32_t height) {
   sensor_msgs::PointCloud2Modifier modifier(msg);
   modifier.setPointCloud2Fields(4, "x", 1, PointField::FLOAT32, "y", 1, PointField::FLOAT32, "z", 1,
                                 PointField::FLOAT32, "intensity", 1, PointField::FLOAT32);
+  if (width * height == 0) return msg;  // no data for an iterator to point into
   sensor_msgs::PointCloud2Iterator<float> x(msg, "x"), y(msg, "y"), z(msg, "z"),
       i(msg, "intensity");
   for (uint32_t r = 0; r < height; ++r) {
