@@ -27,6 +27,28 @@ constexpr double kMinAxisProjection = 1e-9;
 // a table leg in front of a wall from being averaged with the wall.
 constexpr double kSurfaceDepth = 0.1;
 
+// Each bin's range: the mean distance of the points within kSurfaceDepth of
+// its nearest (`nearest_d2`, squared; +inf: empty), NaN for an empty bin.
+// `kept`: every kept point's bin and squared distance.
+std::vector<float> surfaceRanges(const std::vector<std::pair<int, double>>& kept,
+                                 const std::vector<double>& nearest_d2) {
+  const std::size_t bins = nearest_d2.size();
+  std::vector<double> sum(bins, 0.0);
+  std::vector<int> count(bins, 0);
+  for (const auto& [k, d2] : kept) {
+    const double d = std::sqrt(d2);
+    if (d <= std::sqrt(nearest_d2[k]) + kSurfaceDepth) {
+      sum[k] += d;
+      ++count[k];
+    }
+  }
+  std::vector<float> ranges(bins, std::numeric_limits<float>::quiet_NaN());
+  for (std::size_t k = 0; k < bins; ++k) {
+    if (count[k] > 0) ranges[k] = static_cast<float>(sum[k] / count[k]);
+  }
+  return ranges;
+}
+
 }  // namespace
 
 SensorMount SensorMount::fromRpy(double x, double y, double z, double roll, double pitch,
@@ -159,32 +181,15 @@ CloudScan CloudScanReducer::reduce(const std::vector<CloudPoint>& points,
     if (d2 < nearest_d2[k]) nearest_d2[k] = d2;
     kept.emplace_back(k, d2);
   }
-  // The mean distance of the points of each bin's nearest surface.
-  std::vector<double> sum(bins_, 0.0);
-  std::vector<int> count(bins_, 0);
-  for (const auto& [k, d2] : kept) {
-    const double d = std::sqrt(d2);
-    if (d <= std::sqrt(nearest_d2[k]) + kSurfaceDepth) {
-      sum[k] += d;
-      ++count[k];
-    }
-  }
-
+  const std::vector<float> ranges = surfaceRanges(kept, nearest_d2);
   LaserScan& scan = out.scan;
   scan.angle_min = -M_PI;
   scan.angle_increment = width;
   scan.range_min = params_.min_range;
   scan.range_max = params_.max_range;
   scan.sensor_pose = {t.x(), t.y(), heading};
-  scan.ranges.resize(bins_);
-  for (int k = 0; k < bins_; ++k) {
-    if (nearest_d2[k] == kEmpty) {
-      scan.ranges[k] = std::numeric_limits<float>::quiet_NaN();
-    } else {
-      scan.ranges[k] = static_cast<float>(sum[k] / count[k]);
-      ++n.bins_filled;
-    }
-  }
+  scan.ranges = ranges;
+  for (const float range : ranges) n.bins_filled += std::isfinite(range) ? 1 : 0;
   return out;
 }
 
