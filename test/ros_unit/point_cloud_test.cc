@@ -281,7 +281,9 @@ TEST(CloudBag, FirstCloudAgreesWithTheScanAtTheSamePlace) {
   std::optional<geometry_msgs::Transform> mount;
   for (const rosbag::MessageInstance& m : rosbag::View(bag)) {
     if (!mount && m.getTopic() == "/tf") {
-      for (const auto& t : m.instantiate<tf2_msgs::TFMessage>()->transforms) {
+      // Held: a range-for over the temporary's member would outlive it.
+      const auto tf = m.instantiate<tf2_msgs::TFMessage>();
+      for (const auto& t : tf->transforms) {
         if (t.header.frame_id == "base_link" && t.child_frame_id == "velodyne") {
           mount = t.transform;
         }
