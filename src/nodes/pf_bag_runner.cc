@@ -64,6 +64,7 @@ struct Options {
   std::string bag, map, out, params, log, particles_out, covariance;
   std::vector<std::string> scan_topics;   // empty: /scan
   std::vector<std::string> cloud_topics;  // PointCloud2 topics, sensors after the scan topics
+  std::vector<std::string> sensors;       // both, in that order: a sensor's index is its place
   std::string odom_topic = "/odom";
   std::optional<pf::Pose2> initial_pose;
   int particles = 0, max_beams = 0;
@@ -133,6 +134,8 @@ Options parse(int argc, char** argv) {
   if (o.bag.empty() || o.map.empty() || o.out.empty())
     fail(std::string("--bag, --map and --out are required\n") + kUsage);
   if (o.scan_topics.empty() && o.cloud_topics.empty()) o.scan_topics.push_back("/scan");
+  o.sensors = o.scan_topics;
+  o.sensors.insert(o.sensors.end(), o.cloud_topics.begin(), o.cloud_topics.end());
   return o;
 }
 
@@ -151,10 +154,7 @@ pf_ros::LocalizerConfig makeConfig(const Options& o) {
     if (o.seed >= 0) c.filter.seed = static_cast<uint64_t>(o.seed);
     // The sensors by their topics, for the sensor health (and pf_node's names).
     c.scan_topics.clear();
-    for (const std::string& t : o.scan_topics)
-      c.scan_topics += (c.scan_topics.empty() ? "" : " ") + t;
-    for (const std::string& t : o.cloud_topics)
-      c.scan_topics += (c.scan_topics.empty() ? "" : " ") + t;
+    for (const std::string& t : o.sensors) c.scan_topics += (c.scan_topics.empty() ? "" : " ") + t;
     pf::validate(c.filter);
     return c;
   } catch (const std::exception& e) {
@@ -200,8 +200,7 @@ void openBag(const Options& opt, rosbag::Bag* bag) {
   rosbag::View all(*bag);
   std::set<std::string> topics;
   for (const rosbag::ConnectionInfo* c : all.getConnections()) topics.insert(c->topic);
-  std::vector<std::string> needed_topics = opt.scan_topics;
-  needed_topics.insert(needed_topics.end(), opt.cloud_topics.begin(), opt.cloud_topics.end());
+  std::vector<std::string> needed_topics = opt.sensors;
   needed_topics.push_back("/tf");
   for (const std::string& needed : needed_topics) {
     if (!topics.count(needed)) {
@@ -291,8 +290,7 @@ class Replay {
   const RunCounts& counts() const { return counts_; }
   // What the replay reads: the scans, the odometry and tf.
   std::vector<std::string> topics() const {
-    std::vector<std::string> t = opt_.scan_topics;
-    t.insert(t.end(), opt_.cloud_topics.begin(), opt_.cloud_topics.end());
+    std::vector<std::string> t = opt_.sensors;
     t.insert(t.end(), {opt_.odom_topic, "/tf", "/tf_static"});
     return t;
   }
@@ -371,18 +369,19 @@ void Replay::handle(const rosbag::MessageInstance& m) {
   } else if (m.getTopic() == opt_.odom_topic) {
     const auto odom = m.instantiate<nav_msgs::Odometry>();
     if (odom && !odom_on_tf_) tf_.setTransform(pf_ros::odometryToTransform(*odom), "odom_topic");
-  } else if (const auto scan = m.instantiate<sensor_msgs::LaserScan>()) {
-    const auto topic = std::find(opt_.scan_topics.begin(), opt_.scan_topics.end(), m.getTopic());
-    if (topic == opt_.scan_topics.end()) return;
+  } else {
+    const auto topic = std::find(opt_.sensors.begin(), opt_.sensors.end(), m.getTopic());
+    if (topic == opt_.sensors.end()) return;
+    const auto sensor = static_cast<std::size_t>(topic - opt_.sensors.begin());
+    Pending p{nullptr, nullptr, sensor};
+    if (sensor < opt_.scan_topics.size()) {
+      p.scan = m.instantiate<sensor_msgs::LaserScan>();
+    } else {
+      p.cloud = m.instantiate<sensor_msgs::PointCloud2>();
+    }
+    if (!p.scan && !p.cloud) return;  // another type on the topic
     ++counts_.scans;
-    pending_.push_back({scan, nullptr, static_cast<std::size_t>(topic - opt_.scan_topics.begin())});
-  } else if (const auto cloud = m.instantiate<sensor_msgs::PointCloud2>()) {
-    const auto topic = std::find(opt_.cloud_topics.begin(), opt_.cloud_topics.end(), m.getTopic());
-    if (topic == opt_.cloud_topics.end()) return;
-    ++counts_.scans;
-    pending_.push_back(
-        {nullptr, cloud,
-         opt_.scan_topics.size() + static_cast<std::size_t>(topic - opt_.cloud_topics.begin())});
+    pending_.push_back(p);
   }
 }
 

@@ -180,7 +180,6 @@ ScanResult ScanLocalizer::processScan(const sensor_msgs::LaserScan& scan, std::s
   result.warning = scanInconsistency(scan);
   pf::LaserScan core = toCore(scan, toPose2(laser->transform));
   core.sweep = sweepMotion(scan, *tf_, config_, *result.odom);
-  if (sensor < weights_.size()) core.weight = weights_[sensor];
   update(std::move(core), sensor, scan.header.stamp, &result);
   return result;
 }
@@ -221,6 +220,7 @@ void ScanLocalizer::observeHealth(const pf::LaserScan& scan, std::size_t sensor,
 
 void ScanLocalizer::update(pf::LaserScan scan, std::size_t sensor, const ros::Time& stamp,
                            ScanResult* result) {
+  if (sensor < weights_.size()) scan.weight = weights_[sensor];
   group_.clear();
   group_.push_back(std::move(scan));
   if (latest_.size() <= sensor) latest_.resize(sensor + 1);
