@@ -60,7 +60,7 @@ void checkValue(const ParamInfo& info, double value) {
 
 void checkValue(const ParamInfo& info, const std::string& value) {
   if (info.choices.empty()) {
-    if (!value.empty()) return;
+    if (!value.empty() || info.unset_allowed) return;
     throw std::invalid_argument(invalidParameterMessage(info.name, "''", "a non-empty name"));
   }
   for (const std::string& c : info.choices) {

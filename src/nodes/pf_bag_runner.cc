@@ -139,6 +139,13 @@ Options parse(int argc, char** argv) {
   return o;
 }
 
+// A topic list as the parameters take it: separated by spaces.
+std::string joined(const std::vector<std::string>& topics) {
+  std::string out;
+  for (const std::string& t : topics) out += (out.empty() ? "" : " ") + t;
+  return out;
+}
+
 pf_ros::LocalizerConfig makeConfig(const Options& o) {
   try {
     pf_ros::LocalizerConfig c;
@@ -152,9 +159,9 @@ pf_ros::LocalizerConfig makeConfig(const Options& o) {
     }
     if (o.max_beams != 0) c.filter.sensor.max_beams = o.max_beams;
     if (o.seed >= 0) c.filter.seed = static_cast<uint64_t>(o.seed);
-    // The sensors by their topics, for the sensor health (and pf_node's names).
-    c.scan_topics.clear();
-    for (const std::string& t : o.sensors) c.scan_topics += (c.scan_topics.empty() ? "" : " ") + t;
+    // The sensors by their topics, as pf_node has them (sensorTopics()).
+    c.scan_topics = joined(o.scan_topics);
+    c.cloud_topics = joined(o.cloud_topics);
     pf::validate(c.filter);
     return c;
   } catch (const std::exception& e) {

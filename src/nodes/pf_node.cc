@@ -1,6 +1,7 @@
 // pf_node: the live ROS front door of the particle filter.
 //
-// Subscribes scan, odom, map (latched) and initialpose; publishes map -> odom
+// Subscribes scan (or each of scan_topics, and of cloud_topics: PointCloud2),
+// odom, map (latched) and initialpose; publishes map -> odom
 // on tf, the particles on particlecloud and the estimate on pf_pose and
 // amcl_pose. The localization happens in pf_ros::ScanLocalizer and the core,
 // what goes with the filter (time jumping back, the saved pose, the output)
@@ -89,14 +90,17 @@ class PfNode {
         // which takes filter_mutex_; the thread that dropped it may hold that
         // mutex (its map -> odom reached tf), so the main spinner handles it.
         scan_inputs_(
-            scanTopics(config), buffer_, config.odom_frame, &inline_queue_,
+            scanTopics(config), cloudTopics(config), buffer_, config.odom_frame, &inline_queue_,
             [this](const sensor_msgs::LaserScanConstPtr& scan, std::size_t sensor) {
-              onScan(scan, sensor);
+              onScan(PendingScan{scan, ros::WallTime::now(), ros::Time::now(), sensor, nullptr});
             },
-            [this](const sensor_msgs::LaserScanConstPtr& scan,
+            [this](const sensor_msgs::PointCloud2ConstPtr& cloud, std::size_t sensor) {
+              onScan(PendingScan{nullptr, ros::WallTime::now(), ros::Time::now(), sensor, cloud});
+            },
+            [this](const std_msgs::Header& header,
                    tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
               postCallback(ros::getGlobalCallbackQueue(), reinterpret_cast<uint64_t>(this),
-                           [this, scan, reason] { onScanDropped(scan, reason); });
+                           [this, header, reason] { onScanDropped(header, reason); });
             }) {
     odom_sub_ = nh_.subscribe("odom", 50, &PfNode::onOdom, this);
     tf_watch_sub_ = nh_.subscribe("/tf", 100, &PfNode::onTf, this);
@@ -186,8 +190,8 @@ class PfNode {
   // Once tf has the scan's stamp, on whichever thread brought the scan or
   // the transform that completed it (InlineCallbackQueue): only hands the
   // scan to the filter thread, so that no thread waits here for an update.
-  void onScan(const sensor_msgs::LaserScanConstPtr& scan, std::size_t sensor) {
-    if (!slot_.put(PendingScan{scan, ros::WallTime::now(), ros::Time::now(), sensor})) return;
+  void onScan(PendingScan pending) {
+    if (!slot_.put(std::move(pending))) return;
     const std::uint64_t dropped = slot_.dropped();
     warn_.warn("overload",
                "the filter cannot keep up: a scan waiting for it was dropped for a newer one (" +
@@ -214,7 +218,7 @@ class PfNode {
     }
   }
 
-  void onScanDropped(const sensor_msgs::LaserScanConstPtr& scan,
+  void onScanDropped(const std_msgs::Header& header,
                      tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
     std::lock_guard<std::mutex> lock(filter_mutex_);
     // The first scans after a bag starts over often land here as older than
@@ -224,13 +228,13 @@ class PfNode {
     // the oldest waiting, legitimately older than the last scan used.)
     if (ros::Time::isSimTime()) {
       if (reason == tf2_ros::filter_failure_reasons::OutTheBack &&
-          live_.timeJumpedBack(scan->header.stamp)) {
+          live_.timeJumpedBack(header.stamp)) {
         return;
       }
-      if (!scan->header.frame_id.empty()) live_.clearStaleBuffer(scan->header.frame_id);
+      if (!header.frame_id.empty()) live_.clearStaleBuffer(header.frame_id);
     }
-    warn_.warn("scan dropped " + scan->header.frame_id,
-               scanDropMessage(*scan, reason, config_.base_frame, config_.odom_frame));
+    warn_.warn("scan dropped " + header.frame_id,
+               scanDropMessage(header, reason, config_.base_frame, config_.odom_frame));
   }
 
   void onInitialPose(const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg) {

@@ -124,11 +124,12 @@ void LiveLocalizer::applyParticleCap(std::size_t cap) {
 
 void LiveLocalizer::processScan(const PendingScan& pending, const LatestScanSlot& slot,
                                 const ReconfigureServer& reconfigure) {
-  const sensor_msgs::LaserScan& scan = *pending.scan;
-  if (fromBeforeTheJump(scan.header.stamp)) return;
-  if (timeJumpedBack(scan.header.stamp)) return;
+  const std_msgs::Header& header = pending.header();
+  if (fromBeforeTheJump(header.stamp)) return;
+  if (timeJumpedBack(header.stamp)) return;
   const ros::WallTime start = ros::WallTime::now();
-  const ScanResult result = localizer_.processScan(scan, pending.sensor);
+  const ScanResult result = pending.scan ? localizer_.processScan(*pending.scan, pending.sensor)
+                                         : localizer_.processCloud(*pending.cloud, pending.sensor);
   const double update_s = (ros::WallTime::now() - start).toSec();
   if (result.error != ScanError::kNone) {
     warn_->warn(toString(result.error), errorMessage(result));
@@ -136,16 +137,17 @@ void LiveLocalizer::processScan(const PendingScan& pending, const LatestScanSlot
   }
   if (!result.warning.empty()) warn_->warn("scan inconsistent", result.warning);
   const pf::UpdateReport& r = result.report;
+  const ros::Time& stamp = header.stamp;
   last_odom_ = result.odom;
-  jumps_.scanUsed(scan.header.stamp);
+  jumps_.scanUsed(stamp);
   // map -> odom first: tf users wait for it, nobody waits for the rest.
-  filterChanged(scan.header.stamp);
+  filterChanged(stamp);
   if (r.updated) {
     timing_.addUpdate((ros::WallTime::now() - pending.arrival_wall).toSec(),
-                      (pending.arrival_clock - scan.header.stamp).toSec(), update_s);
+                      (pending.arrival_clock - stamp).toSec(), update_s);
     if (governor_.enabled()) applyParticleCap(governor_.addUpdate(r.particles, update_s));
-    output_.publishEstimate(localizer_, scan.header.stamp, false);
-    output_.publishConfidence(localizer_, scan.header.stamp, r, reconfigure.generation(), timing_,
+    output_.publishEstimate(localizer_, stamp, false);
+    output_.publishConfidence(localizer_, stamp, r, reconfigure.generation(), timing_,
                               slot.dropped(), governor_.cap());
     ROS_DEBUG("pf_node: update with %d beams, %zu particles, ESS %.0f%s in %.1f ms", r.beams_used,
               r.particles, r.ess, r.resampled ? ", resampled" : "", update_s * 1e3);

@@ -338,11 +338,19 @@ pf::ParameterTable<C> scanParameters() {
                  I("scan_topics", "topic names",
                    "the lidars' scan topics, separated by spaces: several are weighed together, "
                    "each scan from where its lidar was")
-                     .withNote("e.g. \"scan_front scan_rear\"; one: amcl's scan")),
+                     .withNote("e.g. \"scan_front scan_rear\"; one: amcl's scan")
+                     .unsetMeans("no lidar: cloud_topics alone")),
+      pf::member(&C::cloud_topics,
+                 I("cloud_topics", "topic names",
+                   "3D lidars' and depth cameras' PointCloud2 topics, separated by spaces: "
+                   "each cut to the cloud height band, reduced to a scan and weighed with the "
+                   "lidars")
+                     .withNote("e.g. \"points\"")
+                     .unsetMeans("none")),
       pf::member(&C::scan_weights,
                  I("scan_weights", "weights in (0, 1]",
-                   "how much each of scan_topics counts, in its order, separated by spaces: "
-                   "below 1 for a lidar known to be worse")
+                   "how much each sensor counts, scan_topics then cloud_topics, separated by "
+                   "spaces: below 1 for a sensor known to be worse")
                      .withNote("the last one for the topics after it; e.g. \"1 0.5\""))};
 }
 
@@ -367,6 +375,16 @@ std::vector<std::string> scanTopics(const LocalizerConfig& config) {
   return words(config.scan_topics);
 }
 
+std::vector<std::string> cloudTopics(const LocalizerConfig& config) {
+  return words(config.cloud_topics);
+}
+
+std::vector<std::string> sensorTopics(const LocalizerConfig& config) {
+  std::vector<std::string> topics = scanTopics(config);
+  for (std::string& t : cloudTopics(config)) topics.push_back(std::move(t));
+  return topics;
+}
+
 std::vector<double> scanWeights(const LocalizerConfig& config) {
   std::vector<double> weights;
   for (const std::string& w : words(config.scan_weights)) {
@@ -382,7 +400,7 @@ std::vector<double> scanWeights(const LocalizerConfig& config) {
     throw std::invalid_argument(pf::invalidParameterMessage(
         "scan_weights", "\"" + config.scan_weights + "\"", "at least one number in (0, 1]"));
   }
-  weights.resize(std::max(weights.size(), scanTopics(config).size()), weights.back());
+  weights.resize(std::max(weights.size(), sensorTopics(config).size()), weights.back());
   return weights;
 }
 
@@ -678,9 +696,10 @@ void validate(const LocalizerConfig& c) {
   checkRanges(ownParameters(), c);
   pf::validate(c.cloud);
   scanWeights(c);  // throws, naming scan_weights
-  if (scanTopics(c).empty()) {
-    throw std::invalid_argument(pf::invalidParameterMessage(
-        "scan_topics", "\"" + c.scan_topics + "\"", "at least one topic name"));
+  if (sensorTopics(c).empty()) {
+    throw std::invalid_argument(
+        pf::invalidParameterMessage("scan_topics", "\"" + c.scan_topics + "\"",
+                                    "at least one topic name (or one in cloud_topics)"));
   }
   pf::validate(c.filter);
 }

@@ -44,7 +44,8 @@ std::string literal(double v) {
 }
 std::string literal(int v) { return std::to_string(v); }
 std::string literal(bool v) { return v ? "true" : "false"; }
-std::string literal(const std::string& v) { return v; }
+// An empty text as YAML reads it (a bare "name:" would be null).
+std::string literal(const std::string& v) { return v.empty() ? "\"\"" : v; }
 
 std::string defaultText(const Row& p) {
   const LocalizerConfig defaults;

@@ -23,12 +23,12 @@ std::string failureText(tf2_ros::filter_failure_reasons::FilterFailureReason rea
 
 }  // namespace
 
-std::string scanDropMessage(const sensor_msgs::LaserScan& scan,
+std::string scanDropMessage(const std_msgs::Header& header,
                             tf2_ros::filter_failure_reasons::FilterFailureReason reason,
                             const std::string& base_frame, const std::string& odom_frame) {
-  return "scan dropped: " + failureText(reason) + ". It needs tf from '" + scan.header.frame_id +
-         "' to '" + base_frame + "' (the laser's mounting) and '" + base_frame + "' to '" +
-         odom_frame + "' (odometry) at t=" + std::to_string(scan.header.stamp.toSec()) +
+  return "scan dropped: " + failureText(reason) + ". It needs tf from '" + header.frame_id +
+         "' to '" + base_frame + "' (the sensor's mounting) and '" + base_frame + "' to '" +
+         odom_frame + "' (odometry) at t=" + std::to_string(header.stamp.toSec()) +
          "; check that both are published";
 }
 

@@ -53,7 +53,7 @@ ScanLocalizer::ScanLocalizer(const LocalizerConfig& config, const tf2::BufferCor
       tf_(tf),
       filter_(config.filter),
       cloud_reducer_(config.cloud),
-      health_(scanTopics(config)),
+      health_(sensorTopics(config)),
       weights_(scanWeights(config)) {}
 
 std::string ScanLocalizer::setMap(const nav_msgs::OccupancyGrid& map) {

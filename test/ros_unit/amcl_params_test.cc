@@ -338,5 +338,28 @@ TEST(AmclParams, ScanTopicsAndTheirWeights) {
   }
 }
 
+TEST(AmclParams, CloudTopicsAreSensorsAfterTheScanTopics) {
+  ConfigNotes notes;
+  const LocalizerConfig both = readConfig(
+      *yaml("scan_topics: scan_front\ncloud_topics: \"points depth\"\nscan_weights: \"1 0.5\"\n"),
+      nullptr, &notes);
+  EXPECT_EQ((std::vector<std::string>{"points", "depth"}), cloudTopics(both));
+  EXPECT_EQ((std::vector<std::string>{"scan_front", "points", "depth"}), sensorTopics(both));
+  EXPECT_EQ((std::vector<double>{1.0, 0.5, 0.5}), scanWeights(both));
+  // None by default; clouds alone once scan_topics is empty.
+  EXPECT_TRUE(cloudTopics(LocalizerConfig()).empty());
+  const LocalizerConfig clouds =
+      readConfig(*yaml("scan_topics: \"\"\ncloud_topics: points\n"), nullptr, &notes);
+  EXPECT_EQ((std::vector<std::string>{"points"}), sensorTopics(clouds));
+  // No sensor at all is refused, naming the parameter.
+  try {
+    readConfig(*yaml("scan_topics: \"\"\n"), nullptr, &notes);
+    ADD_FAILURE() << "accepted a configuration without a sensor";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string::npos, std::string(e.what()).find("invalid parameter scan_topics = "))
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace pf_ros

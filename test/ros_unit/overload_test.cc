@@ -19,7 +19,7 @@ namespace {
 PendingScan scanStamped(double t, std::size_t sensor = 0) {
   auto scan = boost::make_shared<sensor_msgs::LaserScan>();
   scan->header.stamp = ros::Time(t);
-  return PendingScan{scan, ros::WallTime(t), ros::Time(t), sensor};
+  return PendingScan{scan, ros::WallTime(t), ros::Time(t), sensor, nullptr};
 }
 
 TEST(LatestScanSlot, TheNewestScanWinsAndTheOlderOneIsCounted) {

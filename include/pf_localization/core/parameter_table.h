@@ -72,9 +72,11 @@ struct ParamInfo {
   ParamInfo& oneOf(std::vector<std::string> words) { return choices = std::move(words), *this; }
   /// How to read special values, appended to the range in messages ("0: off").
   ParamInfo& withNote(std::string text) { return note = std::move(text), *this; }
-  /// A number that may also be unset (NaN or absent), which means `meaning`.
+  /// A number that may also be unset (NaN or absent), or a text that may be
+  /// empty, which means `meaning`.
   ParamInfo& unsetMeans(std::string meaning) {
-    return unset_allowed = true, note = "unset: " + std::move(meaning), *this;
+    note += (note.empty() ? "unset: " : "; unset: ") + std::move(meaning);
+    return unset_allowed = true, *this;
   }
 
   std::string name;
@@ -86,7 +88,7 @@ struct ParamInfo {
   std::string amcl_name;             // with Amcl::kAlias
   std::vector<std::string> choices;  // empty: any non-empty text
   std::string note;
-  bool unset_allowed = false;  // NaN is in range
+  bool unset_allowed = false;  // NaN is in range; a text may be empty
   double slider_min = 0.0;
   double slider_max = 0.0;
   std::string group;  // the section it is listed in (config/pf.yaml, the .cfg's groups)

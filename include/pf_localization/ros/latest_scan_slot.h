@@ -9,6 +9,8 @@
 
 #include <ros/time.h>
 #include <sensor_msgs/LaserScan.h>
+#include <sensor_msgs/PointCloud2.h>
+#include <std_msgs/Header.h>
 
 #include <condition_variable>
 #include <cstdint>
@@ -18,12 +20,15 @@
 
 namespace pf_ros {
 
-/// A scan as it arrived at the node.
+/// A scan, or a 3D sensor's cloud, as it arrived at the node.
 struct PendingScan {
-  sensor_msgs::LaserScanConstPtr scan;
-  ros::WallTime arrival_wall;  // for the latency (scan arrival -> its map -> odom)
-  ros::Time arrival_clock;     // the node's clock (sim time in a bag), for the scan's age
-  std::size_t sensor = 0;      // which scan topic it came on (scanTopics()' index)
+  sensor_msgs::LaserScanConstPtr scan;  // a lidar's scan; empty for a cloud
+  ros::WallTime arrival_wall;           // for the latency (scan arrival -> its map -> odom)
+  ros::Time arrival_clock;              // the node's clock (sim time in a bag), for the scan's age
+  std::size_t sensor = 0;               // which topic it came on (sensorTopics()' index)
+  sensor_msgs::PointCloud2ConstPtr cloud;  // a 3D sensor's cloud, when scan is empty
+
+  const std_msgs::Header& header() const { return scan ? scan->header : cloud->header; }
 };
 
 class LatestScanSlot {

@@ -45,7 +45,11 @@ struct LocalizerConfig {
   // one, amcl's `scan`, or several, whose scans one update weighs together
   // (ScanLocalizer::processScan).
   std::string scan_topics = "scan";
-  // How much each of those counts (scanWeights()): the log-likelihood's factor.
+  // The topics of 3D lidars and depth cameras (PointCloud2), the same way
+  // (cloudTopics()); none by default. Their sensors come after the scan topics'.
+  std::string cloud_topics = "";
+  // How much each sensor counts, scan topics then cloud topics (scanWeights()):
+  // the log-likelihood's factor.
   std::string scan_weights = "1";
   // How a 3D lidar's or depth camera's cloud becomes a scan (ScanLocalizer::processCloud).
   pf::CloudScanParams cloud;
@@ -69,8 +73,12 @@ struct LocalizerConfig {
 
 /// config.scan_topics as a list: the words between spaces and commas.
 std::vector<std::string> scanTopics(const LocalizerConfig& config);
+/// config.cloud_topics, the same way.
+std::vector<std::string> cloudTopics(const LocalizerConfig& config);
+/// Every sensor's topic, by its index: the scan topics, then the cloud topics.
+std::vector<std::string> sensorTopics(const LocalizerConfig& config);
 
-/// config.scan_weights, one per scan topic (the last given repeated). Throws
+/// config.scan_weights, one per sensor (the last given repeated). Throws
 /// std::invalid_argument naming scan_weights for a word that is not a number
 /// in (0, 1], or none.
 std::vector<double> scanWeights(const LocalizerConfig& config);

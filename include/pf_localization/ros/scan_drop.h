@@ -4,16 +4,16 @@
 // filter thread), so that the filter yields the CPU to tf and odometry.
 #pragma once
 
-#include <sensor_msgs/LaserScan.h>
+#include <std_msgs/Header.h>
 #include <tf2_ros/message_filter.h>
 
 #include <string>
 
 namespace pf_ros {
 
-/// The warning for `scan` dropped for `reason`, the robot's frames being
-/// `base_frame` and `odom_frame`.
-std::string scanDropMessage(const sensor_msgs::LaserScan& scan,
+/// The warning for a scan or cloud with `header` dropped for `reason`, the
+/// robot's frames being `base_frame` and `odom_frame`.
+std::string scanDropMessage(const std_msgs::Header& header,
                             tf2_ros::filter_failure_reasons::FilterFailureReason reason,
                             const std::string& base_frame, const std::string& odom_frame);
 

@@ -55,8 +55,8 @@ class ScanLocalizer {
 
   const LocalizerConfig& config() const { return config_; }
   const pf::ParticleFilter& filter() const { return filter_; }
-  /// Each sensor's rate, age and beams: the scan topics', then any other
-  /// sensor's (a cloud's) as "sensor N" once it gave a scan.
+  /// Each sensor's rate, age and beams, named by sensorTopics() (a sensor
+  /// index beyond those as "sensor N", once it gave a scan).
   const pf::SensorHealth& sensorHealth() const { return health_; }
   pf::ParticleFilter& filter() { return filter_; }
 
@@ -138,7 +138,7 @@ class ScanLocalizer {
   std::vector<pf::LaserScan> group_;               // the scans of the current update
   pf::CloudScanReducer cloud_reducer_;
   pf::SensorHealth health_;
-  std::vector<double> weights_;               // of the scan topics' sensors (scan_weights)
+  std::vector<double> weights_;               // of sensorTopics()' sensors (scan_weights)
   std::vector<pf::CloudPoint> cloud_points_;  // scratch of processCloud
 };
 
