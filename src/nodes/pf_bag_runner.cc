@@ -257,7 +257,7 @@ void openOutputs(const Options& opt, Outputs* o) {
     if (!o->log) fail(opt.log + ": cannot write");
     o->log << "t,particles,ess,cpu_ms,mean_beam_likelihood,std_x,std_y,std_yaw,updated,injected,"
               "tempering,hit_fraction,rivals,state,refined,refine_translation,refine_rotation,"
-              "refine_rms,refine_matched,fault_fraction\n";
+              "refine_rms,refine_matched,fault_fraction,missing\n";
   }
   if (!opt.particles_out.empty()) {
     o->dump.open(opt.particles_out);
@@ -314,6 +314,7 @@ class Replay {
   };
   void process(const Pending& pending);
   void logUpdate(double t, const pf_ros::ScanResult& r, double cpu);
+  std::string missingNames(double t) const;
   void dumpParticles(double t);
   void writeCovariance(double t);
   // A sensor that went missing or came back: one line on stderr, as pf_node's
@@ -426,6 +427,16 @@ void Replay::process(const Pending& pending) {
   ++counts_.written;
 }
 
+// The sensors missing at `t`, by name, separated by spaces (the log's column).
+std::string Replay::missingNames(double t) const {
+  std::string names;
+  for (const pf::SensorStatus& s : localizer_.sensorHealth().status(t)) {
+    if (s.state != pf::SensorState::kSilent && s.state != pf::SensorState::kBlocked) continue;
+    names += (names.empty() ? "" : " ") + s.name;
+  }
+  return names;
+}
+
 void Replay::reportSensors(double t) {
   const std::string missing = localizer_.sensorHealth().missing(t);
   if (missing == missing_) return;
@@ -463,7 +474,7 @@ void Replay::logUpdate(double t, const pf_ros::ScanResult& r, double cpu) {
                << pf::toString(conf.state) << "," << r.report.refinement.accepted << ","
                << r.report.refinement.translation << "," << r.report.refinement.rotation << ","
                << r.report.refinement.rms_distance << "," << r.report.refinement.matched_beams
-               << "," << r.report.fault_fraction << "\n";
+               << "," << r.report.fault_fraction << "," << missingNames(t) << "\n";
 }
 
 void Replay::dumpParticles(double t) {

@@ -115,8 +115,9 @@ def read_bag_reference(path, topic='/ground_truth'):
 
 
 def read_update_log(path):
-    """Runner's CSV (t,particles,ess,cpu_ms,mean_beam_likelihood,std_x,std_y,std_yaw,updated)
-    -> dict column -> float array; absent or non-numeric columns are simply missing."""
+    """Runner's CSV (t,particles,ess,cpu_ms,mean_beam_likelihood,std_x,std_y,std_yaw,updated,...)
+    -> dict column -> float array (state and missing: strings); absent or non-numeric columns are
+    simply missing."""
     _need_file(path, 'update log')
     with open(path, newline='') as f:
         rows = list(csv.DictReader(f))
@@ -130,8 +131,8 @@ def read_update_log(path):
             cols[name.strip()] = np.array([float(r[name]) if r[name] not in (None, '') else np.nan
                                            for r in rows])
         except ValueError:
-            if name.strip() == 'state':  # localized / uncertain / lost
-                cols['state'] = np.array([(r[name] or '').strip() for r in rows])
+            if name.strip() in ('state', 'missing'):  # localized / uncertain / lost; sensor names
+                cols[name.strip()] = np.array([(r[name] or '').strip() for r in rows])
     if 't' not in cols:
         raise EvalError('update log %s: column "t" is not numeric' % path)
     return cols
@@ -444,7 +445,23 @@ def log_metrics(log):
                  particles_max=int(np.nanmax(log['particles'])))
     if 'ess' in log:
         m['ess_mean'] = float(np.nanmean(log['ess']))
+    if 'missing' in log:
+        m['sensors_missing'] = missing_sensors(log)
     return m
+
+
+def missing_sensors(log):
+    """Each sensor the log names as missing (silent or blocked): its share of the log's rows and the
+    stretches it was missing, [from, to] in s since the log's first row."""
+    t = log['t'] - log['t'][0] if len(log['t']) else log['t']
+    rows = [set(v.split()) for v in log['missing']]
+    out = {}
+    for name in sorted(set().union(*rows)) if rows else []:
+        on = np.array([name in r for r in rows])
+        edges = np.flatnonzero(np.diff(np.concatenate(([0], on.astype(int), [0]))))
+        out[name] = {'share': float(on.mean()),
+                     'stretches_s': [[float(t[a]), float(t[b - 1])] for a, b in zip(edges[::2], edges[1::2])]}
+    return out
 
 
 # -------------------------------------------------------------------------------------- plots
@@ -792,6 +809,9 @@ def describe(m, summary):
                      % (m['confidently_wrong_updates'], m['confidently_wrong_threshold_m']))
     if 'covariance' in m:
         lines.append(describe_covariance(m['covariance']))
+    for name, v in m.get('sensors_missing', {}).items():
+        lines.append('  sensor missing: %s in %.0f %% of the updates (%s s)' % (
+            name, 100 * v['share'], ', '.join('%.1f-%.1f' % tuple(x) for x in v['stretches_s'])))
     if 'cpu_ms_mean' in m:
         lines.append('  update CPU:     mean %.2f ms  p95 %.2f ms  (%d log rows)'
                      % (m['cpu_ms_mean'], m['cpu_ms_p95'], m['n_log_rows']))

@@ -334,7 +334,30 @@ def load_distance_map(yaml_path):
 # ------------------------------------------------------------------------------- scores
 def self_supervised(traj, log, data, dmap, fit_distance=FIT_DISTANCE):
     """The self-supervised loss of one run (lower is better) and its parts. traj: (N, 4) t, x, y, yaw
-    of the published poses; log: the runner's update log (dict of columns) or None."""
+    of the published poses; log: the runner's update log (dict of columns) or None; data: one scan
+    topic's read_bag_data, or a list of them (a robot with several lidars: the fit is over all their
+    scans, the jumps are counted at the first one's)."""
+    datas = data if isinstance(data, list) else [data]
+    fits, poses = zip(*(scan_fits(traj, d, dmap, fit_distance) for d in datas))
+    fits = np.concatenate(fits)
+    counted = ~np.isnan(fits)  # scans without any valid beam say nothing
+    fit = float(fits[counted].mean()) if counted.any() else 0.0
+    n = len(fits)
+    jumps = count_jumps(poses[0], datas[0])
+    lost = uncertain = 0.0
+    if log is not None and 'state' in log and len(log['state']):
+        states = log['state']
+        lost = float(np.mean(states == 'lost'))
+        uncertain = float(np.mean(states == 'uncertain'))
+    jump_pen = min(1.0, JUMP_WEIGHT * jumps / max(n, 1))
+    loss = (1.0 - fit) + LOST_WEIGHT * lost + UNCERTAIN_WEIGHT * uncertain + jump_pen
+    return loss, {'fit': fit, 'lost_share': lost, 'uncertain_share': uncertain, 'jumps': jumps,
+                  'scans': n, 'scans_with_pose': int(sum(np.isfinite(p[:, 0]).sum() for p in poses))}
+
+
+def scan_fits(traj, data, dmap, fit_distance):
+    """Per scan of data: the share of its valid beams that end near an occupied cell from the
+    published pose at its stamp (0 without one, NaN without a valid beam), and that pose."""
     dist, res, ox, oy = dmap
     st = data['t']
     n = len(st)
@@ -366,10 +389,13 @@ def self_supervised(traj, log, data, dmap, fit_distance=FIT_DISTANCE):
         hit = np.zeros(nv, dtype=bool)
         hit[inside] = dist[cy[inside], cx[inside]] <= fit_distance
         fits[i] = hit.mean()
-    counted = ~np.isnan(fits)  # scans without any valid beam say nothing
-    fit = float(fits[counted].mean()) if counted.any() else 0.0
-    # Jumps of map -> odom, measured where the robot is: the published pose against the previous
-    # one moved by the odometry between the two scans (a far odom origin does not magnify them).
+    return fits, pose
+
+
+def count_jumps(pose, data):
+    """Jumps of map -> odom, measured where the robot is: the published pose against the previous
+    one moved by the odometry between the two scans (a far odom origin does not magnify them)."""
+    st = data['t']
     jumps = 0
     if len(data['odom_t']) >= 2:
         ot, op = data['odom_t'], data['odom']
@@ -389,15 +415,7 @@ def self_supervised(traj, log, data, dmap, fit_distance=FIT_DISTANCE):
             d = np.hypot(e[1:, 0] - px, e[1:, 1] - py)
             da = np.abs(wrap(e[1:, 2] - (e[:-1, 2] + dyaw)))
             jumps = int(np.sum((d > JUMP_M) | (da > JUMP_RAD)))
-    lost = uncertain = 0.0
-    if log is not None and 'state' in log and len(log['state']):
-        states = log['state']
-        lost = float(np.mean(states == 'lost'))
-        uncertain = float(np.mean(states == 'uncertain'))
-    jump_pen = min(1.0, JUMP_WEIGHT * jumps / max(n, 1))
-    loss = (1.0 - fit) + LOST_WEIGHT * lost + UNCERTAIN_WEIGHT * uncertain + jump_pen
-    return loss, {'fit': fit, 'lost_share': lost, 'uncertain_share': uncertain, 'jumps': jumps,
-                  'scans': n, 'scans_with_pose': int(np.isfinite(pose[:, 0]).sum())}
+    return jumps
 
 
 def reference_score(traj, ref):
@@ -431,6 +449,9 @@ def evaluate_bag(job):
                '--quiet', '--seed', str(job['seed']), '--params', params]
         if job['pose'] is not None:
             cmd += ['--initial-pose'] + ['%.6f' % v for v in job['pose']]
+        for flag, topics in (('--scan-topic', job.get('scan_topics')), ('--cloud-topic', job.get('cloud_topics'))):
+            for t in topics or []:
+                cmd += [flag, t]
         try:
             p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, universal_newlines=True,
                                timeout=job['timeout'], preexec_fn=_die_with_parent)
@@ -457,7 +478,8 @@ def evaluate_bag(job):
                 pfe.read_bag_reference(job['bag'])
             res['score'], res['metrics'] = reference_score(est, ref)
         else:
-            data = read_bag_data(job['bag'], odom_frame=job['odom_frame'], base_frame=job['base_frame'])
+            data = [read_bag_data(job['bag'], t, odom_frame=job['odom_frame'], base_frame=job['base_frame'])
+                    for t in job.get('scan_topics') or ['/scan']]
             res['score'], res['metrics'] = self_supervised(est, log, data, load_distance_map(job['map']),
                                                            job['fit_distance'])
         res['ok'] = True
@@ -511,6 +533,12 @@ def parse_args(argv):
                         'localization. Without it, BAG.pose (a sidecar file "X Y YAW") when present, '
                         'else global localization')
     p.add_argument('--reference', action='append', help='reference TUM file, one per bag in order')
+    p.add_argument('--scan-topic', action='append', metavar='TOPIC',
+                   help='a lidar\'s LaserScan topic, once per lidar, the same for every bag (default /scan); '
+                        'the self-supervised fit is over all of their scans')
+    p.add_argument('--cloud-topic', action='append', metavar='TOPIC',
+                   help='a 3D lidar\'s or depth camera\'s PointCloud2 topic, once per sensor (scored with a '
+                        'reference: the self-supervised fit reads scan topics only)')
     p.add_argument('--params-from', help='base parameter file (default: the package\'s config/pf.yaml)')
     p.add_argument('--space', help='search space YAML (default: the built-in space; --print-space shows it)')
     p.add_argument('--trials', type=int, help='completed trials the study should hold')
@@ -630,6 +658,9 @@ def prepare(args):
             for b, r in zip(bags, refs):
                 if not r and not bag_has_topic(b, '/ground_truth'):
                     raise TuneError('--objective reference: %s has no /ground_truth and no --reference' % b)
+    if objective == 'self' and args.cloud_topic and not args.scan_topic:
+        raise TuneError('the self-supervised objective scores LaserScan topics and --cloud-topic gives none: '
+                        'add --scan-topic, or a reference for every bag (%s)' % why)
     return dict(bags=bags, maps=maps, poses=poses, refs=refs, base=base, base_text=base_text, space=space,
                 runner=runner, objective=objective, why=why)
 
@@ -640,6 +671,7 @@ def jobs_for(setup, args, params, keep=None, seed=None):
     seed = args.seed if seed is None else seed
     return [dict(runner=setup['runner'], bag=b, map=m, pose=pose, reference=r, params=full, seed=seed,
                  objective=setup['objective'], fit_distance=args.fit_distance, timeout=args.timeout,
+                 scan_topics=args.scan_topic or [], cloud_topics=args.cloud_topic or [],
                  odom_frame=str(full.get('odom_frame', 'odom')),
                  base_frame=str(full.get('base_frame', 'base_link')),
                  keep=os.path.join(keep, os.path.splitext(os.path.basename(b))[0]) if keep else None)
@@ -649,7 +681,9 @@ def jobs_for(setup, args, params, keep=None, seed=None):
 def study_signature(setup, args):
     return {'bags': setup['bags'], 'objective': setup['objective'], 'fit_distance': args.fit_distance,
             'space': {k: [v['low'], v['high'], v['log'], v['type']] for k, v in setup['space'].items()},
-            'seed': args.seed, 'params_from': os.path.abspath(args.params_from)}
+            'seed': args.seed, 'params_from': os.path.abspath(args.params_from),
+            **({'sensors': (args.scan_topic or []) + (args.cloud_topic or [])}
+               if args.scan_topic or args.cloud_topic else {})}
 
 
 def tune(args, setup, client, say=print):
@@ -858,6 +892,8 @@ def report_lines(args, setup, study, out, found):
              '- objective: **%s** (%s); lower is better; failure scores %g' % (
                  setup['objective'], setup['why'], FAIL_SCORE[setup['objective']]),
              '- bags: %s' % ', '.join('`%s`' % b for b in setup['bags']),
+             '- sensors: %s' % ', '.join('`%s`' % t for t in (args.scan_topic or ['/scan']) +
+                                         (args.cloud_topic or [])),
              '- trials: %d complete of %d; seed %d; storage `%s`' % (
                  len(complete), len(study.trials), args.seed,
                  args.storage or 'sqlite:///%s' % os.path.join(out, 'study.db')),

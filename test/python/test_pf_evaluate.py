@@ -55,6 +55,21 @@ class MetricsTest(unittest.TestCase):
         self.assertEqual(list(log['state']), ['localized', 'lost'])
         self.assertEqual(list(log['particles']), [500.0, 600.0])
 
+    def test_missing_sensors_are_named_with_their_stretches(self):
+        with tempfile.NamedTemporaryFile('w', suffix='.csv', delete=False) as f:
+            f.write('t,particles,missing\n10,500,\n11,500,front\n12,500,front rear\n13,500,\n'
+                    '14,500,front\n')
+        try:
+            log = pfe.read_update_log(f.name)
+        finally:
+            os.remove(f.name)
+        m = pfe.log_metrics(log)['sensors_missing']
+        self.assertEqual(sorted(m), ['front', 'rear'])
+        self.assertAlmostEqual(m['front']['share'], 0.6)
+        self.assertEqual(m['front']['stretches_s'], [[1.0, 2.0], [4.0, 4.0]])
+        self.assertEqual(m['rear']['stretches_s'], [[2.0, 2.0]])
+        self.assertEqual(pfe.log_metrics({'t': log['t'], 'missing': np.array([''] * 5)})['sensors_missing'], {})
+
     def test_constant_offset(self):
         ref = traj([(t, t, 0.0, 0.0) for t in range(10)])
         est = ref + [0, 0.06, 0.08, 0]                       # 0.1 m off everywhere

@@ -192,6 +192,21 @@ class ScoreTest(unittest.TestCase):
             self.assertGreater(good['metrics']['fit'], bad['metrics']['fit'] + 0.2, bag)
             self.assertEqual(good['metrics']['scans_with_pose'], good['metrics']['scans'], bag)
 
+    def test_with_two_lidars_the_fit_is_over_both_lidars_scans(self):
+        job = dict(runner=RUNNER, bag=os.path.join(REPO, 'bags', 'two_lidar.bag'),
+                   map=os.path.join(REPO, 'maps', 'building.yaml'), pose=(1.2, 7.6, 0.0), reference=None,
+                   params=base_params(), seed=1, objective='self', fit_distance=pft.FIT_DISTANCE, timeout=300,
+                   odom_frame='odom', base_frame='base_link', scan_topics=['/scan_front', '/scan_rear'])
+        both = pft.evaluate_bag(job)
+        front = pft.evaluate_bag(dict(job, scan_topics=['/scan_front']))
+        self.assertTrue(both['ok'] and front['ok'], (both.get('error'), front.get('error')))
+        # 942 front and 753 rear scans, each with the pose published at its stamp but the last one
+        # (the bag's odometry ends before it)
+        self.assertEqual(both['metrics']['scans'], 942 + 753)
+        self.assertEqual(both['metrics']['scans_with_pose'], both['metrics']['scans'] - 1)
+        self.assertEqual(front['metrics']['scans'], 942)
+        self.assertGreater(both['metrics']['fit'], 0.9)
+
     def test_a_run_that_fails_is_reported_and_scored_as_a_failure(self):
         with tempfile.TemporaryDirectory() as d:
             broken = os.path.join(d, 'broken.bag')
