@@ -127,12 +127,14 @@ def read_update_log(path):
     for name in rows[0]:
         if name is None:
             continue
+        if name.strip() in ('state', 'missing'):  # localized / uncertain / lost; sensor names
+            cols[name.strip()] = np.array([(r[name] or '').strip() for r in rows])
+            continue
         try:
             cols[name.strip()] = np.array([float(r[name]) if r[name] not in (None, '') else np.nan
                                            for r in rows])
         except ValueError:
-            if name.strip() in ('state', 'missing'):  # localized / uncertain / lost; sensor names
-                cols[name.strip()] = np.array([(r[name] or '').strip() for r in rows])
+            pass
     if 't' not in cols:
         raise EvalError('update log %s: column "t" is not numeric' % path)
     return cols

@@ -68,7 +68,14 @@ class MetricsTest(unittest.TestCase):
         self.assertAlmostEqual(m['front']['share'], 0.6)
         self.assertEqual(m['front']['stretches_s'], [[1.0, 2.0], [4.0, 4.0]])
         self.assertEqual(m['rear']['stretches_s'], [[2.0, 2.0]])
-        self.assertEqual(pfe.log_metrics({'t': log['t'], 'missing': np.array([''] * 5)})['sensors_missing'], {})
+        # a run where no sensor was ever missing: an empty column, still text
+        with tempfile.NamedTemporaryFile('w', suffix='.csv', delete=False) as f:
+            f.write('t,particles,missing\n10,500,\n11,500,\n')
+        try:
+            log = pfe.read_update_log(f.name)
+        finally:
+            os.remove(f.name)
+        self.assertEqual(pfe.log_metrics(log)['sensors_missing'], {})
 
     def test_constant_offset(self):
         ref = traj([(t, t, 0.0, 0.0) for t in range(10)])
