@@ -92,7 +92,11 @@ bad_input  (use_sim_time false)
     (m, default 0.5) of the true pose, and pf_node must have logged at least
     one warning/error on /rosout containing one of warning_keywords.
     Params: pf_node (default /pf_node), map_wait (s, default 60),
-    good_error, require_warning (default true), warning_keywords (list).
+    good_error, require_warning (default true), warning_keywords (list),
+    cloud_topic (default none: a topic of pf_node's cloud_topics, which then
+    also gets clouds without a z field, with float64 fields, with data shorter
+    than their points and of NaN points only, and about which pf_node must
+    warn that it cannot read the point cloud).
 """
 
 import csv
@@ -114,7 +118,7 @@ from diagnostic_msgs.msg import DiagnosticStatus
 from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, TransformStamped, Quaternion
 from nav_msgs.msg import OccupancyGrid, Odometry
 from rosgraph_msgs.msg import Log
-from sensor_msgs.msg import LaserScan
+from sensor_msgs.msg import LaserScan, PointCloud2, PointField
 
 PKG = 'pf_localization'
 NAME = 'pose_checker'
@@ -810,6 +814,9 @@ class BadInputChecker:
         self.odom_pose = (0.0, 0.0, 0.0)   # odom -> base_link
         self.scan_seq = 0
         self.scan_pub = rospy.Publisher('scan', LaserScan, queue_size=10)
+        # A cloud topic of pf_node's cloud_topics: malformed clouds go there too.
+        self.cloud_topic = param('cloud_topic', '')
+        self.cloud_pub = rospy.Publisher(self.cloud_topic, PointCloud2, queue_size=10) if self.cloud_topic else None
         self.odom_pub = rospy.Publisher('odom', Odometry, queue_size=10)
         self.ip_pub = rospy.Publisher('/initialpose', PoseWithCovarianceStamped, queue_size=10)
         self.tf_pub = tf2_ros.TransformBroadcaster()
@@ -877,6 +884,35 @@ class BadInputChecker:
             ('scan with angle_increment NaN', self.make_scan([2.0] * n, angle_increment=nan)),
         ]
 
+    def make_cloud(self, names='xyz', datatype=PointField.FLOAT32, points=None, data_bytes=None):
+        """A PointCloud2 of `points` (x, y, z tuples) with one field per letter of `names`."""
+        import struct
+        points = points if points is not None else [(2.0, 0.0, 0.5)] * 10
+        size = 8 if datatype == PointField.FLOAT64 else 4
+        c = PointCloud2()
+        c.header.stamp = rospy.Time.now()
+        c.header.frame_id = 'base_laser_link'
+        c.height, c.width = 1, len(points)
+        c.fields = [PointField(n, i * size, datatype, 1) for i, n in enumerate(names)]
+        c.point_step = size * len(names)
+        c.row_step = c.point_step * c.width
+        fmt = '<' + ('d' if size == 8 else 'f') * len(names)
+        data = b''.join(struct.pack(fmt, *p[:len(names)]) for p in points)
+        c.data = data[:data_bytes] if data_bytes is not None else data
+        c.is_dense = False
+        return c
+
+    def bad_clouds(self):
+        if not self.cloud_pub:
+            return []
+        nan = float('nan')
+        return [
+            ('cloud without a z field', self.make_cloud(names='xy')),
+            ('cloud with float64 x, y and z', self.make_cloud(datatype=PointField.FLOAT64)),
+            ('cloud whose data is shorter than its points', self.make_cloud(data_bytes=20)),
+            ('cloud of NaN points only', self.make_cloud(points=[(nan, nan, nan)] * 100)),
+        ]
+
     def initialpose(self, x, y, yaw, frame='map', cov=(0.05, 0.05, 0.02), quat=None):
         m = PoseWithCovarianceStamped()
         m.header.stamp = rospy.Time.now()
@@ -915,6 +951,15 @@ class BadInputChecker:
             time.sleep(0.3)
             if not self.check_alive('%s (%s)' % (what, phase)):
                 return False
+        for what, cloud in self.bad_clouds():
+            for _ in range(3):
+                self.publish_tf()
+                cloud.header.stamp = rospy.Time.now()
+                self.cloud_pub.publish(cloud)
+                time.sleep(0.1)
+            time.sleep(0.3)
+            if not self.check_alive('%s (%s)' % (what, phase)):
+                return False
         for what, m in self.bad_initialposes():
             m.header.stamp = rospy.Time.now()
             self.ip_pub.publish(m)
@@ -930,7 +975,8 @@ class BadInputChecker:
     def wait_connected(self, timeout=30.0):
         t0 = time.time()
         while time.time() - t0 < timeout and not rospy.is_shutdown():
-            if (self.scan_pub.get_num_connections() > 0 and self.ip_pub.get_num_connections() > 0):
+            if (self.scan_pub.get_num_connections() > 0 and self.ip_pub.get_num_connections() > 0
+                    and (not self.cloud_pub or self.cloud_pub.get_num_connections() > 0)):
                 return True
             time.sleep(0.1)
         return False
@@ -1051,6 +1097,8 @@ class BadInputChecker:
         if self.require_warning:
             if not any(any(k in m.msg.lower() for k in self.keywords) for m in logs):
                 self.failures.append('%s logged no warning mentioning any of %s about the bad input' % (self.node, self.keywords))
+        if self.cloud_pub and not any('cannot read the point cloud' in m.msg for m in logs):
+            self.failures.append('%s logged no warning that it cannot read a malformed point cloud' % self.node)
         self.check_rate_limited(logs)
         return self.verdict()
 
@@ -1068,10 +1116,10 @@ class BadInputChecker:
             gaps = [b - a for a, b in zip(stamps, stamps[1:])]
             if gaps and min(gaps) < period - 0.5:
                 repeated.append('%r %d times, %.2f s apart' % (text, len(stamps), min(gaps)))
-        self.info.append('rate limit: %d warnings for %d bad scans and %d bad initial poses; '
+        self.info.append('rate limit: %d warnings for %d bad scans, %d bad clouds and %d bad initial poses; '
                          'no text repeated within %.0f s: %s'
-                         % (len(logs), 2 * 3 * len(self.bad_scans()), 2 * len(self.bad_initialposes()),
-                            period, 'yes' if not repeated else 'NO'))
+                         % (len(logs), 2 * 3 * len(self.bad_scans()), 2 * 3 * len(self.bad_clouds()),
+                            2 * len(self.bad_initialposes()), period, 'yes' if not repeated else 'NO'))
         for r in repeated:
             self.failures.append('warning not rate-limited: ' + r)
 
