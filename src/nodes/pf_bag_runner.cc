@@ -64,7 +64,6 @@ struct Options {
   std::string bag, map, out, params, log, particles_out, covariance;
   std::vector<std::string> scan_topics;   // empty: /scan
   std::vector<std::string> cloud_topics;  // PointCloud2 topics, sensors after the scan topics
-  std::vector<std::string> sensors;       // both, in that order: a sensor's index is its place
   std::string odom_topic = "/odom";
   std::optional<pf::Pose2> initial_pose;
   int particles = 0, max_beams = 0;
@@ -134,8 +133,6 @@ Options parse(int argc, char** argv) {
   if (o.bag.empty() || o.map.empty() || o.out.empty())
     fail(std::string("--bag, --map and --out are required\n") + kUsage);
   if (o.scan_topics.empty() && o.cloud_topics.empty()) o.scan_topics.push_back("/scan");
-  o.sensors = o.scan_topics;
-  o.sensors.insert(o.sensors.end(), o.cloud_topics.begin(), o.cloud_topics.end());
   return o;
 }
 
@@ -197,8 +194,8 @@ class ProgressBar {
   int last_ = -1;
 };
 
-// Opens the bag, which must have the scan topic and /tf.
-void openBag(const Options& opt, rosbag::Bag* bag) {
+// Opens the bag, which must have every sensor's topic and /tf.
+void openBag(const Options& opt, const std::vector<std::string>& sensor_topics, rosbag::Bag* bag) {
   try {
     bag->open(opt.bag, rosbag::bagmode::Read);
   } catch (const rosbag::BagException& e) {
@@ -207,7 +204,7 @@ void openBag(const Options& opt, rosbag::Bag* bag) {
   rosbag::View all(*bag);
   std::set<std::string> topics;
   for (const rosbag::ConnectionInfo* c : all.getConnections()) topics.insert(c->topic);
-  std::vector<std::string> needed_topics = opt.sensors;
+  std::vector<std::string> needed_topics = sensor_topics;
   needed_topics.push_back("/tf");
   for (const std::string& needed : needed_topics) {
     if (!topics.count(needed)) {
@@ -288,6 +285,7 @@ class Replay {
          tf2::BufferCore* tf, pf_ros::ScanLocalizer* localizer, Outputs* outputs)
       : opt_(opt),
         config_(config),
+        sensors_(pf_ros::sensorTopics(config)),
         odom_on_tf_(odom_on_tf),
         tf_(*tf),
         localizer_(*localizer),
@@ -297,7 +295,7 @@ class Replay {
   const RunCounts& counts() const { return counts_; }
   // What the replay reads: the scans, the odometry and tf.
   std::vector<std::string> topics() const {
-    std::vector<std::string> t = opt_.sensors;
+    std::vector<std::string> t = sensors_;
     t.insert(t.end(), {opt_.odom_topic, "/tf", "/tf_static"});
     return t;
   }
@@ -323,6 +321,8 @@ class Replay {
 
   const Options& opt_;
   const pf_ros::LocalizerConfig& config_;
+  // Every sensor's topic: a sensor's index is its place (--scan-topic, then --cloud-topic).
+  const std::vector<std::string> sensors_;
   const bool odom_on_tf_;
   tf2::BufferCore& tf_;
   pf_ros::ScanLocalizer& localizer_;
@@ -378,9 +378,9 @@ void Replay::handle(const rosbag::MessageInstance& m) {
     const auto odom = m.instantiate<nav_msgs::Odometry>();
     if (odom && !odom_on_tf_) tf_.setTransform(pf_ros::odometryToTransform(*odom), "odom_topic");
   } else {
-    const auto topic = std::find(opt_.sensors.begin(), opt_.sensors.end(), m.getTopic());
-    if (topic == opt_.sensors.end()) return;
-    const auto sensor = static_cast<std::size_t>(topic - opt_.sensors.begin());
+    const auto topic = std::find(sensors_.begin(), sensors_.end(), m.getTopic());
+    if (topic == sensors_.end()) return;
+    const auto sensor = static_cast<std::size_t>(topic - sensors_.begin());
     Pending p{nullptr, nullptr, sensor};
     if (sensor < opt_.scan_topics.size()) {
       p.scan = m.instantiate<sensor_msgs::LaserScan>();
@@ -509,7 +509,7 @@ int main(int argc, char** argv) {
   const Options opt = parse(argc, argv);
   const pf_ros::LocalizerConfig config = makeConfig(opt);
   rosbag::Bag bag;
-  openBag(opt, &bag);
+  openBag(opt, pf_ros::sensorTopics(config), &bag);
   const bool odom_on_tf = odometryOnTf(bag, config);
   tf2::BufferCore tf(ros::Duration(600.0));
   pf_ros::ScanLocalizer localizer(config, &tf);
