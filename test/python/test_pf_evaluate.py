@@ -45,36 +45,31 @@ class MetricsTest(unittest.TestCase):
         self.assertEqual(times, [3.0])
         self.assertEqual(pfe.confidently_wrong({'t': log['t']}, match), (None, []))
 
-    def test_update_log_keeps_the_state_column(self):
+    @staticmethod
+    def read_log(text):
+        """pf_evaluate's reading of an update log with `text` in it."""
         with tempfile.NamedTemporaryFile('w', suffix='.csv', delete=False) as f:
-            f.write('t,particles,state\n1.0,500,localized\n2.0,600,lost\n')
+            f.write(text)
         try:
-            log = pfe.read_update_log(f.name)
+            return pfe.read_update_log(f.name)
         finally:
             os.remove(f.name)
+
+    def test_update_log_keeps_the_state_column(self):
+        log = self.read_log('t,particles,state\n1.0,500,localized\n2.0,600,lost\n')
         self.assertEqual(list(log['state']), ['localized', 'lost'])
         self.assertEqual(list(log['particles']), [500.0, 600.0])
 
     def test_missing_sensors_are_named_with_their_stretches(self):
-        with tempfile.NamedTemporaryFile('w', suffix='.csv', delete=False) as f:
-            f.write('t,particles,missing\n10,500,\n11,500,front\n12,500,front rear\n13,500,\n'
-                    '14,500,front\n')
-        try:
-            log = pfe.read_update_log(f.name)
-        finally:
-            os.remove(f.name)
+        log = self.read_log('t,particles,missing\n10,500,\n11,500,front\n12,500,front rear\n13,500,\n'
+                            '14,500,front\n')
         m = pfe.log_metrics(log)['sensors_missing']
         self.assertEqual(sorted(m), ['front', 'rear'])
         self.assertAlmostEqual(m['front']['share'], 0.6)
         self.assertEqual(m['front']['stretches_s'], [[1.0, 2.0], [4.0, 4.0]])
         self.assertEqual(m['rear']['stretches_s'], [[2.0, 2.0]])
         # a run where no sensor was ever missing: an empty column, still text
-        with tempfile.NamedTemporaryFile('w', suffix='.csv', delete=False) as f:
-            f.write('t,particles,missing\n10,500,\n11,500,\n')
-        try:
-            log = pfe.read_update_log(f.name)
-        finally:
-            os.remove(f.name)
+        log = self.read_log('t,particles,missing\n10,500,\n11,500,\n')
         self.assertEqual(pfe.log_metrics(log)['sensors_missing'], {})
 
     def test_constant_offset(self):

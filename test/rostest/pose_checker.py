@@ -942,20 +942,13 @@ class BadInputChecker:
         return True
 
     def feed_bad(self, phase):
-        for what, scan in self.bad_scans():
+        bad = [(self.scan_pub, what, m) for what, m in self.bad_scans()]
+        bad += [(self.cloud_pub, what, m) for what, m in self.bad_clouds()]
+        for pub, what, msg in bad:
             for _ in range(3):
                 self.publish_tf()
-                scan.header.stamp = rospy.Time.now()
-                self.scan_pub.publish(scan)
-                time.sleep(0.1)
-            time.sleep(0.3)
-            if not self.check_alive('%s (%s)' % (what, phase)):
-                return False
-        for what, cloud in self.bad_clouds():
-            for _ in range(3):
-                self.publish_tf()
-                cloud.header.stamp = rospy.Time.now()
-                self.cloud_pub.publish(cloud)
+                msg.header.stamp = rospy.Time.now()
+                pub.publish(msg)
                 time.sleep(0.1)
             time.sleep(0.3)
             if not self.check_alive('%s (%s)' % (what, phase)):
