@@ -4,6 +4,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "pf_localization/core/particle_blocks.h"
+
 namespace pf {
 
 const ParameterTable<BeamModelParams>& beamModelParameters() {
@@ -104,15 +106,13 @@ std::size_t BeamModel::logLikelihoods(const PreparedScan& scan, const ParticleSe
   log_likelihood->resize(particles.size());
   std::vector<double> bc, bs;
   beamDirections(scan, &bc, &bs);
-  const long n = static_cast<long>(particles.size());
   // Every particle is scored alone: the result does not depend on the threads.
-#ifdef _OPENMP
-#pragma omp parallel for num_threads(shared_.threads) schedule(static) if (shared_.threads > 1)
-#endif
-  for (long i = 0; i < n; ++i) {
-    (*log_likelihood)[i] =
-        scorePose(scan, bc.data(), bs.data(), particles.x[i], particles.y[i], particles.yaw[i]);
-  }
+  forEachSlice(particles.size(), shared_.threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      (*log_likelihood)[i] =
+          scorePose(scan, bc.data(), bs.data(), particles.x[i], particles.y[i], particles.yaw[i]);
+    }
+  });
   return scan.size();
 }
 

@@ -44,7 +44,7 @@ void validate(const ConfidenceParams& p) {
 }
 
 Confidence assessConfidence(const ParticleSet& particles, const PoseEstimate& estimate,
-                            double hit_fraction, const ConfidenceParams& params) {
+                            double hit_fraction, const ConfidenceParams& params, int threads) {
   Confidence c;
   c.hit_fraction = hit_fraction;
   if (estimate.clusters.empty()) {
@@ -62,7 +62,7 @@ Confidence assessConfidence(const ParticleSet& particles, const PoseEstimate& es
   if (c.rivals > 0) {
     std::vector<std::size_t> all(particles.size());
     std::iota(all.begin(), all.end(), 0);
-    c.covariance = summarize(particles, all).covariance;
+    c.covariance = summarize(particles, all, threads).covariance;
   }
 
   std::ostringstream why;

@@ -16,8 +16,8 @@ void ConfidenceTracker::restart(const Eigen::Matrix3d& covariance) {
 }
 
 void ConfidenceTracker::assess(const ParticleSet& particles, const PoseEstimate& estimate,
-                               double hit_fraction, const ConfidenceParams& params) {
-  confidence_ = assessConfidence(particles, estimate, hit_fraction, params);
+                               double hit_fraction, const ConfidenceParams& params, int threads) {
+  confidence_ = assessConfidence(particles, estimate, hit_fraction, params, threads);
   fit_state_ = confidence_.state;
 }
 

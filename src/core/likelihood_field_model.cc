@@ -13,6 +13,7 @@
 #include "pf_localization/core/fast_math.h"
 #include "pf_localization/core/parameter_check.h"
 #include "pf_localization/core/parameter_table.h"
+#include "pf_localization/core/particle_blocks.h"
 #include "pf_localization/core/thread_scratch.h"
 
 namespace pf {
@@ -57,9 +58,6 @@ const ParameterTable<LikelihoodFieldModelParams>& likelihoodFieldParameters() {
                "product (1) is overconfident")
                  .in(Range::openClosed(0, 1))
                  .live(0, 1)),
-      member(&P::threads, I("sensor_threads", "threads",
-                            "threads scoring the particles; the same result for any")
-                              .in(Range::atLeast(1))),
       member(&P::beam_skip,
              I("do_beamskip", "", "likelihood_field_prob: skip beams most particles disagree with")
                  .amcl()
@@ -347,30 +345,20 @@ void LikelihoodFieldModel::score(const float* bx, const float* by, std::size_t b
   std::vector<double>& cos_yaw = heading_scratch.cos_yaw;
   sin_yaw.resize(n);
   cos_yaw.resize(n);
-  const double* yaw = particles.yaw.data();
-  if (frame.origin.yaw != 0.0) {
-    heading.resize(n);
-    for (std::size_t i = 0; i < n; ++i) heading[i] = particles.yaw[i] - frame.origin.yaw;
-    yaw = heading.data();
-  }
-  sinCos(yaw, n, sin_yaw.data(), cos_yaw.data());
-  const double* s = sin_yaw.data();
-  const double* c = cos_yaw.data();
-  const int threads = params_.threads;
-  if (threads <= 1) {
-    scoreParticles(frame, particles, s, c, 0, n, log_likelihood->data());
-    return;
-  }
+  if (frame.origin.yaw != 0.0) heading.resize(n);
+  double* s = sin_yaw.data();
+  double* c = cos_yaw.data();
   // One contiguous slice per thread; every particle's score is computed
   // alone, so the result is the same for any thread count.
-#ifdef _OPENMP
-#pragma omp parallel for num_threads(threads) schedule(static)
-#endif
-  for (int t = 0; t < threads; ++t) {
-    const std::size_t size = particles.size();
-    scoreParticles(frame, particles, s, c, size * t / threads, size * (t + 1) / threads,
-                   log_likelihood->data());
-  }
+  forEachSlice(n, params_.threads, [&](std::size_t begin, std::size_t end) {
+    const double* yaw = particles.yaw.data();
+    if (frame.origin.yaw != 0.0) {
+      for (std::size_t i = begin; i < end; ++i) heading[i] = particles.yaw[i] - frame.origin.yaw;
+      yaw = heading.data();
+    }
+    sinCos(yaw + begin, end - begin, s + begin, c + begin);
+    scoreParticles(frame, particles, s, c, begin, end, log_likelihood->data());
+  });
 }
 
 std::vector<uint8_t> LikelihoodFieldModel::keptBeams(const float* bx, const float* by,

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "pf_localization/core/particle_blocks.h"
 #include "pf_localization/core/prefault.h"
 
 namespace pf {
@@ -19,9 +20,9 @@ void OdometryFaultTracker::clampTo(const OdometryMotionParams& params) {
 }
 
 void OdometryFaultTracker::adapt(const std::vector<double>& weights,
-                                 const OdometryMotionParams& params) {
-  double share = 0.0;
-  for (std::size_t i = 0; i < weights.size(); ++i) share += faulty_[i] ? weights[i] : 0.0;
+                                 const OdometryMotionParams& params, int threads) {
+  const double share = sumBlocks(weights.size(), threads,
+                                 [&](std::size_t i) { return faulty_[i] ? weights[i] : 0.0; });
   // The scan's evidence for a fault: how much more weight per particle the
   // faulty ones won than the others, against the share they were given.
   // Where the scan cannot tell them apart (plain corridor walls) the ratio

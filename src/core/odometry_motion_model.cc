@@ -105,20 +105,23 @@ void OdometryMotionModel::apply(const Pose2& from, const Pose2& to, ParticleSet*
 
 void OdometryMotionModel::apply(const Pose2& from, const Pose2& to, double fault_fraction,
                                 ParticleSet* particles, Random* random,
-                                std::vector<uint8_t>* faulty) const {
+                                std::vector<uint8_t>* faulty, int threads) const {
   thread_local std::vector<uint8_t> unused;
   std::vector<uint8_t>* flags = faulty != nullptr ? faulty : &unused;
   flags->resize(particles->size());
+  BlockStreams& streams = threadScratch<BlockStreams>();
+  streams.reset(particles->size(), random);
   if (params_.kind == OdometryMotionParams::Kind::kOmni) {
-    applyOmni(from, to, fault_fraction, particles, random, flags->data());
+    applyOmni(from, to, fault_fraction, particles, &streams, flags->data(), threads);
   } else {
-    applyDifferential(from, to, fault_fraction, particles, random, flags->data());
+    applyDifferential(from, to, fault_fraction, particles, &streams, flags->data(), threads);
   }
 }
 
 void OdometryMotionModel::applyDifferential(const Pose2& from, const Pose2& to,
                                             double fault_fraction, ParticleSet* particles,
-                                            Random* random, uint8_t* faulty) const {
+                                            BlockStreams* streams, uint8_t* faulty,
+                                            int threads) const {
   const OdometryStep step = decompose(from, to);
   const double rot1 = rotationMagnitude(step.rot1);
   const double rot2 = rotationMagnitude(step.rot2);
@@ -128,10 +131,11 @@ void OdometryMotionModel::applyDifferential(const Pose2& from, const Pose2& to,
       std::sqrt(params_.alpha3 * trans2 + params_.alpha4 * (rot1 * rot1 + rot2 * rot2));
   const double sigma_rot2 = std::sqrt(params_.alpha1 * rot2 * rot2 + params_.alpha2 * trans2);
 
-  // Two passes: the random draws, one particle after the other (the random
-  // stream is the same as drawing and moving each particle in turn), then
-  // the headings' sines and cosines for the whole cloud at once (sinCos
-  // vectorises; one C library call per particle was most of this step).
+  // Two passes per block: the random draws, one particle after the other
+  // (the random stream is the same as drawing and moving each particle in
+  // turn), then the headings' sines and cosines for the whole block at once
+  // (sinCos vectorises; one C library call per particle was most of this
+  // step).
   ParticleSet& p = *particles;
   const std::size_t n = p.size();
   struct TransScratch {
@@ -146,23 +150,27 @@ void OdometryMotionModel::applyDifferential(const Pose2& from, const Pose2& to,
   turn2.resize(n);
   s.resize(n);
   c.resize(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    const double r1 = step.rot1 - random->gaussian(sigma_rot1);
-    trans[i] = sampleTranslation(step.trans, sigma_trans, fault_fraction, params_.fault_margin,
-                                 random, &faulty[i]);
-    turn2[i] = step.rot2 - random->gaussian(sigma_rot2);
-    p.yaw[i] += r1;  // the heading of travel, until the last pass
-  }
-  sinCos(p.yaw.data(), n, s.data(), c.data());
-  for (std::size_t i = 0; i < n; ++i) {
-    p.x[i] += trans[i] * c[i];
-    p.y[i] += trans[i] * s[i];
-    p.yaw[i] = normalizeAngle(p.yaw[i] + turn2[i]);
-  }
+  forEachBlock(n, threads, [&](std::size_t b, std::size_t begin, std::size_t end) {
+    Random* random = streams->stream(b);
+    for (std::size_t i = begin; i < end; ++i) {
+      const double r1 = step.rot1 - random->gaussian(sigma_rot1);
+      trans[i] = sampleTranslation(step.trans, sigma_trans, fault_fraction, params_.fault_margin,
+                                   random, &faulty[i]);
+      turn2[i] = step.rot2 - random->gaussian(sigma_rot2);
+      p.yaw[i] += r1;  // the heading of travel, until the last pass
+    }
+    sinCos(p.yaw.data() + begin, end - begin, s.data() + begin, c.data() + begin);
+    for (std::size_t i = begin; i < end; ++i) {
+      p.x[i] += trans[i] * c[i];
+      p.y[i] += trans[i] * s[i];
+      p.yaw[i] = normalizeAngle(p.yaw[i] + turn2[i]);
+    }
+  });
 }
 
 void OdometryMotionModel::applyOmni(const Pose2& from, const Pose2& to, double fault_fraction,
-                                    ParticleSet* particles, Random* random, uint8_t* faulty) const {
+                                    ParticleSet* particles, BlockStreams* streams, uint8_t* faulty,
+                                    int threads) const {
   const double dx = to.x - from.x;
   const double dy = to.y - from.y;
   const double trans = std::hypot(dx, dy);
@@ -176,15 +184,18 @@ void OdometryMotionModel::applyOmni(const Pose2& from, const Pose2& to, double f
   const double sigma_strafe = std::sqrt(params_.alpha1 * rot2 + params_.alpha5 * trans2);
 
   ParticleSet& p = *particles;
-  for (std::size_t i = 0; i < p.size(); ++i) {
-    const double t = sampleTranslation(trans, sigma_trans, fault_fraction, params_.fault_margin,
-                                       random, &faulty[i]);
-    const double s = random->gaussian(sigma_strafe);
-    const double heading = p.yaw[i] + bearing;
-    p.x[i] += t * std::cos(heading) - s * std::sin(heading);
-    p.y[i] += t * std::sin(heading) + s * std::cos(heading);
-    p.yaw[i] = normalizeAngle(p.yaw[i] + rot + random->gaussian(sigma_rot));
-  }
+  forEachBlock(p.size(), threads, [&](std::size_t b, std::size_t begin, std::size_t end) {
+    Random* random = streams->stream(b);
+    for (std::size_t i = begin; i < end; ++i) {
+      const double t = sampleTranslation(trans, sigma_trans, fault_fraction, params_.fault_margin,
+                                         random, &faulty[i]);
+      const double s = random->gaussian(sigma_strafe);
+      const double heading = p.yaw[i] + bearing;
+      p.x[i] += t * std::cos(heading) - s * std::sin(heading);
+      p.y[i] += t * std::sin(heading) + s * std::cos(heading);
+      p.yaw[i] = normalizeAngle(p.yaw[i] + rot + random->gaussian(sigma_rot));
+    }
+  });
 }
 
 }  // namespace pf

@@ -14,22 +14,26 @@ namespace pf {
 
 std::unique_ptr<SensorModel> makeSensorModel(const OccupancyGrid& grid,
                                              const ParticleFilterParams& params) {
+  LikelihoodFieldModelParams sensor = params.sensor;
+  sensor.threads = resolvedThreads(params.threads);
   switch (params.laser_model_type) {
     case LaserModelType::kBeam:
-      return std::make_unique<BeamModel>(grid, params.sensor, params.beam);
+      return std::make_unique<BeamModel>(grid, sensor, params.beam);
     case LaserModelType::kLikelihoodFieldProb:
-      return std::make_unique<LikelihoodFieldModel>(grid, params.sensor);
+      return std::make_unique<LikelihoodFieldModel>(grid, sensor);
     case LaserModelType::kLikelihoodField:
       break;
   }
   // amcl's likelihood_field never skips beams.
-  LikelihoodFieldModelParams sensor = params.sensor;
   sensor.beam_skip = false;
   return std::make_unique<LikelihoodFieldModel>(grid, sensor);
 }
 
 ParticleFilter::ParticleFilter(const ParticleFilterParams& params)
-    : params_((validate(params), params)), random_(params.seed), motion_(params.motion) {
+    : params_((validate(params), params)),
+      threads_(resolvedThreads(params.threads)),
+      random_(params.seed),
+      motion_(params.motion) {
   // Room for the largest cloud from the start: the particle count swings
   // between min and max particles, and reallocating would make the process's
   // memory swing with it (and allocate on the update path). See
@@ -56,7 +60,7 @@ bool sameSensor(const ParticleFilterParams& a, const ParticleFilterParams& b) {
   return a.laser_model_type == b.laser_model_type && s.z_hit == t.z_hit && s.z_rand == t.z_rand &&
          s.sigma_hit == t.sigma_hit && s.max_distance == t.max_distance &&
          s.max_beams == t.max_beams && s.range_min == t.range_min && s.range_max == t.range_max &&
-         s.likelihood_exponent == t.likelihood_exponent && s.threads == t.threads &&
+         s.likelihood_exponent == t.likelihood_exponent && a.threads == b.threads &&
          s.beam_skip == t.beam_skip && s.beam_skip_distance == t.beam_skip_distance &&
          s.beam_skip_threshold == t.beam_skip_threshold &&
          s.beam_skip_error_threshold == t.beam_skip_error_threshold &&
@@ -82,6 +86,7 @@ void ParticleFilter::setParams(const ParticleFilterParams& params) {
   const uint64_t seed = params_.seed;
   params_ = params;
   params_.seed = seed;
+  threads_ = resolvedThreads(params_.threads);
   motion_.setModel(motion);
   if (model) sensor_.setModel(std::move(model));
 }
@@ -118,7 +123,7 @@ void ParticleFilter::initializeGaussian(const Pose2& mean, const Eigen::Matrix3d
     particles_.setPose(i, {mean.x + d.x(), mean.y + d.y(), normalizeAngle(mean.yaw + d.z())});
   }
   particles_.setUniformWeights();
-  estimate_ = estimatePose(particles_, params_.clusters);
+  estimate_ = estimatePose(particles_, params_.clusters, threads_);
   restartAfterInitialization();
 }
 
@@ -133,7 +138,7 @@ void ParticleFilter::initializeUniform() {
     particles_.setPose(i, randomFreePose(grid, &random_));
   }
   particles_.setUniformWeights();
-  estimate_ = estimatePose(particles_, params_.clusters);
+  estimate_ = estimatePose(particles_, params_.clusters, threads_);
   restartAfterInitialization();
 }
 
@@ -194,14 +199,14 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& scans) {
   std::optional<Pose2> predicted;
   if (gate.from) {
     predicted = compose(refinement_.mapToOdom(estimate_.pose, *gate.from), odom);
-    motion_.apply(*gate.from, odom, &particles_, &random_);
+    motion_.apply(*gate.from, odom, &particles_, &random_, threads_);
   }
   weigh(*gate.scans, &report);
   if (gate.from && OdometryFaultTracker::observable(gate.step, params_.motion)) {
-    motion_.faults().adapt(particles_.weight, params_.motion);
+    motion_.faults().adapt(particles_.weight, params_.motion, threads_);
   }
   report.fault_fraction = motion_.faults().fraction();
-  report.ess = effectiveSampleSize(particles_.weight);
+  report.ess = effectiveSampleSize(particles_.weight, threads_);
   estimateAndJudge(*gate.scans, predicted);
   report.refinement = refinement_.atUpdate(sensor_.model(), scans, odom, predicted,
                                            confidence_.confidence().state, params_, &estimate_);
@@ -221,11 +226,11 @@ void ParticleFilter::estimateAndJudge(const std::vector<PreparedScan>& scans,
                                       const std::optional<Pose2>& predicted) {
   // The estimate comes from the weighted cloud, before resampling: resampling
   // only adds noise, and the random particles recovery injects must not count.
-  estimate_ = estimatePose(particles_, params_.clusters);
+  estimate_ = estimatePose(particles_, params_.clusters, threads_);
   const SensorModel& model = sensor_.model();
   confidence_.assess(particles_, estimate_,
                      hitFraction(model, scans, estimate_.pose, params_.confidence.hit_distance),
-                     params_.confidence);
+                     params_.confidence, threads_);
   gate_.recordFit(model, scans, estimate_.pose, params_);
   // Tempering and recovery follow the evidence of this scan (fitState());
   // only the published verdict waits for a jumped estimate to be confirmed.
@@ -236,7 +241,7 @@ void ParticleFilter::weigh(const std::vector<PreparedScan>& scans, UpdateReport*
   const double ess_fraction =
       temperingEssFraction(confidence_.fitState(), confidence_.confidence(), params_);
   const Weighing w =
-      sensor_.weigh(scans, ess_fraction, params_.sensor.likelihood_exponent, &particles_);
+      sensor_.weigh(scans, ess_fraction, params_.sensor.likelihood_exponent, &particles_, threads_);
   report->tempering = w.tempering;
   report->beams_skipped = w.beams_skipped;
   report->mean_beam_likelihood = w.mean_beam_likelihood;
@@ -249,7 +254,7 @@ void ParticleFilter::resample(UpdateReport* report) {
                                            static_cast<std::size_t>(params_.kld.max_particles),
                                            !grid.freeCells().empty(), params_.recovery);
   const ResampleOutcome out =
-      recovery_.resample(plan, report->ess, params_, grid, &random_, &particles_);
+      recovery_.resample(plan, report->ess, params_, grid, &random_, &particles_, threads_);
   report->resampled = out.resampled;
   report->injected = out.injected;
   report->expanded = out.expanded;

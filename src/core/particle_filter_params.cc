@@ -1,8 +1,10 @@
 #include "pf_localization/core/particle_filter_params.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <thread>
 
 #include "pf_localization/core/parameter_check.h"
 
@@ -61,6 +63,14 @@ ParameterTable<ParticleFilterParams> laserModelParameters() {
       setLaserModel, laserModelInfo())};
 }
 
+ParameterTable<ParticleFilterParams> computeParameters() {
+  return {member(
+      &ParticleFilterParams::threads,
+      ParamInfo("threads", "threads", "threads of the filter update; the same result for any")
+          .in(Range::atLeast(0))
+          .withNote("0: one per processor core"))};
+}
+
 ParameterTable<ParticleFilterParams> refinementParameters() {
   return {member(
       &ParticleFilterParams::refine_estimate,
@@ -73,6 +83,7 @@ const ParameterTable<ParticleFilterParams>& ownParameters() {
     ParameterTable<ParticleFilterParams> t = updateParameters();
     append(&t, laserModelParameters(), "sensor");
     append(&t, refinementParameters(), "refinement");
+    append(&t, computeParameters(), "compute");
     return t;
   }();
   return table;
@@ -165,9 +176,15 @@ const ParameterTable<ParticleFilterParams>& particleFilterParameters() {
     append(&t, nested(&P::sensor, beamSkipParameters()), "sensor");
     append(&t, nested(&P::beam, beamModelParameters()), "sensor");
     append(&t, refinementParameters(), "refinement");
+    append(&t, computeParameters(), "compute");
     return t;
   }();
   return table;
+}
+
+int resolvedThreads(int threads) {
+  if (threads > 0) return threads;
+  return static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
 }
 
 void validate(const ParticleFilterParams& p) {

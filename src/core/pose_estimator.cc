@@ -10,6 +10,7 @@
 #include "pf_localization/core/bin_index.h"
 #include "pf_localization/core/bin_table.h"
 #include "pf_localization/core/fast_math.h"
+#include "pf_localization/core/particle_blocks.h"
 #include "pf_localization/core/thread_scratch.h"
 
 namespace pf {
@@ -65,10 +66,10 @@ __attribute__((target("avx2"))) inline __m256i binField(__m256d v, __m256d cell,
 // heading that one step of 2 pi does not wrap (or NaN) is left to the scalar
 // code. Returns how many particles it packed (a multiple of four).
 __attribute__((target("avx2"))) std::size_t packClusterBinsAvx2(const ParticleSet& particles,
+                                                                std::size_t begin, std::size_t n,
                                                                 double cell_xy, int64_t yaw_bins,
                                                                 double yaw_bin_size,
                                                                 uint64_t* out) {
-  const std::size_t n = particles.size();
   const __m256d cell = _mm256_set1_pd(cell_xy), yaw_cell = _mm256_set1_pd(yaw_bin_size);
   const __m256d pi = _mm256_set1_pd(M_PI), minus_pi = _mm256_set1_pd(-M_PI);
   const __m256d two_pi = _mm256_set1_pd(2.0 * M_PI);
@@ -79,7 +80,7 @@ __attribute__((target("avx2"))) std::size_t packClusterBinsAvx2(const ParticleSe
   const __m256d yaw_hi = _mm256_set1_pd(static_cast<double>(yaw_bins - 1));
   const __m256i half = _mm256_set1_epi64x(int64_t{1} << 20);
 
-  std::size_t i = 0;
+  std::size_t i = begin;
   for (; i + 4 <= n; i += 4) {
     const __m256d a = _mm256_loadu_pd(particles.yaw.data() + i);
     // normalizeAngle's one step: a > pi and a <= -pi never both hold.
@@ -105,39 +106,62 @@ __attribute__((target("avx2"))) std::size_t packClusterBinsAvx2(const ParticleSe
 
 }  // namespace
 
-void packClusterBins(const ParticleSet& particles, double cell_xy, int64_t yaw_bins,
-                     uint64_t* out) {
+void packClusterBins(const ParticleSet& particles, std::size_t begin, std::size_t end,
+                     double cell_xy, int64_t yaw_bins, uint64_t* out) {
   const double yaw_bin_size = 1.0 / static_cast<double>(yaw_bins);
-  std::size_t i = 0;
+  std::size_t i = begin;
 #if defined(__x86_64__)
   static const bool avx2 = __builtin_cpu_supports("avx2");
-  if (avx2) i = packClusterBinsAvx2(particles, cell_xy, yaw_bins, yaw_bin_size, out);
+  if (avx2) i = packClusterBinsAvx2(particles, begin, end, cell_xy, yaw_bins, yaw_bin_size, out);
 #endif
-  for (; i < particles.size(); ++i) {
+  for (; i < end; ++i) {
     out[i] = packedBinOf(particles.x[i], particles.y[i], particles.yaw[i], cell_xy, yaw_bins,
                          yaw_bin_size);
   }
 }
 
-Cluster summarize(const ParticleSet& particles, const std::vector<std::size_t>& indices) {
+void packClusterBins(const ParticleSet& particles, double cell_xy, int64_t yaw_bins,
+                     uint64_t* out) {
+  packClusterBins(particles, 0, particles.size(), cell_xy, yaw_bins, out);
+}
+
+Cluster summarize(const ParticleSet& particles, const std::vector<std::size_t>& indices,
+                  int threads) {
+  struct Sums {
+    double w = 0.0, sx = 0.0, sy = 0.0, ss = 0.0, sc = 0.0;
+  };
+  const Sums sums = reduceBlocks(
+      indices.size(), threads, Sums(),
+      [&](std::size_t k, Sums& a) {
+        const std::size_t i = indices[k];
+        const double w = particles.weight[i];
+        a.w += w;
+        a.sx += w * particles.x[i];
+        a.sy += w * particles.y[i];
+        a.ss += w * std::sin(particles.yaw[i]);
+        a.sc += w * std::cos(particles.yaw[i]);
+      },
+      [](Sums& into, const Sums& from) {
+        into.w += from.w;
+        into.sx += from.sx;
+        into.sy += from.sy;
+        into.ss += from.ss;
+        into.sc += from.sc;
+      });
   Cluster c;
   c.count = indices.size();
-  double sx = 0.0, sy = 0.0, ss = 0.0, sc = 0.0;
-  for (std::size_t i : indices) {
-    const double w = particles.weight[i];
-    c.weight += w;
-    sx += w * particles.x[i];
-    sy += w * particles.y[i];
-    ss += w * std::sin(particles.yaw[i]);
-    sc += w * std::cos(particles.yaw[i]);
-  }
+  c.weight = sums.w;
   if (!(c.weight > 0.0)) return c;
-  c.mean = {sx / c.weight, sy / c.weight, normalizeAngle(std::atan2(ss, sc))};
-  for (std::size_t i : indices) {
-    const Eigen::Vector3d d(particles.x[i] - c.mean.x, particles.y[i] - c.mean.y,
-                            angleDiff(particles.yaw[i], c.mean.yaw));
-    c.covariance += particles.weight[i] * d * d.transpose();
-  }
+  c.mean = {sums.sx / c.weight, sums.sy / c.weight, normalizeAngle(std::atan2(sums.ss, sums.sc))};
+  c.covariance = reduceBlocks(
+      indices.size(), threads, Eigen::Matrix3d(Eigen::Matrix3d::Zero()),
+      [&](std::size_t k, Eigen::Matrix3d& m) {
+        const std::size_t i = indices[k];
+        const Eigen::Vector3d d(particles.x[i] - c.mean.x, particles.y[i] - c.mean.y,
+                                angleDiff(particles.yaw[i], c.mean.yaw));
+        m += particles.weight[i] * d * d.transpose();
+      },
+      [](Eigen::Matrix3d& into, const Eigen::Matrix3d& from) { into += from; });
   c.covariance /= c.weight;
   return c;
 }
@@ -150,8 +174,25 @@ struct EstimatorScratch {
   BinTable bin_of;
   std::vector<uint64_t> packed;
   std::vector<BinTable::Bin> keys;
-  std::vector<int> particle_bin, parent, cluster_of_root, cluster;
+  std::vector<int> particle_bin, parent, cluster_of_root, cluster, cluster_of_bin;
   std::vector<double> bin_weight, sin_yaw, cos_yaw, sums, moments;
+};
+
+// A cloud of several blocks (particle_blocks.h) is binned block by block:
+// each block's bins in order of first appearance in it, then the blocks'
+// bins merged in block order, which is the order of first appearance in
+// the whole cloud. Sums over particles are taken per bin of each block and
+// added up in block order: the same bits for any thread count.
+struct BlockBins {
+  BinTable table;
+  std::vector<uint64_t> keys;  // the block's bins, in order of first appearance
+  std::vector<int> global;     // each of them as a bin of the whole cloud
+  std::size_t row = 0;         // the block's first row in BlockScratch::rows
+};
+struct BlockScratch {
+  std::vector<BlockBins> blocks;
+  std::vector<int> local_bin;  // each particle's bin in its block
+  std::vector<double> rows;    // per block, per bin of the block: the sums
 };
 
 // Bins every particle: s->keys the occupied bins in order of first
@@ -184,18 +225,90 @@ void binParticles(const ParticleSet& particles, double cell_xy, int64_t yaw_bins
   }
 }
 
+// binParticles block by block, with the blocks' bins in *b.
+void binParticlesByBlock(const ParticleSet& particles, double cell_xy, int64_t yaw_bins,
+                         int threads, EstimatorScratch* s, BlockScratch* b) {
+  const std::size_t n = particles.size();
+  const std::size_t blocks = blockCount(n);
+  std::vector<uint64_t>& packed = s->packed;
+  packed.resize(n);
+  b->local_bin.resize(n);
+  if (b->blocks.size() < blocks) b->blocks.resize(blocks);
+  forEachBlock(n, threads, [&](std::size_t k, std::size_t begin, std::size_t end) {
+    packClusterBins(particles, begin, end, cell_xy, yaw_bins, packed.data());
+    BlockBins& block = b->blocks[k];
+    block.table.reset(end - begin);
+    block.keys.clear();
+    uint64_t last_key = ~uint64_t{0};
+    int last_id = -1;
+    for (std::size_t i = begin; i < end; ++i) {
+      if (packed[i] != last_key) {
+        last_id = block.table.insert(packed[i]);
+        last_key = packed[i];
+        if (static_cast<std::size_t>(last_id) == block.keys.size()) block.keys.push_back(last_key);
+      }
+      b->local_bin[i] = last_id;
+    }
+  });
+  std::size_t most = 0;  // bins, at most
+  for (std::size_t k = 0; k < blocks; ++k) most += b->blocks[k].keys.size();
+  s->bin_of.reset(most);
+  s->keys.clear();
+  std::size_t row = 0;
+  for (std::size_t k = 0; k < blocks; ++k) {
+    BlockBins& block = b->blocks[k];
+    block.global.resize(block.keys.size());
+    block.row = row;
+    row += block.keys.size();
+    for (std::size_t l = 0; l < block.keys.size(); ++l) {
+      const int id = s->bin_of.insert(block.keys[l]);
+      if (static_cast<std::size_t>(id) == s->keys.size()) {
+        s->keys.push_back(BinTable::unpack(block.keys[l]));
+      }
+      block.global[l] = id;
+    }
+  }
+  s->particle_bin.resize(n);
+  forEachBlock(n, threads, [&](std::size_t k, std::size_t begin, std::size_t end) {
+    const std::vector<int>& global = b->blocks[k].global;
+    for (std::size_t i = begin; i < end; ++i) s->particle_bin[i] = global[b->local_bin[i]];
+  });
+}
+
+// Adds term(i, row) of every particle i into the kWidth-wide row
+// out[target(bin)] of its bin (`bin` a bin of the whole cloud): per bin of
+// each block, then those sums in block order. `out` holds zeros.
+template <int kWidth, typename Target, typename Term>
+void sumByBlockBins(std::size_t n, int threads, BlockScratch* b, Target target, Term term,
+                    double* out) {
+  const std::size_t blocks = blockCount(n);
+  const std::size_t rows = b->blocks[blocks - 1].row + b->blocks[blocks - 1].keys.size();
+  b->rows.assign(kWidth * rows, 0.0);
+  forEachBlock(n, threads, [&](std::size_t k, std::size_t begin, std::size_t end) {
+    double* block_rows = b->rows.data() + kWidth * b->blocks[k].row;
+    for (std::size_t i = begin; i < end; ++i) {
+      term(i, block_rows + static_cast<std::size_t>(kWidth) * b->local_bin[i]);
+    }
+  });
+  for (std::size_t k = 0; k < blocks; ++k) {
+    const BlockBins& block = b->blocks[k];
+    for (std::size_t l = 0; l < block.keys.size(); ++l) {
+      const double* from = b->rows.data() + kWidth * (block.row + l);
+      double* to = out + static_cast<std::size_t>(kWidth) * target(block.global[l]);
+      for (int c = 0; c < kWidth; ++c) to[c] += from[c];
+    }
+  }
+}
+
 // Joins occupied bins that touch (26-neighbourhood) into clusters, but only
-// bins that carry weight (see ClusterParams::join_weight_ratio): s->parent
-// is the union-find forest over s->keys.
-void joinTouchingBins(const ParticleSet& particles, double join_weight_ratio, int64_t yaw_bins,
-                      EstimatorScratch* s) {
+// bins that carry weight (see ClusterParams::join_weight_ratio), given each
+// bin's weight in s->bin_weight: s->parent is the union-find forest over
+// s->keys.
+void joinTouchingBins(double join_weight_ratio, int64_t yaw_bins, EstimatorScratch* s) {
   const BinTable& bin_of = s->bin_of;
   const std::vector<BinTable::Bin>& keys = s->keys;
   std::vector<int>& parent = s->parent;
-  std::vector<double>& bin_weight = s->bin_weight;
-  bin_weight.assign(keys.size(), 0.0);
-  accumulateRuns<1>(s->particle_bin, bin_weight.data(),
-                    [&](std::size_t i, double* a) { a[0] += particles.weight[i]; });
+  const std::vector<double>& bin_weight = s->bin_weight;
   const double join_weight =
       join_weight_ratio * *std::max_element(bin_weight.begin(), bin_weight.end());
   parent.resize(keys.size());
@@ -219,99 +332,168 @@ void joinTouchingBins(const ParticleSet& particles, double join_weight_ratio, in
   }
 }
 
-// Cluster ids in order of first appearance: s->cluster[i] for particle i.
-// Returns the number of clusters. The roots are found once per bin, not
-// once per particle.
-int labelClusters(std::size_t particle_count, EstimatorScratch* s) {
+// Cluster ids in order of first appearance of their bins:
+// s->cluster_of_bin[b] for bin b. Returns the number of clusters. The roots
+// are found once per bin, not once per particle. As the bins are numbered
+// in order of first appearance, so are the clusters.
+int labelBins(EstimatorScratch* s) {
   std::vector<int>& parent = s->parent;
-  const std::vector<int>& particle_bin = s->particle_bin;
   std::vector<int>& cluster_of_root = s->cluster_of_root;
-  std::vector<int>& cluster = s->cluster;
-  for (std::size_t b = 0; b < s->keys.size(); ++b) parent[b] = find(parent, static_cast<int>(b));
-  cluster_of_root.assign(s->keys.size(), -1);
-  cluster.resize(particle_count);
+  const std::size_t bins = s->keys.size();
+  for (std::size_t b = 0; b < bins; ++b) parent[b] = find(parent, static_cast<int>(b));
+  cluster_of_root.assign(bins, -1);
+  s->cluster_of_bin.resize(bins);
   int clusters = 0;
-  for (std::size_t i = 0; i < particle_count; ++i) {
-    int& id = cluster_of_root[parent[particle_bin[i]]];
+  for (std::size_t b = 0; b < bins; ++b) {
+    int& id = cluster_of_root[parent[b]];
     if (id < 0) id = clusters++;
-    cluster[i] = id;
+    s->cluster_of_bin[b] = id;
   }
   return clusters;
 }
 
-// Each cluster's count, weight and weighted mean, in one pass over flat
-// arrays.
-std::vector<Cluster> clusterMeans(const ParticleSet& particles, int clusters, EstimatorScratch* s) {
-  const std::vector<int>& cluster = s->cluster;
-  // The headings' sines and cosines for the whole cloud at once (sinCos
-  // vectorises), for the mean directions.
-  std::vector<double>& sin_yaw = s->sin_yaw;
-  std::vector<double>& cos_yaw = s->cos_yaw;
-  sin_yaw.resize(particles.size());
-  cos_yaw.resize(particles.size());
-  sinCos(particles.yaw.data(), particles.size(), sin_yaw.data(), cos_yaw.data());
-  std::vector<Cluster> c(clusters);
-  // Per cluster: the count, the weight and the weighted sums of x, y, sin, cos.
-  std::vector<double>& sums = s->sums;
-  sums.assign(6 * static_cast<std::size_t>(clusters), 0.0);
-  accumulateRuns<6>(cluster, sums.data(), [&](std::size_t i, double* a) {
-    const double w = particles.weight[i];
-    a[0] += 1.0;
-    a[1] += w;
-    a[2] += w * particles.x[i];
-    a[3] += w * particles.y[i];
-    a[4] += w * sin_yaw[i];
-    a[5] += w * cos_yaw[i];
-  });
-  for (int k = 0; k < clusters; ++k) {
-    const double* sum = &sums[6 * static_cast<std::size_t>(k)];
-    c[k].count = static_cast<std::size_t>(sum[0]);
-    c[k].weight = sum[1];
-    const double w = c[k].weight > 0.0 ? c[k].weight : 1.0;
-    c[k].mean = {sum[2] / w, sum[3] / w, normalizeAngle(std::atan2(sum[4], sum[5]))};
-  }
-  return c;
+// The mean of cluster k from its sums (count, weight, and the weighted sums
+// of x, y, sin, cos).
+void meanFromSums(const double* sum, Cluster* c) {
+  c->count = static_cast<std::size_t>(sum[0]);
+  c->weight = sum[1];
+  const double w = c->weight > 0.0 ? c->weight : 1.0;
+  c->mean = {sum[2] / w, sum[3] / w, normalizeAngle(std::atan2(sum[4], sum[5]))};
 }
 
-// Each cluster's weighted covariance about its mean, in a second pass.
-void clusterCovariances(const ParticleSet& particles, EstimatorScratch* s,
-                        std::vector<Cluster>* clusters) {
+// Adds particle i's terms to its cluster's sums of meanFromSums.
+inline void addMeanTerms(const ParticleSet& particles, const double* sin_yaw, const double* cos_yaw,
+                         std::size_t i, double* a) {
+  const double w = particles.weight[i];
+  a[0] += 1.0;
+  a[1] += w;
+  a[2] += w * particles.x[i];
+  a[3] += w * particles.y[i];
+  a[4] += w * sin_yaw[i];
+  a[5] += w * cos_yaw[i];
+}
+
+// Adds particle i's second moments about the mean of its cluster `k` (in
+// plain arrays: an Eigen temporary per particle went through the stack and
+// stalled on store forwarding), with the same products in the same order
+// as w d d^T.
+inline void addMomentTerms(const ParticleSet& particles, const Cluster& k, std::size_t i,
+                           double* m) {
+  const double d[3] = {particles.x[i] - k.mean.x, particles.y[i] - k.mean.y,
+                       angleDiff(particles.yaw[i], k.mean.yaw)};
+  const double w = particles.weight[i];
+  for (int r = 0; r < 3; ++r) {
+    const double wd = w * d[r];
+    for (int col = 0; col < 3; ++col) m[3 * col + r] += wd * d[col];
+  }
+}
+
+// Each cluster's covariance from its summed second moments.
+void covariancesFromMoments(const std::vector<double>& moments, std::vector<Cluster>* clusters) {
   std::vector<Cluster>& c = *clusters;
-  const std::vector<int>& cluster = s->cluster;
-  // The second moments in plain arrays (an Eigen temporary per particle went
-  // through the stack and stalled on store forwarding), with the same
-  // products in the same order as w d d^T.
-  std::vector<double>& moments = s->moments;
-  moments.assign(9 * c.size(), 0.0);
-  accumulateRuns<9>(cluster, moments.data(), [&](std::size_t i, double* m) {
-    const Cluster& k = c[cluster[i]];
-    const double d[3] = {particles.x[i] - k.mean.x, particles.y[i] - k.mean.y,
-                         angleDiff(particles.yaw[i], k.mean.yaw)};
-    const double w = particles.weight[i];
-    for (int r = 0; r < 3; ++r) {
-      const double wd = w * d[r];
-      for (int col = 0; col < 3; ++col) m[3 * col + r] += wd * d[col];
-    }
-  });
   for (std::size_t k = 0; k < c.size(); ++k) {
     c[k].covariance = Eigen::Map<const Eigen::Matrix3d>(&moments[9 * k]);
     if (c[k].weight > 0.0) c[k].covariance /= c[k].weight;
   }
 }
 
+// The clusters of a cloud of one block: every sum particle by particle, in
+// order.
+std::vector<Cluster> clustersOfOneBlock(const ParticleSet& particles, const ClusterParams& params,
+                                        int64_t yaw_bins, int threads, EstimatorScratch* s) {
+  binParticles(particles, params.cell_xy, yaw_bins, s);
+  std::vector<double>& bin_weight = s->bin_weight;
+  bin_weight.assign(s->keys.size(), 0.0);
+  accumulateRuns<1>(s->particle_bin, bin_weight.data(),
+                    [&](std::size_t i, double* a) { a[0] += particles.weight[i]; });
+  joinTouchingBins(params.join_weight_ratio, yaw_bins, s);
+  const int clusters = labelBins(s);
+  std::vector<int>& cluster = s->cluster;
+  cluster.resize(particles.size());
+  for (std::size_t i = 0; i < particles.size(); ++i) {
+    cluster[i] = s->cluster_of_bin[s->particle_bin[i]];
+  }
+  // The headings' sines and cosines for the whole cloud at once (sinCos
+  // vectorises), for the mean directions.
+  const std::size_t n = particles.size();
+  s->sin_yaw.resize(n);
+  s->cos_yaw.resize(n);
+  double* sin_yaw = s->sin_yaw.data();
+  double* cos_yaw = s->cos_yaw.data();
+  forEachSlice(n, threads, [&](std::size_t begin, std::size_t end) {
+    sinCos(particles.yaw.data() + begin, end - begin, sin_yaw + begin, cos_yaw + begin);
+  });
+  std::vector<Cluster> c(clusters);
+  std::vector<double>& sums = s->sums;
+  sums.assign(6 * static_cast<std::size_t>(clusters), 0.0);
+  accumulateRuns<6>(cluster, sums.data(), [&](std::size_t i, double* a) {
+    addMeanTerms(particles, sin_yaw, cos_yaw, i, a);
+  });
+  for (int k = 0; k < clusters; ++k) meanFromSums(&sums[6 * static_cast<std::size_t>(k)], &c[k]);
+  std::vector<double>& moments = s->moments;
+  moments.assign(9 * c.size(), 0.0);
+  accumulateRuns<9>(cluster, moments.data(), [&](std::size_t i, double* m) {
+    addMomentTerms(particles, c[cluster[i]], i, m);
+  });
+  covariancesFromMoments(moments, &c);
+  return c;
+}
+
+// The clusters of a cloud of several blocks, on up to `threads` threads:
+// the same steps, every sum block by block (sumByBlockBins).
+std::vector<Cluster> clustersOfBlocks(const ParticleSet& particles, const ClusterParams& params,
+                                      int64_t yaw_bins, int threads, EstimatorScratch* s) {
+  BlockScratch& b = threadScratch<BlockScratch>();
+  const std::size_t n = particles.size();
+  binParticlesByBlock(particles, params.cell_xy, yaw_bins, threads, s, &b);
+  const auto same_bin = [](int bin) { return bin; };
+  s->bin_weight.assign(s->keys.size(), 0.0);
+  sumByBlockBins<1>(
+      n, threads, &b, same_bin, [&](std::size_t i, double* a) { a[0] += particles.weight[i]; },
+      s->bin_weight.data());
+  joinTouchingBins(params.join_weight_ratio, yaw_bins, s);
+  const int clusters = labelBins(s);
+  const std::vector<int>& cluster_of_bin = s->cluster_of_bin;
+  const auto cluster_of = [&](int bin) { return cluster_of_bin[bin]; };
+  s->sin_yaw.resize(n);
+  s->cos_yaw.resize(n);
+  double* sin_yaw = s->sin_yaw.data();
+  double* cos_yaw = s->cos_yaw.data();
+  forEachSlice(n, threads, [&](std::size_t begin, std::size_t end) {
+    sinCos(particles.yaw.data() + begin, end - begin, sin_yaw + begin, cos_yaw + begin);
+  });
+  std::vector<Cluster> c(clusters);
+  std::vector<double>& sums = s->sums;
+  sums.assign(6 * static_cast<std::size_t>(clusters), 0.0);
+  sumByBlockBins<6>(
+      n, threads, &b, cluster_of,
+      [&](std::size_t i, double* a) { addMeanTerms(particles, sin_yaw, cos_yaw, i, a); },
+      sums.data());
+  for (int k = 0; k < clusters; ++k) meanFromSums(&sums[6 * static_cast<std::size_t>(k)], &c[k]);
+  std::vector<double>& moments = s->moments;
+  moments.assign(9 * c.size(), 0.0);
+  const std::vector<int>& particle_bin = s->particle_bin;
+  sumByBlockBins<9>(
+      n, threads, &b, cluster_of,
+      [&](std::size_t i, double* m) {
+        addMomentTerms(particles, c[cluster_of_bin[particle_bin[i]]], i, m);
+      },
+      moments.data());
+  covariancesFromMoments(moments, &c);
+  return c;
+}
+
 }  // namespace
 
-PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& params) {
+PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& params, int threads) {
   PoseEstimate estimate;
   if (particles.empty()) return estimate;
   // Yaw bins wrap around, so the last bin touches the first.
   const int64_t yaw_bins = std::max<int64_t>(1, std::llround(2.0 * M_PI / params.cell_yaw));
   EstimatorScratch& scratch = threadScratch<EstimatorScratch>();
-  binParticles(particles, params.cell_xy, yaw_bins, &scratch);
-  joinTouchingBins(particles, params.join_weight_ratio, yaw_bins, &scratch);
-  const int clusters = labelClusters(particles.size(), &scratch);
-  estimate.clusters = clusterMeans(particles, clusters, &scratch);
-  clusterCovariances(particles, &scratch, &estimate.clusters);
+  estimate.clusters = blockCount(particles.size()) <= 1
+                          ? clustersOfOneBlock(particles, params, yaw_bins, threads, &scratch)
+                          : clustersOfBlocks(particles, params, yaw_bins, threads, &scratch);
   // Heaviest first; ties broken by the mean so the order never depends on hashing.
   std::sort(estimate.clusters.begin(), estimate.clusters.end(),
             [](const Cluster& a, const Cluster& b) {

@@ -102,13 +102,13 @@ RecoveryPlan Recovery::plan(LocalizationState state, std::size_t particles,
 
 ResampleOutcome Recovery::resample(const RecoveryPlan& plan, double ess,
                                    const ParticleFilterParams& params, const OccupancyGrid& grid,
-                                   Random* random, ParticleSet* particles) {
+                                   Random* random, ParticleSet* particles, int threads) {
   ResampleOutcome out;
   const std::size_t n = particles->size();
   const double p = plan.inject_probability;
   if (ess >= params.resample_ess_fraction * n && p < 0.01 && !plan.spread) return out;
 
-  const std::size_t target = kldParticleCount(*particles, params.kld);
+  const std::size_t target = kldParticleCount(*particles, params.kld, threads);
   // Random particles are spread over the whole map, so they are counted
   // against the largest cloud, not the converged one: a lost filter must
   // search with as many particles as a global localization.
@@ -117,7 +117,7 @@ ResampleOutcome Recovery::resample(const RecoveryPlan& plan, double ess,
       std::min(max, static_cast<std::size_t>(std::floor(p * max + random->uniform())));
   const std::size_t kept =
       std::min(max - injected, static_cast<std::size_t>(std::ceil((1.0 - p) * target)));
-  systematicResample(*particles, kept, random, &spare_);
+  systematicResample(*particles, kept, random, &spare_, threads);
   std::swap(*particles, spare_);
   if (plan.spread) ExpansionResetting::spread(params.recovery, kept, random, particles);
   particles->resize(kept + injected);

@@ -6,6 +6,7 @@
 
 #include "pf_localization/core/bin_index.h"
 #include "pf_localization/core/bin_table.h"
+#include "pf_localization/core/particle_blocks.h"
 #include "pf_localization/core/thread_scratch.h"
 
 namespace pf {
@@ -37,15 +38,55 @@ const ParameterTable<KldParams>& kldParameters() {
   return table;
 }
 
-double effectiveSampleSize(const std::vector<double>& weights) {
-  double sum_sq = 0.0;
-  for (double w : weights) sum_sq += w * w;
+double effectiveSampleSize(const std::vector<double>& weights, int threads) {
+  const double sum_sq =
+      sumBlocks(weights.size(), threads, [&](std::size_t i) { return weights[i] * weights[i]; });
   return sum_sq > 0.0 ? 1.0 / sum_sq : 0.0;
 }
 
-void systematicResample(const ParticleSet& in, std::size_t n, Random* random, ParticleSet* out) {
+namespace {
+
+// systematicResample on several threads: the running sums of the weights
+// first, one after the other (the same additions as the one-thread loop, so
+// the same values), then each thread's slice of the survivors finds its
+// first particle by bisection in them and goes on as the loop does.
+void systematicResampleSliced(const ParticleSet& in, std::size_t n, Random* random,
+                              ParticleSet* out, int threads) {
+  struct Cumulative {
+    std::vector<double> sums;
+  };  // kept: no allocation per update
+  std::vector<double>& cumulative = threadScratch<Cumulative>().sums;
+  const std::size_t m = in.size();
+  cumulative.resize(m);
+  double running = 0.0;
+  for (std::size_t j = 0; j < m; ++j) cumulative[j] = running += in.weight[j];
+  const double step = cumulative[m - 1] / static_cast<double>(n);
+  const double offset = random->uniform();
+  const double* c = cumulative.data();
+  forEachSlice(n, threads, [&](std::size_t begin, std::size_t end) {
+    const double first = (offset + static_cast<double>(begin)) * step;
+    std::size_t j = std::min<std::size_t>(std::upper_bound(c, c + m, first) - c, m - 1);
+    for (std::size_t i = begin; i < end; ++i) {
+      const double pointer = (offset + static_cast<double>(i)) * step;
+      while (pointer >= c[j] && j + 1 < m) ++j;
+      out->x[i] = in.x[j];
+      out->y[i] = in.y[j];
+      out->yaw[i] = in.yaw[j];
+    }
+  });
+}
+
+}  // namespace
+
+void systematicResample(const ParticleSet& in, std::size_t n, Random* random, ParticleSet* out,
+                        int threads) {
   out->resize(in.empty() ? 0 : n);
   if (out->empty()) return;
+  if (threadsFor(n, threads) > 1) {
+    systematicResampleSliced(in, n, random, out, threads);
+    out->setUniformWeights();
+    return;
+  }
   double total = 0.0;
   for (double w : in.weight) total += w;
   const double step = total / static_cast<double>(n);
@@ -111,7 +152,85 @@ double kldBound(std::size_t k, double kld_err, double confidence) {
   return static_cast<double>(k - 1) / (2.0 * kld_err) * b * b * b;
 }
 
-std::size_t kldParticleCount(const ParticleSet& particles, const KldParams& params) {
+namespace {
+
+// The occupied bins of some particles and the weight in each, in order of
+// first appearance. Kept between calls, so that binning allocates nothing.
+struct KldBins {
+  BinTable bins;
+  std::vector<uint64_t> keys;
+  std::vector<double> weight;
+};
+
+// Bins the particles [begin, end) into *out.
+void binWeights(const ParticleSet& particles, std::size_t begin, std::size_t end,
+                const KldParams& params, KldBins* out) {
+  out->bins.reset(end - begin);
+  out->keys.clear();
+  out->weight.clear();
+  // Resampling leaves the copies of one particle side by side, so the bin of
+  // the particle before is the likeliest: it spares most hash look-ups.
+  uint64_t last_key = ~uint64_t{0};
+  int id = -1;
+  for (std::size_t i = begin; i < end; ++i) {
+    const uint64_t key = BinTable::key(binIndex(particles.x[i], params.bin_xy),
+                                       binIndex(particles.y[i], params.bin_xy),
+                                       binIndex(particles.yaw[i], params.bin_yaw));
+    if (key != last_key) {
+      id = out->bins.insert(key);
+      last_key = key;
+      if (static_cast<std::size_t>(id) == out->weight.size()) {
+        out->weight.push_back(0.0);
+        out->keys.push_back(key);
+      }
+    }
+    out->weight[id] += particles.weight[i];
+  }
+}
+
+// The bins of the whole cloud: one block's as they are; several blocks'
+// binned each on its own, then merged in block order (each bin's weight is
+// the sum of its blocks' in that order).
+const KldBins& binWeights(const ParticleSet& particles, const KldParams& params, int threads) {
+  struct Scratch {
+    KldBins whole;
+    std::vector<KldBins> blocks;
+  };
+  Scratch& scratch = threadScratch<Scratch>();
+  const std::size_t n = particles.size();
+  const std::size_t blocks = blockCount(n);
+  if (blocks <= 1) {
+    binWeights(particles, 0, n, params, &scratch.whole);
+    return scratch.whole;
+  }
+  if (scratch.blocks.size() < blocks) scratch.blocks.resize(blocks);
+  KldBins* parts = scratch.blocks.data();
+  forEachBlock(n, threads, [&](std::size_t b, std::size_t begin, std::size_t end) {
+    binWeights(particles, begin, end, params, &parts[b]);
+  });
+  KldBins& whole = scratch.whole;
+  std::size_t most = 0;  // bins, at most
+  for (std::size_t b = 0; b < blocks; ++b) most += parts[b].keys.size();
+  whole.bins.reset(most);
+  whole.keys.clear();
+  whole.weight.clear();
+  for (std::size_t b = 0; b < blocks; ++b) {
+    for (std::size_t k = 0; k < parts[b].keys.size(); ++k) {
+      const int id = whole.bins.insert(parts[b].keys[k]);
+      if (static_cast<std::size_t>(id) == whole.weight.size()) {
+        whole.weight.push_back(parts[b].weight[k]);
+        whole.keys.push_back(parts[b].keys[k]);
+      } else {
+        whole.weight[id] += parts[b].weight[k];
+      }
+    }
+  }
+  return whole;
+}
+
+}  // namespace
+
+std::size_t kldParticleCount(const ParticleSet& particles, const KldParams& params, int threads) {
   // A fixed budget (min_particles = max_particles, as amcl is often run) is
   // the answer whatever the bins say: no need to bin 5000 particles for it.
   if (params.min_particles == params.max_particles) {
@@ -121,31 +240,7 @@ std::size_t kldParticleCount(const ParticleSet& particles, const KldParams& para
   // resample of the current size: bins holding only negligible particles
   // will be empty after resampling and must not inflate k.
   const double threshold = particles.empty() ? 0.0 : 1.0 / static_cast<double>(particles.size());
-  // Kept between calls (per thread), so that binning allocates nothing.
-  struct Scratch {
-    BinTable bins;
-    std::vector<double> bin_weight;
-  };
-  Scratch& scratch = threadScratch<Scratch>();
-  BinTable& bins = scratch.bins;
-  std::vector<double>& bin_weight = scratch.bin_weight;
-  bins.reset(particles.size());
-  bin_weight.clear();
-  // Resampling leaves the copies of one particle side by side, so the bin of
-  // the particle before is the likeliest: it spares most hash look-ups.
-  uint64_t last_key = ~uint64_t{0};
-  int id = -1;
-  for (std::size_t i = 0; i < particles.size(); ++i) {
-    const uint64_t key = BinTable::key(binIndex(particles.x[i], params.bin_xy),
-                                       binIndex(particles.y[i], params.bin_xy),
-                                       binIndex(particles.yaw[i], params.bin_yaw));
-    if (key != last_key) {
-      id = bins.insert(key);
-      last_key = key;
-      if (static_cast<std::size_t>(id) == bin_weight.size()) bin_weight.push_back(0.0);
-    }
-    bin_weight[id] += particles.weight[i];
-  }
+  const std::vector<double>& bin_weight = binWeights(particles, params, threads).weight;
   std::size_t k = 0;
   for (double w : bin_weight) k += w >= threshold ? 1 : 0;
   const double n = std::ceil(kldBound(k, params.kld_err, params.confidence));

@@ -2,20 +2,22 @@
 
 #include <algorithm>
 
+#include "pf_localization/core/particle_blocks.h"
 #include "pf_localization/core/prefault.h"
 
 namespace pf {
 
 Weighing SensorUpdate::weigh(const PreparedScan& scan, double min_ess_fraction,
-                             double likelihood_exponent, ParticleSet* particles) {
+                             double likelihood_exponent, ParticleSet* particles, int threads) {
   const std::size_t beams_counted = model_->logLikelihoods(scan, *particles, &log_likelihood_);
-  return finish(scan.size(), beams_counted, min_ess_fraction, likelihood_exponent, particles);
+  return finish(scan.size(), beams_counted, min_ess_fraction, likelihood_exponent, particles,
+                threads);
 }
 
 Weighing SensorUpdate::weigh(const std::vector<PreparedScan>& scans, double min_ess_fraction,
-                             double likelihood_exponent, ParticleSet* particles) {
+                             double likelihood_exponent, ParticleSet* particles, int threads) {
   if (scans.size() == 1) {
-    return weigh(scans.front(), min_ess_fraction, likelihood_exponent, particles);
+    return weigh(scans.front(), min_ess_fraction, likelihood_exponent, particles, threads);
   }
   log_likelihood_.assign(particles->size(), 0.0);
   std::size_t beams = 0, beams_counted = 0;
@@ -23,17 +25,20 @@ Weighing SensorUpdate::weigh(const std::vector<PreparedScan>& scans, double min_
     beams += scan.size();
     if (scan.size() == 0) continue;
     beams_counted += model_->logLikelihoods(scan, *particles, &sensor_log_likelihood_);
-    for (std::size_t i = 0; i < log_likelihood_.size(); ++i) {
-      log_likelihood_[i] += scan.weight * sensor_log_likelihood_[i];
-    }
+    forEachSlice(log_likelihood_.size(), threads, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) {
+        log_likelihood_[i] += scan.weight * sensor_log_likelihood_[i];
+      }
+    });
   }
-  return finish(beams, beams_counted, min_ess_fraction, likelihood_exponent, particles);
+  return finish(beams, beams_counted, min_ess_fraction, likelihood_exponent, particles, threads);
 }
 
 Weighing SensorUpdate::finish(std::size_t beams, std::size_t beams_counted, double min_ess_fraction,
-                              double likelihood_exponent, ParticleSet* particles) {
+                              double likelihood_exponent, ParticleSet* particles, int threads) {
   Weighing w;
-  w.tempering = applyLikelihood(log_likelihood_, min_ess_fraction, &particles->weight, &scratch_);
+  w.tempering =
+      applyLikelihood(log_likelihood_, min_ess_fraction, &particles->weight, &scratch_, threads);
   w.beams_skipped = static_cast<int>(beams - beams_counted);
   // The per-beam geometric mean is independent of the beam count, so
   // comparable across scans and robots. Weighted with the posterior, not the
@@ -42,7 +47,7 @@ Weighing SensorUpdate::finish(std::size_t beams, std::size_t beams_counted, doub
   // them. Over the beams the model counted: beam skipping may leave some out.
   const double counted =
       static_cast<double>(std::max<std::size_t>(beams_counted, 1)) * likelihood_exponent;
-  w.mean_beam_likelihood = meanBeamLikelihood(particles->weight, log_likelihood_, counted);
+  w.mean_beam_likelihood = meanBeamLikelihood(particles->weight, log_likelihood_, counted, threads);
   return w;
 }
 

@@ -5,49 +5,91 @@
 #include <limits>
 
 #include "pf_localization/core/fast_math.h"
+#include "pf_localization/core/particle_blocks.h"
 #include "pf_localization/core/thread_scratch.h"
 
 namespace pf {
 namespace {
 
+// Every loop below over the particles is split over `threads`: the
+// element-wise ones in even slices, the sums and maxima block by block
+// (particle_blocks.h), so that the weights are the same bits for any count.
+
+// A running sum and sum of squares.
+struct Sums {
+  double sum = 0.0, sum_sq = 0.0;
+};
+void mergeSums(Sums& into, const Sums& from) {
+  into.sum += from.sum;
+  into.sum_sq += from.sum_sq;
+}
+
+// The largest of v(i) over [0, n) (-inf for none).
+template <typename Value>
+double maxBlocks(std::size_t n, int threads, Value&& v) {
+  return reduceBlocks(
+      n, threads, -std::numeric_limits<double>::infinity(),
+      [&](std::size_t i, double& m) { m = std::max(m, v(i)); },
+      [](double& into, double from) { into = std::max(into, from); });
+}
+
+// f(i) for every i in [0, n), in slices.
+template <typename F>
+void forEachParticle(std::size_t n, int threads, F&& f) {
+  forEachSlice(n, threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) f(i);
+  });
+}
+
 // ESS of the weights prior * likelihood^beta, from their logarithms.
 double effectiveSampleSize(const std::vector<double>& log_prior,
-                           const std::vector<double>& log_likelihood, double beta) {
-  double max_log = -std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < log_prior.size(); ++i) {
-    max_log = std::max(max_log, log_prior[i] + beta * log_likelihood[i]);
-  }
+                           const std::vector<double>& log_likelihood, double beta, int threads) {
+  const std::size_t n = log_prior.size();
+  const double max_log =
+      maxBlocks(n, threads, [&](std::size_t i) { return log_prior[i] + beta * log_likelihood[i]; });
   if (!std::isfinite(max_log)) return 0.0;
   struct WScratch {
     std::vector<double> w;
   };  // kept: no allocation per update
   WScratch& w_scratch = threadScratch<WScratch>();
   std::vector<double>& w = w_scratch.w;
-  w.resize(log_prior.size());
-  for (std::size_t i = 0; i < log_prior.size(); ++i) {
-    w[i] = log_prior[i] + beta * log_likelihood[i] - max_log;
-  }
-  exps(w.data(), w.size(), w.data());
-  double sum = 0.0, sum_sq = 0.0;
-  for (double v : w) {
-    sum += v;
-    sum_sq += v * v;
-  }
-  return sum * sum / sum_sq;
+  w.resize(n);
+  double* wp = w.data();
+  forEachSlice(n, threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      wp[i] = log_prior[i] + beta * log_likelihood[i] - max_log;
+    }
+    exps(wp + begin, end - begin, wp + begin);
+  });
+  const Sums s = reduceBlocks(
+      n, threads, Sums(),
+      [&](std::size_t i, Sums& a) {
+        a.sum += wp[i];
+        a.sum_sq += wp[i] * wp[i];
+      },
+      mergeSums);
+  return s.sum * s.sum / s.sum_sq;
+}
+
+// The sum and sum of squares of v.
+Sums sums(const std::vector<double>& v, int threads) {
+  return reduceBlocks(
+      v.size(), threads, Sums(),
+      [&](std::size_t i, Sums& a) {
+        a.sum += v[i];
+        a.sum_sq += v[i] * v[i];
+      },
+      mergeSums);
 }
 
 // The prior's effective sample size: after a resampling every weight is the
 // same, and it is then N; otherwise it comes from the weights themselves,
 // (sum w)^2 / sum w^2, without exponentials.
-double priorEffectiveSampleSize(const std::vector<double>& w, bool uniform) {
+double priorEffectiveSampleSize(const std::vector<double>& w, bool uniform, int threads) {
   double prior_ess = static_cast<double>(w.size());
   if (!uniform) {
-    double sum = 0.0, sum_sq = 0.0;
-    for (double v : w) {
-      sum += v;
-      sum_sq += v * v;
-    }
-    prior_ess = sum_sq > 0.0 ? sum * sum / sum_sq : 0.0;
+    const Sums s = sums(w, threads);
+    prior_ess = s.sum_sq > 0.0 ? s.sum * s.sum / s.sum_sq : 0.0;
   }
   return prior_ess;
 }
@@ -58,24 +100,34 @@ double priorEffectiveSampleSize(const std::vector<double>& w, bool uniform) {
 // the normalised posterior into *weights and returns true; *posterior is
 // working storage of N values.
 bool multiplyDirectly(const std::vector<double>& ll, double min_ess, std::vector<double>* weights,
-                      std::vector<double>* posterior) {
-  std::vector<double>& w = *weights;
-  std::vector<double>& e = *posterior;
-  const std::size_t n = w.size();
-  double max_ll = -std::numeric_limits<double>::infinity();
-  for (double v : ll) max_ll = std::max(max_ll, v);
+                      std::vector<double>* posterior, int threads) {
+  double* w = weights->data();
+  double* e = posterior->data();
+  const std::size_t n = weights->size();
+  const double max_ll = maxBlocks(ll.size(), threads, [&](std::size_t i) { return ll[i]; });
   if (!std::isfinite(max_ll)) return false;
-  for (std::size_t i = 0; i < n; ++i) e[i] = ll[i] - max_ll;
-  exps(e.data(), n, e.data());
-  double total = 0.0, total_sq = 0.0, peak = 0.0;
-  for (std::size_t i = 0; i < n; ++i) {
-    e[i] *= w[i];
-    total += e[i];
-    total_sq += e[i] * e[i];
-    peak = std::max(peak, e[i]);
-  }
-  if (peak > 1e-100 && !(min_ess > 0.0 && total * total / total_sq < min_ess)) {
-    for (std::size_t i = 0; i < n; ++i) w[i] = e[i] / total;
+  forEachSlice(n, threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) e[i] = ll[i] - max_ll;
+    exps(e + begin, end - begin, e + begin);
+  });
+  struct Product {
+    double total = 0.0, total_sq = 0.0, peak = 0.0;
+  };
+  const Product p = reduceBlocks(
+      n, threads, Product(),
+      [&](std::size_t i, Product& a) {
+        e[i] *= w[i];
+        a.total += e[i];
+        a.total_sq += e[i] * e[i];
+        a.peak = std::max(a.peak, e[i]);
+      },
+      [](Product& into, const Product& from) {
+        into.total += from.total;
+        into.total_sq += from.total_sq;
+        into.peak = std::max(into.peak, from.peak);
+      });
+  if (p.peak > 1e-100 && !(min_ess > 0.0 && p.total * p.total / p.total_sq < min_ess)) {
+    forEachParticle(n, threads, [&](std::size_t i) { w[i] = e[i] / p.total; });
     return true;
   }
   return false;
@@ -83,13 +135,15 @@ bool multiplyDirectly(const std::vector<double>& ll, double min_ess, std::vector
 
 // The prior's logarithms. A constant prior does not change the normalised
 // result: zeros spare N logarithms.
-void logPrior(const std::vector<double>& w, bool uniform, std::vector<double>* log_prior) {
+void logPrior(const std::vector<double>& w, bool uniform, std::vector<double>* log_prior,
+              int threads) {
   const std::size_t n = w.size();
   if (uniform) {
     log_prior->assign(n, 0.0);
   } else {
     log_prior->resize(n);
-    for (std::size_t i = 0; i < n; ++i) (*log_prior)[i] = std::log(w[i]);
+    double* lp = log_prior->data();
+    forEachParticle(n, threads, [&](std::size_t i) { lp[i] = std::log(w[i]); });
   }
 }
 
@@ -98,30 +152,29 @@ void logPrior(const std::vector<double>& w, bool uniform, std::vector<double>* l
 // prior * likelihood / max, *total its sum. Returns the log of the max, and
 // its effective sample size in *ess.
 double untemperedPosterior(const std::vector<double>& log_prior, const std::vector<double>& ll,
-                           std::vector<double>* posterior, double* total_out, double* ess) {
-  std::vector<double>& e = *posterior;
-  const std::size_t n = e.size();
-  double max_log = -std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < n; ++i) {
+                           std::vector<double>* posterior, double* total_out, double* ess,
+                           int threads) {
+  double* e = posterior->data();
+  const std::size_t n = posterior->size();
+  const double max_log = maxBlocks(n, threads, [&](std::size_t i) {
     e[i] = log_prior[i] + ll[i];
-    max_log = std::max(max_log, e[i]);
-  }
+    return e[i];
+  });
   // When every particle scores zero (possible with z_rand = 0: an end point
   // far from any obstacle has likelihood exp(-800) = 0), max_log is -inf and
   // normalising would give 0/0 = NaN weights, which the resampler collapses
   // onto particle 0. Evidence that rules out all particles alike favours
   // none: the caller leaves the weights as they were.
-  double total = 0.0, total_sq = 0.0;
+  Sums s;
   if (std::isfinite(max_log)) {
-    for (std::size_t i = 0; i < n; ++i) e[i] -= max_log;
-    exps(e.data(), n, e.data());
-    for (std::size_t i = 0; i < n; ++i) {
-      total += e[i];
-      total_sq += e[i] * e[i];
-    }
+    forEachSlice(n, threads, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) e[i] -= max_log;
+      exps(e + begin, end - begin, e + begin);
+    });
+    s = sums(*posterior, threads);
   }
-  *total_out = total;
-  *ess = total_sq > 0.0 ? total * total / total_sq : 0.0;
+  *total_out = s.sum;
+  *ess = s.sum_sq > 0.0 ? s.sum * s.sum / s.sum_sq : 0.0;
   return max_log;
 }
 
@@ -132,25 +185,26 @@ double untemperedPosterior(const std::vector<double>& log_prior, const std::vect
 // are then the prior again).
 double temperedPosterior(const std::vector<double>& log_prior, const std::vector<double>& ll,
                          double min_ess, std::vector<double>* posterior, double* total_out,
-                         double* max_log_out) {
-  std::vector<double>& e = *posterior;
-  const std::size_t n = e.size();
+                         double* max_log_out, int threads) {
+  double* e = posterior->data();
+  const std::size_t n = posterior->size();
   double lo = 0.0, hi = 1.0;
   for (int k = 0; k < 20; ++k) {
     const double mid = 0.5 * (lo + hi);
-    (effectiveSampleSize(log_prior, ll, mid) >= min_ess ? lo : hi) = mid;
+    (effectiveSampleSize(log_prior, ll, mid, threads) >= min_ess ? lo : hi) = mid;
   }
   const double beta = lo;
-  double max_log = -std::numeric_limits<double>::infinity();
-  for (std::size_t i = 0; i < n; ++i) {
+  const double max_log = maxBlocks(n, threads, [&](std::size_t i) {
     e[i] = log_prior[i] + beta * ll[i];
-    max_log = std::max(max_log, e[i]);
-  }
+    return e[i];
+  });
   double total = 0.0;
   if (std::isfinite(max_log)) {
-    for (std::size_t i = 0; i < n; ++i) e[i] -= max_log;
-    exps(e.data(), n, e.data());
-    for (std::size_t i = 0; i < n; ++i) total += e[i];
+    forEachSlice(n, threads, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) e[i] -= max_log;
+      exps(e + begin, end - begin, e + begin);
+    });
+    total = sumBlocks(n, threads, [&](std::size_t i) { return e[i]; });
   }
   *total_out = total;
   *max_log_out = max_log;
@@ -160,35 +214,37 @@ double temperedPosterior(const std::vector<double>& log_prior, const std::vector
 }  // namespace
 
 double applyLikelihood(const std::vector<double>& ll, double min_ess_fraction,
-                       std::vector<double>* weights, WeightingScratch* scratch) {
+                       std::vector<double>* weights, WeightingScratch* scratch, int threads) {
   std::vector<double>& w = *weights;
   const std::size_t n = w.size();
-  const bool uniform = std::all_of(w.begin(), w.end(), [&](double v) { return v == w.front(); });
+  const bool uniform = reduceBlocks(
+      n, threads, true, [&](std::size_t i, bool& same) { same = same && w[i] == w.front(); },
+      [](bool& into, bool from) { into = into && from; });
   // A share of the effective particles before the scan, not of all of them:
   // recovery's barely weighted guesses count as particles but not as
   // effective ones, and measured against N a cloud salted with them could
   // never keep enough, so every scan was tempered away to nothing.
-  const double min_ess = min_ess_fraction * priorEffectiveSampleSize(w, uniform);
+  const double min_ess = min_ess_fraction * priorEffectiveSampleSize(w, uniform, threads);
   std::vector<double>& e = scratch->log_posterior;
   e.resize(n);
-  if (!uniform && multiplyDirectly(ll, min_ess, &w, &e)) return 1.0;
+  if (!uniform && multiplyDirectly(ll, min_ess, &w, &e, threads)) return 1.0;
   // Otherwise in logarithms.
   std::vector<double>& log_prior = scratch->log_prior;
-  logPrior(w, uniform, &log_prior);
+  logPrior(w, uniform, &log_prior, threads);
   double total = 0.0, ess = 0.0;
-  double max_log = untemperedPosterior(log_prior, ll, &e, &total, &ess);
+  double max_log = untemperedPosterior(log_prior, ll, &e, &total, &ess, threads);
   double beta = 1.0;
   if (min_ess > 0.0 && ess < min_ess) {
-    beta = temperedPosterior(log_prior, ll, min_ess, &e, &total, &max_log);
+    beta = temperedPosterior(log_prior, ll, min_ess, &e, &total, &max_log, threads);
   }
   // Evidence that rules out every particle alike: the weights stay.
   if (!std::isfinite(max_log)) return beta;
-  for (std::size_t i = 0; i < n; ++i) w[i] = e[i] / total;
+  forEachParticle(n, threads, [&](std::size_t i) { w[i] = e[i] / total; });
   return beta;
 }
 
 double meanBeamLikelihood(const std::vector<double>& weights,
-                          const std::vector<double>& log_likelihood, double beams) {
+                          const std::vector<double>& log_likelihood, double beams, int threads) {
   struct PerBeamScratch {
     std::vector<double> per_beam;
   };  // kept: no allocation per update
@@ -196,11 +252,12 @@ double meanBeamLikelihood(const std::vector<double>& weights,
   std::vector<double>& per_beam = per_beam_scratch.per_beam;
   const std::size_t n = weights.size();
   per_beam.resize(n);
-  for (std::size_t i = 0; i < n; ++i) per_beam[i] = log_likelihood[i] / beams;
-  exps(per_beam.data(), n, per_beam.data());
-  double mean_beam = 0.0;
-  for (std::size_t i = 0; i < n; ++i) mean_beam += weights[i] * per_beam[i];
-  return mean_beam;
+  double* pb = per_beam.data();
+  forEachSlice(n, threads, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) pb[i] = log_likelihood[i] / beams;
+    exps(pb + begin, end - begin, pb + begin);
+  });
+  return sumBlocks(n, threads, [&](std::size_t i) { return weights[i] * pb[i]; });
 }
 
 }  // namespace pf

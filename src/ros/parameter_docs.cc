@@ -31,6 +31,7 @@ const std::vector<Group>& groups() {
       {"motion", "Motion model"},
       {"sensor", "Sensor model"},
       {"refinement", "Refinement: the published pose fitted to the map"},
+      {"compute", "Computing: threads"},
       {"scan", "Scans"},
   };
   return g;

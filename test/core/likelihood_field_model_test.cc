@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "pf_localization/core/particle_blocks.h"
 #include "pf_localization/core/random.h"
 #include "support/rooms.h"
 
@@ -329,7 +330,8 @@ TEST(LikelihoodFieldModel, ThreadCountDoesNotChangeTheScores) {
   p.threads = 3;
   const LikelihoodFieldModel three(wallGrid(8), p);
   ParticleSet set;
-  set.resize(1001);  // not a multiple of the thread count
+  // Enough particles for three threads (particle_blocks.h), not a multiple of three.
+  set.resize(3 * kMinParticlesPerThread + 1);
   Random random(3);
   for (std::size_t i = 0; i < set.size(); ++i) {
     set.setPose(i, {random.uniform(0.0, 1.0), random.uniform(0.0, 0.5), random.uniform(-3, 3)});
@@ -361,7 +363,6 @@ TEST(LikelihoodFieldModel, InvalidParametersThrowNamingThem) {
   expectRejected(with([](P& p) { p.max_distance = 0.0; }), "max_dist");
   expectRejected(with([](P& p) { p.max_distance = NAN; }), "max_dist");
   expectRejected(with([](P& p) { p.likelihood_exponent = 0.0; }), "laser_likelihood_exponent");
-  expectRejected(with([](P& p) { p.threads = 0; }), "sensor_threads");
   expectRejected(with([](P& p) { p.likelihood_exponent = 1.5; }), "laser_likelihood_exponent");
   // Only z_hit or only z_rand is fine.
   EXPECT_NO_THROW(LikelihoodFieldModel(wallGrid(8), with([](P& p) { p.z_rand = 0.0; })));

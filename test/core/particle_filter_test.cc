@@ -120,6 +120,7 @@ TEST(ParticleFilterParams, InvalidValuesAreNamed) {
   expectInvalid([](P& p) { p.resample_ess_fraction = 1.5; },
                 "ParticleFilterParams::resample_ess_fraction");
   expectInvalid([](P& p) { p.update_min_d = -0.1; }, "update_min_d");
+  expectInvalid([](P& p) { p.threads = -1; }, "threads");
   expectInvalid([](P& p) { p.sensor.max_beams = 0; }, "laser_max_beams");
   expectInvalid([](P& p) { p.sensor.max_distance = 0.0; }, "laser_likelihood_max_dist");
   expectInvalid([](P& p) { p.clusters.cell_xy = 0.0; }, "ClusterParams::cell_xy");

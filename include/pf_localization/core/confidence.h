@@ -61,9 +61,10 @@ struct Confidence {
 void validate(const ConfidenceParams& params);
 
 /// The verdict for one update: `estimate` of the weighted cloud `particles`,
-/// and the fraction of the scan's beams that hit an obstacle from it.
+/// and the fraction of the scan's beams that hit an obstacle from it. The
+/// whole cloud's covariance, when there are rivals, on up to `threads`.
 Confidence assessConfidence(const ParticleSet& particles, const PoseEstimate& estimate,
-                            double hit_fraction, const ConfidenceParams& params);
+                            double hit_fraction, const ConfidenceParams& params, int threads = 1);
 
 /// The history check: `predicted` is the previous estimate moved by the
 /// odometry since, `estimate` the new one. A jump between them starts

@@ -26,7 +26,7 @@ class ConfidenceTracker {
   /// The verdict on this update's weighted cloud, `hit_fraction` of the
   /// scan's beams hitting an obstacle from `estimate`.
   void assess(const ParticleSet& particles, const PoseEstimate& estimate, double hit_fraction,
-              const ConfidenceParams& params);
+              const ConfidenceParams& params, int threads = 1);
   /// The history check (holdAfterJump) against `predicted`, the previous
   /// estimate moved by the odometry since; nothing without one.
   void holdAfterJump(const std::optional<Pose2>& predicted, const Pose2& estimate,

@@ -50,8 +50,9 @@ struct LikelihoodFieldModelParams {
   // scan likelihood to this power (tempering) keeps rival hypotheses alive
   // until the evidence really separates them. 1 = independent beams.
   double likelihood_exponent = 0.2;  // (0, 1]
-  // Threads scoring the particles (OpenMP builds). Each particle is scored on
-  // its own, so the result does not depend on this number.
+  // Threads scoring the particles (OpenMP builds): not a parameter of its
+  // own, the filter's `threads` (makeSensorModel). Each particle is scored
+  // on its own, so the result does not depend on this number.
   int threads = 1;
   // Beam skipping (see above; amcl's do_beamskip and beam_skip_*). Only
   // laser_model_type likelihood_field_prob turns it on, as in amcl.

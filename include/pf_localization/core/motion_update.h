@@ -24,9 +24,11 @@ class MotionUpdate {
   }
 
   /// Moves every particle by the noisy odometry motion from `from` to `to`,
-  /// the tracker's share of them assuming a fault (and flagged so).
-  void apply(const Pose2& from, const Pose2& to, ParticleSet* particles, Random* random) {
-    model_.apply(from, to, faults_.sampledFraction(), particles, random, faults_.flags());
+  /// the tracker's share of them assuming a fault (and flagged so), on up
+  /// to `threads` threads (the same result for any count).
+  void apply(const Pose2& from, const Pose2& to, ParticleSet* particles, Random* random,
+             int threads = 1) {
+    model_.apply(from, to, faults_.sampledFraction(), particles, random, faults_.flags(), threads);
   }
 
   const OdometryMotionParams& params() const { return model_.params(); }

@@ -64,8 +64,10 @@ class OdometryFaultTracker {
   std::vector<uint8_t>* flags() { return &faulty_; }
   /// The new share from the posterior weight of the flagged particles
   /// (`weights` normalised, in the order of the flags) against the share
-  /// they were given, clamped.
-  void adapt(const std::vector<double>& weights, const OdometryMotionParams& params);
+  /// they were given, clamped; summed on up to `threads` threads (the same
+  /// result for any count).
+  void adapt(const std::vector<double>& weights, const OdometryMotionParams& params,
+             int threads = 1);
 
   /// Prefaults room for `n` particles' flags.
   void reserve(std::size_t n);

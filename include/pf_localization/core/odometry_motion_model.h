@@ -46,6 +46,7 @@
 #include <vector>
 
 #include "pf_localization/core/parameter_table.h"
+#include "pf_localization/core/particle_blocks.h"
 #include "pf_localization/core/particle_set.h"
 #include "pf_localization/core/pose2.h"
 #include "pf_localization/core/random.h"
@@ -106,15 +107,18 @@ class OdometryMotionModel {
   void apply(const Pose2& from, const Pose2& to, ParticleSet* particles, Random* random) const;
   /// The same with `fault_fraction` in place of the parameter's (the filter
   /// adapts it), writing into `faulty` (when not null) which particles took
-  /// a fault (1) and which the odometry's step (0).
+  /// a fault (1) and which the odometry's step (0), on up to `threads`
+  /// threads: each block of particles draws from its own stream
+  /// (particle_blocks.h), so the result is the same for any thread count.
   void apply(const Pose2& from, const Pose2& to, double fault_fraction, ParticleSet* particles,
-             Random* random, std::vector<uint8_t>* faulty) const;
+             Random* random, std::vector<uint8_t>* faulty, int threads = 1) const;
 
  private:
   void applyDifferential(const Pose2& from, const Pose2& to, double fault_fraction,
-                         ParticleSet* particles, Random* random, uint8_t* faulty) const;
+                         ParticleSet* particles, BlockStreams* random, uint8_t* faulty,
+                         int threads) const;
   void applyOmni(const Pose2& from, const Pose2& to, double fault_fraction, ParticleSet* particles,
-                 Random* random, uint8_t* faulty) const;
+                 BlockStreams* random, uint8_t* faulty, int threads) const;
 
   OdometryMotionParams params_;
 };

@@ -152,6 +152,7 @@ class ParticleFilter {
   void reserveStorage(std::size_t max_particles);
 
   ParticleFilterParams params_;
+  int threads_;  // params_.threads resolved (resolvedThreads)
   Random random_;
   SensorUpdate sensor_;  // the sensor model (none without a map) and its scratch
   MotionUpdate motion_;  // the motion model and the odometry fault share

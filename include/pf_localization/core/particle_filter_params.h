@@ -114,6 +114,9 @@ struct ParticleFilterParams {
   // fit; a cloud that is only wide, with its beams fitting, keeps the other.
   double tempering_ess_fraction_uncertain = kTemperingEssFractionUncertain;
   uint64_t seed = 0;
+  // Threads of the filter update (0: one per processor core). The result is
+  // the same bits for any count (particle_blocks.h).
+  int threads = 0;
   OdometryMotionParams motion;
   // Which sensor model weighs the particles. Beam skipping (sensor.beam_skip)
   // takes effect with kLikelihoodFieldProb only, as in amcl.
@@ -140,6 +143,9 @@ void validateInternals(const RecoveryParams& params);
 /// Every parameter of ParticleFilterParams, its parts' included, in the order
 /// config/pf.yaml lists them.
 const ParameterTable<ParticleFilterParams>& particleFilterParameters();
+
+/// The threads `threads` stands for: itself, or one per processor core for 0.
+int resolvedThreads(int threads);
 
 /// Throws std::invalid_argument naming the first parameter out of range and
 /// its valid range ("invalid parameter NAME = VALUE: must be RANGE").

@@ -40,17 +40,26 @@ struct PoseEstimate {
   std::vector<Cluster> clusters;                         // heaviest first
 };
 
-/// Weighted mean and covariance of a set of particles (indices into `particles`).
-Cluster summarize(const ParticleSet& particles, const std::vector<std::size_t>& indices);
+/// Weighted mean and covariance of a set of particles (indices into
+/// `particles`), on up to `threads` threads with the same result for any
+/// count (particle_blocks.h).
+Cluster summarize(const ParticleSet& particles, const std::vector<std::size_t>& indices,
+                  int threads = 1);
 
 /// The histogram bin of every particle that estimatePose clusters by, packed
 /// by BinTable::key: x and y in cells of `cell_xy`, the heading (wrapped into
 /// (-pi, pi]) in `yaw_bins` bins that wrap around. Four particles at a time
 /// where the processor has AVX2, with the same keys as one by one.
 void packClusterBins(const ParticleSet& particles, double cell_xy, int64_t yaw_bins, uint64_t* out);
+/// The same for the particles [begin, end) only (out[begin, end)).
+void packClusterBins(const ParticleSet& particles, std::size_t begin, std::size_t end,
+                     double cell_xy, int64_t yaw_bins, uint64_t* out);
 
 /// Clusters the cloud and summarises every cluster; the estimate is the heaviest.
-/// An empty set gives an estimate with no clusters.
-PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& params);
+/// An empty set gives an estimate with no clusters. On up to `threads`
+/// threads: a cloud of several blocks (particle_blocks.h) is binned and
+/// summed block by block, so the result is the same for any count.
+PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& params,
+                          int threads = 1);
 
 }  // namespace pf

@@ -115,9 +115,11 @@ class Recovery {
   /// anything: KLD-sampling (Fox 2003) picks the count, systematic
   /// resampling the survivors, and the injected share comes from
   /// randomFreePose on `grid`. Draws from `random`: the injected count, the
-  /// resampling, the spread, the injected poses.
+  /// resampling, the spread, the injected poses. KLD's bins and the
+  /// resampling run on up to `threads` threads (the same for any count).
   ResampleOutcome resample(const RecoveryPlan& plan, double ess, const ParticleFilterParams& params,
-                           const OccupancyGrid& grid, Random* random, ParticleSet* particles);
+                           const OccupancyGrid& grid, Random* random, ParticleSet* particles,
+                           int threads = 1);
 
   /// Prefaults the resampler's output for `n` particles.
   void reserve(std::size_t n);

@@ -26,14 +26,16 @@ namespace pf {
 
 /// 1 / sum(w^2) of normalised weights: N for uniform weights, 1 when one
 /// particle carries all the weight.
-double effectiveSampleSize(const std::vector<double>& weights);
+double effectiveSampleSize(const std::vector<double>& weights, int threads = 1);
 
 /// Replaces `particles` with `n` survivors drawn systematically by weight;
 /// the survivors get uniform weights.
 void systematicResample(ParticleSet* particles, std::size_t n, Random* random);
 /// The same into `out` (not `in`), whose storage is reused: a filter that
-/// alternates two sets allocates nothing per update.
-void systematicResample(const ParticleSet& in, std::size_t n, Random* random, ParticleSet* out);
+/// alternates two sets allocates nothing per update. On up to `threads`
+/// threads, with the same survivors for any count.
+void systematicResample(const ParticleSet& in, std::size_t n, Random* random, ParticleSet* out,
+                        int threads = 1);
 
 struct KldParams {
   int min_particles = 500;
@@ -57,7 +59,9 @@ double kldBound(std::size_t k, double kld_err, double confidence);
 
 /// The particle count KLD-sampling asks for after resampling `particles`:
 /// k counts the bins expected to receive at least one survivor, clamped to
-/// [min_particles, max_particles].
-std::size_t kldParticleCount(const ParticleSet& particles, const KldParams& params);
+/// [min_particles, max_particles]. The bins are counted block by block on
+/// up to `threads` threads (particle_blocks.h): the same for any count.
+std::size_t kldParticleCount(const ParticleSet& particles, const KldParams& params,
+                             int threads = 1);
 
 }  // namespace pf

@@ -36,14 +36,16 @@ class SensorUpdate {
   /// Multiplies the weights of `particles` by the likelihood of `scan`,
   /// tempered so that at least `min_ess_fraction` of the effective sample
   /// size is left, and normalises them. `likelihood_exponent` is the sensor
-  /// model's: the mean beam likelihood undoes it. Precondition: hasModel().
+  /// model's: the mean beam likelihood undoes it. The weighting runs on up
+  /// to `threads` threads, with the same result for any count (the model
+  /// scores on its own). Precondition: hasModel().
   Weighing weigh(const PreparedScan& scan, double min_ess_fraction, double likelihood_exponent,
-                 ParticleSet* particles);
+                 ParticleSet* particles, int threads = 1);
   /// The same for the scans of several sensors (scan_group.h): their
   /// log-likelihoods, each times its PreparedScan::weight, add up. One scan
   /// weighs exactly as weigh() does.
   Weighing weigh(const std::vector<PreparedScan>& scans, double min_ess_fraction,
-                 double likelihood_exponent, ParticleSet* particles);
+                 double likelihood_exponent, ParticleSet* particles, int threads = 1);
 
   /// Prefaults the scratch for `n` particles.
   void reserve(std::size_t n);
@@ -51,7 +53,7 @@ class SensorUpdate {
  private:
   // Tempers and normalises log_likelihood_ into the weights; the report.
   Weighing finish(std::size_t beams, std::size_t beams_counted, double min_ess_fraction,
-                  double likelihood_exponent, ParticleSet* particles);
+                  double likelihood_exponent, ParticleSet* particles, int threads);
 
   std::unique_ptr<SensorModel> model_;
   std::vector<double> log_likelihood_;

@@ -22,13 +22,14 @@ struct WeightingScratch {
 /// bisection) that leaves at least min_ess_fraction times the prior's
 /// effective sample size (0 disables tempering: beta = 1). When every
 /// particle has likelihood zero the weights are left as they were. Returns
-/// beta.
+/// beta. On up to `threads` threads, with the same result for any count
+/// (particle_blocks.h).
 double applyLikelihood(const std::vector<double>& log_likelihood, double min_ess_fraction,
-                       std::vector<double>* weights, WeightingScratch* scratch);
+                       std::vector<double>* weights, WeightingScratch* scratch, int threads = 1);
 
 /// sum_i weights[i] * exp(log_likelihood[i] / beams): the per-beam geometric
 /// mean likelihood, averaged with the weights.
 double meanBeamLikelihood(const std::vector<double>& weights,
-                          const std::vector<double>& log_likelihood, double beams);
+                          const std::vector<double>& log_likelihood, double beams, int threads = 1);
 
 }  // namespace pf

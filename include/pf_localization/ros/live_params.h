@@ -6,7 +6,7 @@
 //
 // Not live: the frames, tf_broadcast, the initial pose (that is what
 // initialpose is for), the seed, odom_model_type, laser_model_type,
-// sensor_threads, save_pose_rate, first_map_only / use_map_topic.
+// threads, save_pose_rate, first_map_only / use_map_topic.
 #pragma once
 
 #include <dynamic_reconfigure/Config.h>

@@ -1,0 +1,73 @@
+#include "pf_localization/core/worker_pool.h"
+
+#include <algorithm>
+
+namespace pf {
+
+WorkerPool& WorkerPool::instance() {
+  static WorkerPool pool;
+  return pool;
+}
+
+WorkerPool::~WorkerPool() {
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+  }
+  wake_.notify_all();
+  for (std::thread& worker : workers_) worker.join();
+}
+
+void WorkerPool::takeTasks(std::unique_lock<std::mutex>* lock) {
+  while (next_ < tasks_) {
+    const std::size_t k = next_++;
+    lock->unlock();
+    call_(task_, k);
+    lock->lock();
+    if (--unfinished_ == 0) done_.notify_all();
+  }
+}
+
+void WorkerPool::runErased(int threads, std::size_t tasks, Call call, void* task) {
+  const auto alone = [&] {
+    for (std::size_t k = 0; k < tasks; ++k) call(task, k);
+  };
+  if (threads <= 1 || tasks <= 1) return alone();
+  // Another job under way (another filter's, or this one's around work
+  // nested in it): this one on its caller's thread alone.
+  std::unique_lock<std::mutex> job(job_mutex_, std::try_to_lock);
+  if (!job.owns_lock()) return alone();
+  std::unique_lock<std::mutex> lock(mutex_);
+  const std::size_t helpers =
+      std::min<std::size_t>(static_cast<std::size_t>(threads) - 1, tasks - 1);
+  while (workers_.size() < helpers) {
+    const std::size_t id = workers_.size();
+    workers_.emplace_back([this, id] { work(id); });
+  }
+  call_ = call;
+  task_ = task;
+  tasks_ = tasks;
+  next_ = 0;
+  unfinished_ = tasks;
+  participants_ = helpers;
+  ++generation_;
+  wake_.notify_all();
+  takeTasks(&lock);
+  done_.wait(lock, [&] { return unfinished_ == 0; });
+  call_ = nullptr;
+  task_ = nullptr;
+  tasks_ = 0;
+}
+
+void WorkerPool::work(std::size_t id) {
+  std::size_t seen = 0;
+  std::unique_lock<std::mutex> lock(mutex_);
+  for (;;) {
+    wake_.wait(lock, [&] { return stop_ || (generation_ != seen && id < participants_); });
+    if (stop_) return;
+    seen = generation_;
+    takeTasks(&lock);
+  }
+}
+
+}  // namespace pf
