@@ -3,20 +3,22 @@
 // can be regenerated bit for bit (pf_make_map writes maps/warehouse.pgm and
 // .yaml: 2400 x 1600 cells of 0.05 m, extent x -1..119, y -1..79).
 //
-//   y=77.7 +-------------------------------------------------+---------+
-//          |              north main aisle                   | office  |
-//    68.4  |     ===========  ===========  ===========        +--door---+ 71
-//          |     ===========  ===========  ===========                  |
-//          | west  ... 11 identical double rows of racks, aisles ...    |
-//          | main   aisle 10 twin aisles between them (3 m), each row   |  east
-//          | aisle ===========  ===========  ===========   in three     |  main
-//    12.0  |     ===========  ===========  ===========    segments       |  aisle
-//          |       o(20,7)    o(40,7)    o(60,7)    o(80,7)    o(100,7)  |
-//          |   staging area: pillars, pallets            (no doors east) |
-//    y=0.3 +--[ ]-[ ]-[ ]--[ ]-[ ]-----[ ]-[ ]-----[ ]-------------------+
-//         x=0.3   loading dock: 8 door recesses, irregular          x=117.7
-//               x 10.0   39.8 44.0   73.8 78.0   107.8
-//                 (segment 0 | cross aisle 1 | segment 1 | cross aisle 2 | segment 2)
+//   y=77.7 +---------------------------------------------------+--------+
+//          |                  north main aisle                 | office |
+//   y=68.4 |   [==row 10==]   [==========]   [==========]      +-door---+ y=71
+//          | w     aisle 10                                           e |
+//          | e [==row 9===]   [==========]   [==========]             a |
+//          | s      ...  11 identical double rows, the                s |
+//          | t      10 twin aisles (3 m) between them                 t |
+//          |   [==row 1===]   [==========]   [==========]               |
+//          |       aisle 1                                              |
+//   y=12.0 |   [==row 0===]   [==========]   [==========]               |
+//          |     o(20,7)    o(40,7)    o(60,7)    o(80,7)    o(100,7)   |
+//          |  staging area (pillars o)                                  |
+//    y=0.3 +---u-u-u---u-u-----u-u-----u--------------------------------+
+//         x=0.3  loading dock: 8 door recesses (u), irregular      x=117.7
+//   the rows' segments: x 10.0-39.8, 44.0-73.8, 78.0-107.8; between
+//   them cross aisles 1 and 2 (4.2 m); west and east main aisles ~10 m
 //
 // What a 2D lidar at ~0.2 m above the floor sees of a rack: its uprights,
 // and nothing of its beams (the lowest beam level is above it) nor of the
