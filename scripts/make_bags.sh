@@ -36,7 +36,10 @@ bags="tracking           building  1
       sparse             building  7     --scan-period 2
       corridor           corridor  8     --scan-period 2.5
       two_lidar          building  9     --rig amr
-      two_lidar_covered  building  9     --rig amr --block front:30:42"
+      two_lidar_covered  building  9     --rig amr --block front:30:42
+      warehouse_tracking warehouse 11    --rig warehouse --scan-period 0.2
+      warehouse_global   warehouse 12    --rig warehouse --scan-period 0.2
+      warehouse_kidnap   warehouse 13    --rig warehouse --scan-period 0.2"
 # The bags' path scripts are bags/BAG.path, but for these, which share one.
 path_of() {
   case "$1" in
@@ -106,7 +109,7 @@ done <<<"$generated"
 if $check; then
   status=0
   for f in maps/building.yaml maps/building.pgm maps/small.yaml maps/small.pgm \
-           maps/corridor.yaml maps/corridor.pgm \
+           maps/corridor.yaml maps/corridor.pgm maps/warehouse.yaml maps/warehouse.pgm \
            $(awk '{print "bags/" $1 ".bag"}' <<<"$bags"); do
     want=$(sha256sum <"$repo/$f" 2>/dev/null | cut -d' ' -f1 || true)
     got=$(sha256sum <"$out/$f" | cut -d' ' -f1)

@@ -1,5 +1,6 @@
 // pf_make_map: writes the package's own maps (building, small and corridor, see
-// pf_localization/sim/building_map.h) in the map_server format.
+// pf_localization/sim/building_map.h; warehouse, see warehouse_map.h) in the
+// map_server format.
 //
 //   pf_make_map --out-dir maps
 //
@@ -11,12 +12,14 @@
 
 #include "pf_localization/core/map_loader.h"
 #include "pf_localization/sim/building_map.h"
+#include "pf_localization/sim/warehouse_map.h"
 
 namespace {
 
 constexpr char kUsage[] =
     "usage: pf_make_map [--out-dir DIR]   (default: maps)\n"
-    "writes DIR/building.yaml/.pgm, DIR/small.yaml/.pgm and DIR/corridor.yaml/.pgm\n";
+    "writes DIR/building.yaml/.pgm, DIR/small.yaml/.pgm, DIR/corridor.yaml/.pgm and\n"
+    "DIR/warehouse.yaml/.pgm\n";
 
 }  // namespace
 
@@ -38,11 +41,12 @@ int main(int argc, char** argv) {
     pf::saveMap(pf::sim::makeBuildingMap(), out_dir + "/building.yaml");
     pf::saveMap(pf::sim::makeSmallMap(), out_dir + "/small.yaml");
     pf::saveMap(pf::sim::makeCorridorMap(), out_dir + "/corridor.yaml");
+    pf::saveMap(pf::sim::makeWarehouseMap(), out_dir + "/warehouse.yaml");
   } catch (const std::exception& e) {
     std::cerr << "pf_make_map: " << e.what() << "\n";
     return 1;
   }
-  std::cout << "wrote " << out_dir << "/building.yaml, " << out_dir << "/small.yaml and " << out_dir
-            << "/corridor.yaml\n";
+  std::cout << "wrote " << out_dir << "/building.yaml, " << out_dir << "/small.yaml, " << out_dir
+            << "/corridor.yaml and " << out_dir << "/warehouse.yaml\n";
   return 0;
 }

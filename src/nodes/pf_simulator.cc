@@ -2,7 +2,7 @@
 // writes what the real robot would have recorded, as a ROS 1 bag.
 //
 //   pf_simulator --map maps/building.yaml --path bags/tracking.path
-//                --seed 1 --out bags/tracking.bag [--rig neato|amr|cloud]
+//                --seed 1 --out bags/tracking.bag [--rig neato|amr|cloud|warehouse]
 //                [--compression bz2|lz4|none] [--odom-error K] [--unsigned-odometry]
 //                [--no-people] [--scan-period S] [--block NAME:T0:T1] [--start-time SECONDS]
 //
@@ -28,10 +28,16 @@
 //                  720 beams at 0.5 deg from angle 0, 0.05-20 m, no return +inf
 //                  in the building's 3D world (building_clutter.h: a 2.5 m
 //                  ceiling, objects of other heights that are not on the map)
+//   warehouse: the AMR's body with one 270-degree safety lidar on its front edge
+//        (amr_rig.h), for maps/warehouse.yaml
+//     /scan        sensor_msgs/LaserScan, laser (x 0.32, z 0.2), 10 Hz or --scan-period:
+//                  541 beams at 0.5 deg from -135 deg, 0.05-25 m, no return +inf,
+//                  with the warehouse's pallets that are not on the map
+//                  (warehouse_map.h)
 //
 // The robot starts at the script's start pose in the map and at the origin
 // of odom. The simulation steps at 100 Hz; scans are offset from the odometry
-// (the Neato's and the cloud's by 70 ms), so a consumer must interpolate tf
+// (the Neato's, the cloud's and the warehouse's by 70 ms), so a consumer must interpolate tf
 // rather than find exact stamps. --block covers a planar lidar (by name:
 // laser, front, rear) from T0 to T1 s after the start: every beam then reads
 // range_min (sensor_block.h). Bag time equals header stamp, and the bag
@@ -49,6 +55,7 @@
 #include <cstdint>
 #include <cstring>
 #include <iostream>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -67,6 +74,7 @@
 #include "pf_localization/sim/ring_lidar.h"
 #include "pf_localization/sim/scene_3d.h"
 #include "pf_localization/sim/sensor_block.h"
+#include "pf_localization/sim/warehouse_map.h"
 
 namespace {
 
@@ -81,9 +89,10 @@ constexpr int kTruthEvery = 10;           // 10 Hz /ground_truth
 constexpr int kScanEvery = 20;            // the Neato's 5 Hz /scan by default ...
 constexpr int kScanOffset = 7;            // ... 70 ms after an odometry tick (the cloud's too)
 constexpr int kCloudEvery = 10;           // the ring lidar's 10 Hz by default
+constexpr int kWarehouseEvery = 10;       // the warehouse lidar's 10 Hz by default
 constexpr double kNeatoRadius = 0.17;     // m, a Neato is 0.33 m across
 
-enum class RigKind { kNeato, kAmr, kCloud };
+enum class RigKind { kNeato, kAmr, kCloud, kWarehouse };
 
 struct Options {
   std::string map, path, out;
@@ -94,7 +103,7 @@ struct Options {
   bool unsigned_odometry = false;
   bool people = true;
   double start_time = 1000.0;
-  // Ticks between scans (the neato and cloud rigs): the sensor's own rate, or
+  // Ticks between scans (the neato, cloud and warehouse rigs): the sensor's own rate, or
   // a sparse log's period (the CARMEN logs keep one scan every few seconds).
   std::optional<int> scan_every;
   std::vector<pf::sim::SensorBlock> blocks;
@@ -103,20 +112,23 @@ struct Options {
 constexpr char kUsage[] =
     "usage: pf_simulator --map MAP.yaml --path SCRIPT.path --out OUT.bag\n"
     "                    [--seed N] [--compression bz2|lz4|none]\n"
-    "                    [--rig neato|amr|cloud]  the robot and its sensors (default neato):\n"
+    "                    [--rig neato|amr|cloud|warehouse]  the robot and its sensors\n"
+    "                         (default neato):\n"
     "                         neato  a Neato XV-11, /scan\n"
     "                         amr    an AMR with front and rear 270-degree lidars,\n"
     "                                /scan_front (12.5 Hz) and /scan_rear (10 Hz)\n"
     "                         cloud  the AMR with a 16-ring 3D lidar, /points, and a\n"
     "                                360-degree lidar at the same place, /scan\n"
+    "                         warehouse  the AMR with one 270-degree 25 m lidar on its\n"
+    "                                front, /scan, among maps/warehouse.yaml's pallets\n"
     "                    [--odom-error K]   scale the odometry errors (0: perfect)\n"
     "                    [--unsigned-odometry]  log reversing as driving forwards\n"
     "                    [--no-people]      ignore the script's 'person' lines\n"
     "                    [--start-time S]   first stamp, s (default 1000)\n"
-    "                    [--scan-period S]  s between scans, neato and cloud rigs\n"
-    "                                       (default 0.2 and 0.1)\n"
+    "                    [--scan-period S]  s between scans, neato, cloud and warehouse\n"
+    "                                       rigs (default 0.2, 0.1 and 0.1)\n"
     "                    [--block NAME:T0:T1]  cover the lidar NAME (neato: laser; amr:\n"
-    "                                       front, rear; cloud: laser) from T0 to T1 s\n"
+    "                                       front, rear; cloud, warehouse: laser) from T0 to T1 s\n"
     "                                       after the start: all its beams read range_min;\n"
     "                                       may be repeated\n";
 
@@ -163,8 +175,10 @@ Options parseOptions(int argc, char** argv) {
         o.rig = RigKind::kAmr;
       } else if (rig == "cloud") {
         o.rig = RigKind::kCloud;
+      } else if (rig == "warehouse") {
+        o.rig = RigKind::kWarehouse;
       } else {
-        usage("--rig must be neato, amr or cloud");
+        usage("--rig must be neato, amr, cloud or warehouse");
       }
     } else if (arg == "--compression") {
       o.compression = value();
@@ -218,6 +232,12 @@ pf::sim::DiffDriveParams odometryErrors(double scale) {
   return p;
 }
 
+// A scan every `every` ticks, the first 70 ms after an odometry tick (or at
+// the start, for a scan on every tick up to 70 ms apart).
+pf::sim::ScanSchedule offsetSchedule(int every) {
+  return {every * kTickNs, (kScanOffset % every) * kTickNs};
+}
+
 // The Neato's laser, scanning every `every` ticks from 70 ms.
 PlanarLidar neatoLidar(int every) {
   PlanarLidar l;
@@ -232,7 +252,7 @@ PlanarLidar neatoLidar(int every) {
   const pf::sim::NeatoLaserParams model;
   l.range_min = model.range_min;
   l.range_max = model.range_max;
-  l.schedule = {every * kTickNs, (kScanOffset % every) * kTickNs};
+  l.schedule = offsetSchedule(every);
   l.scan_time = kScanEvery * kTick;  // one turn of the laser, however sparse the log
   return l;
 }
@@ -252,16 +272,16 @@ struct Rig {
   std::optional<pf::sim::Scene3D> scene;
 };
 
-// The 3D rig's objects are placed in the building: on another map they
-// would stand in walls or outside, which this says rather than simulates.
-void checkClutterOnMap(const pf::OccupancyGrid& map) {
-  for (const pf::sim::Box3& box : pf::sim::buildingClutter()) {
+// A rig's objects that are not on the map are placed for one map: on another
+// they would stand in walls or outside, which this says rather than
+// simulates. `whose` names them and the map they are made for.
+void checkObjectsOnMap(const pf::OccupancyGrid& map, const std::vector<pf::sim::Box3>& objects,
+                       const std::string& whose) {
+  for (const pf::sim::Box3& box : objects) {
     for (double x = box.x0; x <= box.x1; x += 0.5 * map.resolution()) {
       for (double y = box.y0; y <= box.y1; y += 0.5 * map.resolution()) {
         if (map.state(map.worldToCell(x, y)) != pf::CellState::kFree) {
-          throw std::runtime_error(
-              "the cloud rig's objects (building_clutter.h) are not in free space of this map: "
-              "it is made for maps/building.yaml");
+          throw std::runtime_error(whose + " are not in free space of this map");
         }
       }
     }
@@ -285,13 +305,25 @@ Rig makeRig(const Options& o, const pf::OccupancyGrid& map,
       add(pf::sim::amrRearLidar(), Model::kSafety);
       break;
     case RigKind::kCloud: {
-      checkClutterOnMap(map);
-      const int every = o.scan_every.value_or(kCloudEvery);
-      const pf::sim::ScanSchedule schedule{every * kTickNs, (kScanOffset % every) * kTickNs};
+      checkObjectsOnMap(map, pf::sim::buildingClutter(),
+                        "the cloud rig's objects (building_clutter.h; it is made for "
+                        "maps/building.yaml)");
+      const pf::sim::ScanSchedule schedule = offsetSchedule(o.scan_every.value_or(kCloudEvery));
       rig.ring = pf::sim::amrRingLidar(schedule);
       rig.ring_random = pf::sim::SimRandom(sensorSeed(o.seed, 0));
       add(pf::sim::amrMastLidar(schedule), Model::kSafety);
       rig.scene.emplace(map, pf::sim::kBuildingCeiling, pf::sim::buildingClutter(), people);
+      break;
+    }
+    case RigKind::kWarehouse: {
+      const std::vector<pf::sim::Box3> pallets = pf::sim::warehousePallets();
+      checkObjectsOnMap(map, pallets,
+                        "the warehouse rig's pallets (warehouse_map.h; it is made for "
+                        "maps/warehouse.yaml)");
+      add(pf::sim::amrWarehouseLidar(offsetSchedule(o.scan_every.value_or(kWarehouseEvery))),
+          Model::kSafety);
+      // No ceiling: a level lidar never reaches a warehouse's roof.
+      rig.scene.emplace(map, std::numeric_limits<double>::infinity(), pallets, people);
       break;
     }
   }

@@ -43,6 +43,18 @@ PlanarLidar amrRearLidar() {
   return l;
 }
 
+PlanarLidar amrWarehouseLidar(const ScanSchedule& schedule) {
+  PlanarLidar l = safetyLidar();
+  l.name = "laser";
+  l.frame = "laser";
+  l.topic = "/scan";
+  l.mount = {0.32, 0.0, 0.0};  // the middle of the front edge
+  l.range_max = 25.0;          // a warehouse's long aisles need more than the 20 m
+  l.schedule = schedule;
+  l.scan_time = 0.1;  // the lidar's own 10 Hz, however sparse the log
+  return l;
+}
+
 RingLidar amrRingLidar(const ScanSchedule& schedule) {
   RingLidar l;
   l.frame = "velodyne";

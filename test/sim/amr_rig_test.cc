@@ -107,6 +107,34 @@ TEST(AmrRigTest, LidarsScanAtTheirOwnRatesAndNeverAtTheSameInstant) {
   EXPECT_DOUBLE_EQ(rear.schedule.rateHz(), 10.0);
 }
 
+TEST(AmrRigTest, TheWarehouseLidarLooksForwardFromTheFrontEdgeTo25Metres) {
+  const PlanarLidar l = amrWarehouseLidar({100'000'000, 70'000'000});
+  EXPECT_EQ(l.topic, "/scan");
+  EXPECT_EQ(l.beams, 541);
+  EXPECT_NEAR(l.angle_min, -135 * kDeg, 1e-12);
+  EXPECT_NEAR(l.angleMax(), 135 * kDeg, 1e-12);
+  EXPECT_EQ(l.range_max, 25.0);
+  EXPECT_DOUBLE_EQ(l.schedule.rateHz(), 10.0);
+  // On the front edge of the body (0.64 m long), centred, looking ahead.
+  EXPECT_EQ(l.mount.x, 0.32);
+  EXPECT_EQ(l.mount.y, 0.0);
+  EXPECT_EQ(l.mount.yaw, 0.0);
+  const RayCaster walls(room());
+  const auto r = idealRanges(l, walls, {}, {5.0, 5.0, 0.0}, 0.0);
+  EXPECT_NEAR(r[beamAt(l, 0.0)], 9.95 - 5.32, 1e-9);        // ahead
+  EXPECT_NEAR(r[beamAt(l, 90 * kDeg)], 9.95 - 5.0, 1e-9);   // left
+  EXPECT_NEAR(r[beamAt(l, -90 * kDeg)], 5.0 - 0.05, 1e-9);  // right
+  // It sees as far as its range allows and no further: in a 10 m room
+  // nothing is out of range; in a 40 m one looking along it, +inf.
+  const int n = 800;
+  std::vector<int8_t> data(n * 200, 0);
+  for (int i = 0; i < n; ++i) data[i] = data[199 * n + i] = 100;
+  for (int j = 0; j < 200; ++j) data[j * n] = data[j * n + n - 1] = 100;
+  const RayCaster hall(OccupancyGrid(n, 200, 0.05, {}, data));
+  EXPECT_NEAR(idealRanges(l, hall, {}, {15.0, 5.0, 0.0}, 0.0)[beamAt(l, 0.0)], 39.95 - 15.32, 1e-9);
+  EXPECT_TRUE(std::isinf(idealRanges(l, hall, {}, {10.0, 5.0, 0.0}, 0.0)[beamAt(l, 0.0)]));
+}
+
 TEST(AmrRigTest, TheMastLidarSitsWhereTheRingLidarIsAndScansWithIt) {
   const ScanSchedule schedule{2'000'000'000, 70'000'000};
   const RingLidar ring = amrRingLidar(schedule);

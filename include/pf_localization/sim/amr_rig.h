@@ -18,6 +18,12 @@
 // (12.5 Hz from 30 ms, 10 Hz from 60 ms: one is on odd 10 ms ticks, the
 // other on even ones).
 //
+// The warehouse rig (issue 30) keeps the body and carries one safety lidar
+// of longer range, centred on the front edge, as a warehouse AMR that only
+// drives forwards does: 0.2 m up, 541 beams at 0.5 degrees from -135 to +135
+// degrees, 0.05-25 m, 10 Hz (or a log's sparser period). Its 270 degrees
+// miss the quarter behind the robot.
+//
 // The 3D rig puts a 16-ring lidar (ring_lidar.h) on a mast above the centre
 // of the robot, 0.6 m up, and a 360-degree planar lidar at the same place,
 // for comparing the two on the same path.
@@ -36,6 +42,10 @@ inline constexpr double kAmrRadius = 0.39;
 PlanarLidar amrFrontLidar();
 /// The rear-right safety lidar: name "rear", frame rear_laser, /scan_rear.
 PlanarLidar amrRearLidar();
+
+/// The warehouse rig's front lidar: name "laser", frame laser (x 0.32, y 0,
+/// z 0.2, yaw 0), /scan, range 0.05-25 m, scanning on `schedule`.
+PlanarLidar amrWarehouseLidar(const ScanSchedule& schedule);
 
 /// The 3D rig's 16-ring lidar: frame velodyne, 0.6 m above base_link's
 /// origin, yaw 0, sweeping on `schedule`.
