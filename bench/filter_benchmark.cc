@@ -5,6 +5,7 @@
 // every beam valid, particles scattered around one pose, so the figures only
 // depend on the code and the machine.
 #include <benchmark/benchmark.h>
+#include <malloc.h>
 
 #include <algorithm>
 #include <cmath>
@@ -281,6 +282,61 @@ void BM_LikelihoodField(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_LikelihoodField)->Arg(1000)->Arg(2000)->Arg(4000)->Unit(benchmark::kMillisecond);
+
+// A map installed in the filter, as pf_node does when one arrives: the
+// distance transform, the likelihood table and the rest of the default
+// sensor model. Issue 30: a 4000 x 4000 map (200 x 200 m) within 1 s.
+void BM_MapSetUp(benchmark::State& state) {
+  const pf::OccupancyGrid grid = pillarMap(static_cast<int>(state.range(0)));
+  pf::ParticleFilterParams params;
+  params.kld.max_particles = 1000;
+  pf::ParticleFilter filter(params);
+  for (auto _ : state) filter.setMap(grid);
+}
+BENCHMARK(BM_MapSetUp)->Arg(1000)->Arg(4000)->Unit(benchmark::kMillisecond)->Iterations(3);
+
+// The heap a filter holds per particle of max_particles once it has run a
+// global localization's updates with them all: the particles and the
+// storage each step keeps between updates (the prefaulted cloud, the
+// resampler's second set, the weighting's and the estimate's scratch), the
+// map's share left out (it is measured with none of the particles). The
+// figure the README states; it fails above kMaxBytesPerParticle.
+constexpr double kMaxBytesPerParticle = 400.0;
+void BM_MemoryPerParticle(benchmark::State& state) {
+  const std::size_t n = state.range(0);
+  const pf::OccupancyGrid grid = pillarMap(400);
+  const pf::LaserScan scan = fullScan(360);
+  // Heap in use: the arena's and the blocks large enough to be mapped alone.
+  const auto heap = [] {
+    const struct mallinfo2 m = mallinfo2();
+    return static_cast<double>(m.uordblks + m.hblkhd);
+  };
+  double per_particle = 0.0;
+  for (auto _ : state) {
+    const double before = heap();
+    {
+      pf::ParticleFilterParams params;
+      params.kld.min_particles = 500;
+      params.kld.max_particles = static_cast<int>(n);
+      params.update_min_d = params.update_min_a = 0.0;
+      params.threads = 2;
+      pf::ParticleFilter filter(params);
+      filter.setMap(grid);
+      const double with_map = heap();
+      filter.initializeUniform();
+      for (int k = 0; k < 3; ++k) filter.update({0.05 * k, 0.0, 0.0}, scan);
+      per_particle = (heap() - with_map) / static_cast<double>(n);
+      benchmark::DoNotOptimize(before);
+    }
+  }
+  state.counters["bytes_per_particle"] = per_particle;
+  if (per_particle > kMaxBytesPerParticle) {
+    state.SkipWithError("more heap per particle than kMaxBytesPerParticle");
+  }
+}
+// One size only: the per-thread scratch of the steps is kept for the
+// process's life, so a smaller run before would have grown it already.
+BENCHMARK(BM_MemoryPerParticle)->Arg(1000000)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 // A 16-ring lidar's sweep (16 x 1800 = 28 800 points, -15 to +15 deg, as the
 // simulator's ring_lidar.h) 0.6 m up in a 10 x 8 m room with a 2.5 m
