@@ -128,7 +128,8 @@ pf_check_deb() {
   done
   # Depends as package names, one a line (versions and alternatives dropped).
   depends=$(dpkg-deb -f "$deb" Depends | sed -E 's/[,|]/\n/g' | sed -E 's/\(.*\)//; s/:any//; s/ //g' | sed '/^$/d' | sort -u)
-  for p in python3-roslaunch python3-rosbag libroscpp4d; do
+  # python3-genpy: pf_hypotheses' generated Python module imports it.
+  for p in python3-roslaunch python3-rosbag libroscpp4d python3-genpy; do
     grep -qx "$p" <<<"$depends" || { echo "Depends lacks $p: $(dpkg-deb -f "$deb" Depends)"; bad=1; }
   done
   if grep -E -- '-dev$' <<<"$depends"; then echo "Depends names -dev packages (above)"; bad=1; fi
@@ -152,6 +153,8 @@ pf_check_deb() {
            usr/share/pf_localization/bags/tracking.bag usr/share/pf_localization/rviz/pf.rviz \
            usr/lib/pf_localization/pf_node usr/lib/pf_localization/map_publisher \
            usr/lib/pf_localization/pf_evaluate "usr/lib/$multiarch/libpf_core.so" \
+           usr/share/pf_localization/msg/PoseHypotheses.msg usr/include/pf_localization/PoseHypotheses.h \
+           usr/lib/python3/dist-packages/pf_localization/msg/_PoseHypotheses.py \
            usr/share/doc/ros-pf-localization/copyright; do
     grep -qx "$f" <<<"$listing" || { echo "missing /$f"; bad=1; }
   done
