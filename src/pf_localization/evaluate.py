@@ -153,25 +153,31 @@ def read_update_log(path):
 COV_COLUMNS = ('t', 'xx', 'xy', 'yy', 'yawyaw', 'xyaw', 'yyaw')
 
 
-def read_covariance(path):
-    """Runner's covariance CSV (header t,xx,xy,yy,yawyaw,xyaw,yyaw) -> (N, 7) array in that column
-    order, sorted by time. Lines that do not parse are skipped; 'nan' is kept (no estimate yet)."""
-    _need_file(path, 'covariance file')
+def read_columns(path, what, columns):
+    """A runner's CSV whose header names `columns` (among others, in any order) -> (N, len(columns))
+    array in the order of `columns`, unsorted. Lines that do not parse are skipped."""
+    _need_file(path, what)
     with open(path, newline='') as f:
         reader = csv.reader(f)
         header = [h.strip() for h in next(reader, [])]
-        missing = [c for c in COV_COLUMNS if c not in header]
+        missing = [c for c in columns if c not in header]
         if missing:
-            raise EvalError('covariance file %s lacks column(s) %s (expected header %s)'
-                            % (path, ', '.join(missing), ','.join(COV_COLUMNS)))
-        idx = [header.index(c) for c in COV_COLUMNS]
+            raise EvalError('%s %s lacks column(s) %s (expected header %s)'
+                            % (what, path, ', '.join(missing), ','.join(columns)))
+        idx = [header.index(c) for c in columns]
         rows = []
         for r in reader:
             try:
                 rows.append([float(r[i]) for i in idx])
             except (ValueError, IndexError):
                 continue
-    a = np.array(rows, dtype=float).reshape(-1, len(COV_COLUMNS))
+    return np.array(rows, dtype=float).reshape(-1, len(columns))
+
+
+def read_covariance(path):
+    """Runner's covariance CSV (header t,xx,xy,yy,yawyaw,xyaw,yyaw) -> (N, 7) array in that column
+    order, sorted by time. Lines that do not parse are skipped; 'nan' is kept (no estimate yet)."""
+    a = read_columns(path, 'covariance file', COV_COLUMNS)
     a = a[np.isfinite(a[:, 0])]
     if len(a) == 0:
         raise EvalError('covariance file %s has no rows' % path)
@@ -180,21 +186,9 @@ def read_covariance(path):
 
 def read_hypotheses(path):
     """Runner's hypotheses CSV (header t,rank,x,y,yaw,weight,std_x,std_y) -> (N, 8) array in that
-    column order, sorted by time then rank."""
-    _need_file(path, 'hypotheses file')
-    with open(path, newline='') as f:
-        reader = csv.reader(f)
-        header = [h.strip() for h in next(reader, [])]
-        missing = [c for c in HYP_COLUMNS if c not in header]
-        if missing:
-            raise EvalError('hypotheses file %s lacks column(s) %s (expected header %s)'
-                            % (path, ', '.join(missing), ','.join(HYP_COLUMNS)))
-        idx = [header.index(c) for c in HYP_COLUMNS]
-        try:
-            rows = [[float(r[i]) for i in idx] for r in reader if r]
-        except (ValueError, IndexError) as e:
-            raise EvalError('hypotheses file %s: a line does not parse (%s)' % (path, e))
-    a = np.array(rows, dtype=float).reshape(-1, len(HYP_COLUMNS))
+    column order, sorted by time then rank. Lines that do not parse are skipped."""
+    a = read_columns(path, 'hypotheses file', HYP_COLUMNS)
+    a = a[np.isfinite(a[:, 0])]
     if len(a) == 0:
         raise EvalError('hypotheses file %s has no rows' % path)
     return a[np.lexsort((a[:, 1], a[:, 0]))]
