@@ -135,8 +135,9 @@ class ParticleFilter {
   const PoseEstimate& estimate() const { return estimate_; }
   /// How far to trust the estimate, as of the last update.
   const Confidence& confidence() const { return confidence_.confidence(); }
-  /// The places the estimate's clusters hold with real weight, by the rule
-  /// confidence() counts rivals with (hypotheses.h).
+  /// The places the estimate's clusters hold with real weight: the
+  /// heaviest, every rival confidence() counts, and any cluster with
+  /// kMinHypothesisShare of the weight (hypotheses.h).
   Hypotheses hypotheses() const {
     return hypothesesOf(estimate_, params_.confidence.rival_weight_ratio);
   }
