@@ -19,6 +19,10 @@ packages=(
   libtf2-dev libtf2-ros-dev libtf2-geometry-msgs-dev libtf2-msgs-dev
   libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev libstd-srvs-dev libdiagnostic-msgs-dev
   librosbag-dev librosbag-storage-dev python3-rosbag
+  # msg/PoseHypotheses.msg: message_generation (the C++ and Python generators)
+  # and message_runtime; std_msgs for its header
+  ros-message-generation ros-message-runtime python3-genmsg python3-gencpp python3-genpy
+  libstd-msgs-dev python3-std-msgs
   # dynamic_reconfigure: the C++ server and its headers; the .cfg generator,
   # the Python client (test/rostest/reconfigure_checker.py) and dynparam
   libdynamic-reconfigure-config-init-mutex-dev python3-dynamic-reconfigure

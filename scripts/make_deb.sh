@@ -4,9 +4,9 @@
 # anything):
 #   /usr/lib/pf_localization/        the nodes and Python tools (catkin's libexec)
 #   /usr/lib/<multiarch>/            libpf_core.so, libpf_ros.so, libpf_sim.so; cmake/, pkgconfig/
-#   /usr/share/pf_localization/      package.xml, launch, config, maps, bags, rviz
-#   /usr/include/pf_localization/    the headers
-#   /usr/lib/python3/dist-packages/pf_localization/   the dynamic_reconfigure client module
+#   /usr/share/pf_localization/      package.xml, launch, config, maps, bags, rviz, msg
+#   /usr/include/pf_localization/    the headers (PoseHypotheses.h: pf_hypotheses' message)
+#   /usr/lib/python3/dist-packages/pf_localization/   the dynamic_reconfigure client module, msg/
 #   /usr/share/doc/ros-pf-localization/               copyright, changelog
 # As Debian builds its ROS packages: the package alone, with cmake and
 # Debian's catkin, CMAKE_INSTALL_PREFIX=/usr (catkin then installs in Debian's
@@ -95,7 +95,11 @@ for d in "${rundeps[@]}"; do
     # linked C++ libraries: dpkg-shlibdeps
     roscpp|rosbag|message_filters|tf2|tf2_ros|dynamic_reconfigure|yaml-cpp) ;;
     # messages and services, tf2_geometry_msgs, Eigen: headers, compiled in
-    tf2_msgs|sensor_msgs|nav_msgs|geometry_msgs|std_srvs|diagnostic_msgs|tf2_geometry_msgs|eigen) ;;
+    tf2_msgs|sensor_msgs|nav_msgs|geometry_msgs|std_msgs|std_srvs|diagnostic_msgs|tf2_geometry_msgs|eigen) ;;
+    # pf_hypotheses' message: compiled into pf_node; its generated Python
+    # module (rostopic echo, a Python client) imports genpy and the message
+    # packages it is built from
+    message_runtime) depends+=(python3-genpy python3-std-msgs python3-geometry-msgs) ;;
     roslaunch) ;;          # python3-roslaunch (above)
     python3-numpy|python3-yaml) ;;  # above
     # pf_tune only (Optuna, Dask, its plots and progress bar): suggested, not

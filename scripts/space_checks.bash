@@ -7,7 +7,8 @@
 #   pf_in_space SETUP CMD...        runs CMD with only SETUP (a setup.bash) loaded
 #   pf_space_cmd SETUP CMD...       the same command line, in the array PF_SPACE_CMD
 #   pf_check_rosrun SETUP           rosrun pf_localization pf_evaluate --help, no prompt, no loop
-#   pf_check_install_demo WS        roslaunch bag_demo.launch from WS/install: pf_node publishes pf_pose
+#   pf_check_install_demo WS        roslaunch bag_demo.launch from WS/install: pf_node publishes pf_pose,
+#                                   and pf_hypotheses as rostopic reads it (the generated message)
 #   pf_check_demo SETUP SHARE       the same from any space; SHARE: where pf_localization must be found
 #   pf_check_deb DEB PACKAGE_XML    the .deb of scripts/make_deb.sh: fields, files under /usr, Depends,
 #                                   no test node
@@ -47,13 +48,15 @@ pf_check_rosrun() {
 }
 
 # bag_demo.launch from the install space alone (a private roscore on a random
-# port, the bundled bag at 2x, 66 s long): pf_node must publish pf_pose within 60 s.
+# port, the bundled bag at 2x, 66 s long): pf_node must publish pf_pose within 60 s,
+# and pf_hypotheses (latched), which rostopic must read with the space's own
+# generated Python message.
 # SIGTERM stops roslaunch: a background job of a script ignores SIGINT.
 pf_check_install_demo() {
   pf_check_demo "$1/install/setup.bash" "$1/install/share/pf_localization"
 }
 pf_check_demo() {
-  local setup=$1 share=$2 tmp port launch_pid rc out
+  local setup=$1 share=$2 tmp port launch_pid rc out hyp
   if [ ! -f "$setup" ]; then echo "no $setup"; return 1; fi
   tmp=$(mktemp -d /tmp/pf_install_demo.XXXXXX)
   port=$((20000 + RANDOM % 20000))
@@ -77,6 +80,7 @@ pf_check_demo() {
     done
     out=$(pf_in_space "$setup" timeout 60 rostopic echo -n 3 /pf_pose 2>&1)
     rc=$?
+    hyp=$(pf_in_space "$setup" timeout 20 rostopic echo -n 1 /pf_hypotheses 2>&1)
     kill -TERM "$launch_pid" 2>/dev/null
     wait "$launch_pid"
     n=$(grep -c '^header:' <<<"$out")
@@ -86,7 +90,13 @@ pf_check_demo() {
       echo "(logs in $tmp)"
       exit 1
     fi
-    echo "bag_demo.launch from $(dirname "$setup"): $n pf_pose messages, e.g. x=$(grep -m1 -A1 'position:' <<<"$out" | sed -nE 's/.*x: //p')"
+    if ! grep -qE '^count: [1-9]' <<<"$hyp"; then
+      echo "rostopic echo -n 1 /pf_hypotheses: no hypothesis read:"
+      head -n 20 <<<"$hyp"
+      echo "(logs in $tmp)"
+      exit 1
+    fi
+    echo "bag_demo.launch from $(dirname "$setup"): $n pf_pose messages, e.g. x=$(grep -m1 -A1 'position:' <<<"$out" | sed -nE 's/.*x: //p'); pf_hypotheses $(grep -m1 '^count:' <<<"$hyp")"
   )
   rc=$?
   [ "$rc" -eq 0 ] && rm -rf "$tmp"
@@ -128,7 +138,8 @@ pf_check_deb() {
   done
   # Depends as package names, one a line (versions and alternatives dropped).
   depends=$(dpkg-deb -f "$deb" Depends | sed -E 's/[,|]/\n/g' | sed -E 's/\(.*\)//; s/:any//; s/ //g' | sed '/^$/d' | sort -u)
-  for p in python3-roslaunch python3-rosbag libroscpp4d; do
+  # python3-genpy: pf_hypotheses' generated Python module imports it.
+  for p in python3-roslaunch python3-rosbag libroscpp4d python3-genpy; do
     grep -qx "$p" <<<"$depends" || { echo "Depends lacks $p: $(dpkg-deb -f "$deb" Depends)"; bad=1; }
   done
   if grep -E -- '-dev$' <<<"$depends"; then echo "Depends names -dev packages (above)"; bad=1; fi
@@ -152,6 +163,8 @@ pf_check_deb() {
            usr/share/pf_localization/bags/tracking.bag usr/share/pf_localization/rviz/pf.rviz \
            usr/lib/pf_localization/pf_node usr/lib/pf_localization/map_publisher \
            usr/lib/pf_localization/pf_evaluate "usr/lib/$multiarch/libpf_core.so" \
+           usr/share/pf_localization/msg/PoseHypotheses.msg usr/include/pf_localization/PoseHypotheses.h \
+           usr/lib/python3/dist-packages/pf_localization/msg/_PoseHypotheses.py \
            usr/share/doc/ros-pf-localization/copyright; do
     grep -qx "$f" <<<"$listing" || { echo "missing /$f"; bad=1; }
   done

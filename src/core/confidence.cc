@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
+#include "pf_localization/core/hypotheses.h"
 #include "pf_localization/core/parameter_check.h"
 
 namespace pf {
@@ -56,7 +57,8 @@ Confidence assessConfidence(const ParticleSet& particles, const PoseEstimate& es
   c.std_y = std::sqrt(first.covariance(1, 1));
   c.std_yaw = std::sqrt(first.covariance(2, 2));
   for (std::size_t k = 1; k < estimate.clusters.size(); ++k) {
-    c.rivals += estimate.clusters[k].weight >= params.rival_weight_ratio * first.weight ? 1 : 0;
+    // Every rival is listed on pf_hypotheses (hypothesesOf).
+    c.rivals += isRival(estimate.clusters[k], first, params.rival_weight_ratio) ? 1 : 0;
   }
   c.covariance = first.covariance;
   if (c.rivals > 0) {

@@ -53,6 +53,8 @@ constexpr char kUsage[] =
     "         [--particles-out P.csv]    every particle of every update in the first 30 s\n"
     "         [--covariance COV.csv]     t,xx,xy,yy,yawyaw,xyaw,yyaw: pf_pose's covariance\n"
     "                                    at each pose of the trajectory (same stamps)\n"
+    "         [--hypotheses HYP.csv]     t,rank,x,y,yaw,weight,std_x,std_y: pf_hypotheses,\n"
+    "                                    one line per hypothesis per filter update\n"
     "         [--quiet]                  no progress bar\n";
 
 // How long (bag time) a scan may wait for its odometry before it is used anyway.
@@ -61,7 +63,7 @@ constexpr double kMaxTfWait = 1.0;
 constexpr double kParticleDumpSeconds = 30.0;
 
 struct Options {
-  std::string bag, map, out, params, log, particles_out, covariance;
+  std::string bag, map, out, params, log, particles_out, covariance, hypotheses;
   std::vector<std::string> scan_topics;   // empty: /scan
   std::vector<std::string> cloud_topics;  // PointCloud2 topics, sensors after the scan topics
   std::string odom_topic = "/odom";
@@ -108,6 +110,8 @@ Options parse(int argc, char** argv) {
       o.particles_out = value(), ++i;
     else if (a == "--covariance")
       o.covariance = value(), ++i;
+    else if (a == "--hypotheses")
+      o.hypotheses = value(), ++i;
     else if (a == "--scan-topic")
       o.scan_topics.push_back(value()), ++i;
     else if (a == "--cloud-topic")
@@ -240,9 +244,9 @@ void loadMap(const Options& opt, pf_ros::ScanLocalizer* localizer) {
 }
 
 // The files a run writes: the trajectory, and the optional update log,
-// particle dump and covariance (closed streams when not asked for).
+// particle dump, covariance and hypotheses (closed streams when not asked for).
 struct Outputs {
-  std::ofstream out, log, dump, cov;
+  std::ofstream out, log, dump, cov, hypotheses;
 };
 
 void openOutputs(const Options& opt, Outputs* o) {
@@ -265,6 +269,11 @@ void openOutputs(const Options& opt, Outputs* o) {
     o->cov.open(opt.covariance);
     if (!o->cov) fail(opt.covariance + ": cannot write");
     o->cov << "t,xx,xy,yy,yawyaw,xyaw,yyaw\n";
+  }
+  if (!opt.hypotheses.empty()) {
+    o->hypotheses.open(opt.hypotheses);
+    if (!o->hypotheses) fail(opt.hypotheses + ": cannot write");
+    o->hypotheses << "t,rank,x,y,yaw,weight,std_x,std_y\n" << std::fixed << std::setprecision(6);
   }
 }
 
@@ -314,6 +323,7 @@ class Replay {
   void logUpdate(double t, const pf_ros::ScanResult& r, double cpu);
   std::string missingNames(double t) const;
   void dumpParticles(double t);
+  void writeHypotheses(double t);
   void writeCovariance(double t);
   // A sensor that went missing or came back: one line on stderr, as pf_node's
   // diagnostics name it.
@@ -415,6 +425,7 @@ void Replay::process(const Pending& pending) {
     counts_.update_cpu.add(cpu);
     if (outputs_.log) logUpdate(t, r, cpu);
     if (outputs_.dump && t - first_stamp_ <= kParticleDumpSeconds) dumpParticles(t);
+    if (outputs_.hypotheses) writeHypotheses(t);
   }
   // The pose a tf user would get: the newest map -> odom composed with the
   // odometry at the scan's stamp.
@@ -481,6 +492,18 @@ void Replay::dumpParticles(double t) {
   const pf::ParticleSet& p = localizer_.filter().particles();
   for (std::size_t i = 0; i < p.size(); ++i) {
     outputs_.dump << t << "," << p.x[i] << "," << p.y[i] << "," << p.yaw[i] << "\n";
+  }
+}
+
+// What pf_node publishes on pf_hypotheses after this update, one line per
+// hypothesis, heaviest (rank 1) first.
+void Replay::writeHypotheses(double t) {
+  const pf::Hypotheses h = localizer_.filter().hypotheses();
+  for (std::size_t k = 0; k < h.listed.size(); ++k) {
+    const pf::Hypothesis& a = h.listed[k];
+    outputs_.hypotheses << t << "," << k + 1 << "," << a.pose.x << "," << a.pose.y << ","
+                        << a.pose.yaw << "," << a.weight << "," << std::sqrt(a.covariance(0, 0))
+                        << "," << std::sqrt(a.covariance(1, 1)) << "\n";
   }
 }
 

@@ -3,13 +3,15 @@
 usage: pf_evaluate --traj TRAJ.tum (--bag BAG | --ref REF.tum) [--map MAP.yaml]
                    [--log UPDATES.csv] [--particles PARTICLES.csv|.bin] [--out DIR]
                    [--cov COV.csv] [--ref-std 0] [--lost 0.3] [--max-gap 0.5] [--hold]
-                   [--gif-seconds 30]
+                   [--gif-seconds 30] [--hypotheses HYP.csv]
 
 Inputs
   TRAJ.tum   the filter's estimates, one line per scan: t x y z qx qy qz qw (map frame).
   reference  the bag's /ground_truth (geometry_msgs/PoseStamped, header stamps) or a TUM file.
   COV.csv    pf_bag_runner --covariance: t,xx,xy,yy,yawyaw,xyaw,yyaw, the published covariance
              (pf_pose) in force from each stamp on.
+  HYP.csv    pf_bag_runner --hypotheses: t,rank,x,y,yaw,weight,std_x,std_y, what pf_hypotheses
+             publishes at each filter update (one line per hypothesis, rank 1 the heaviest).
 
 Time association: every reference pose gets the estimate at its stamp, linearly interpolated in
 x, y and along the shorter arc in yaw between the two bracketing estimates when both lie within
@@ -33,6 +35,10 @@ Metrics (DIR/summary.json)
   95 if honest), NEES mean (2 if honest) and median (2 ln 2 = 1.39 if honest) of the finite d^2.
   A singular S (a degenerate covariance) counts as not covering (d^2 = inf) and is counted.
   With --log, the mean/p95 update CPU time and particle counts from the runner's update log.
+  With --hypotheses, whether the true place is among the published hypotheses: the share of the
+  updates (with a reference pose within --max-gap, interpolated as above) where one lies within
+  1 m of it, over all of them and over those with several hypotheses (while ambiguous), and how
+  many hypotheses there were.
 
 Plots (PNG): trajectory.png (map, estimate, reference), error.png (position and yaw error over
 time); with --log spread.png (particle std dev) and cpu.png (update CPU time, particle count);
@@ -52,6 +58,10 @@ EXACT_S = 1e-4  # estimates this close to a reference stamp count as taken at it
 OFF_M = 0.5     # an estimate this far from the reference is "off" (the issue trackers' figure)
 SETTLE_S = 10.0  # the start of a run that off_fraction_after_settle leaves out
 WRONG_M = 1.0    # "localized" while this far off is confidently wrong
+# A hypothesis this close to the reference holds the true place: as WRONG_M, the distance at which
+# an estimate stops being a noisy version of the right place (a twin room is 4.75 m away).
+HYPOTHESIS_NEAR_M = 1.0
+HYP_COLUMNS = ('t', 'rank', 'x', 'y', 'yaw', 'weight', 'std_x', 'std_y')
 CHI2_95_2DOF = 5.991  # 95 % quantile of the chi-square distribution with 2 degrees of freedom
 
 
@@ -143,29 +153,70 @@ def read_update_log(path):
 COV_COLUMNS = ('t', 'xx', 'xy', 'yy', 'yawyaw', 'xyaw', 'yyaw')
 
 
-def read_covariance(path):
-    """Runner's covariance CSV (header t,xx,xy,yy,yawyaw,xyaw,yyaw) -> (N, 7) array in that column
-    order, sorted by time. Lines that do not parse are skipped; 'nan' is kept (no estimate yet)."""
-    _need_file(path, 'covariance file')
+def read_columns(path, what, columns):
+    """A runner's CSV whose header names `columns` (among others, in any order) -> (N, len(columns))
+    array in the order of `columns`, unsorted. Lines that do not parse are skipped."""
+    _need_file(path, what)
     with open(path, newline='') as f:
         reader = csv.reader(f)
         header = [h.strip() for h in next(reader, [])]
-        missing = [c for c in COV_COLUMNS if c not in header]
+        missing = [c for c in columns if c not in header]
         if missing:
-            raise EvalError('covariance file %s lacks column(s) %s (expected header %s)'
-                            % (path, ', '.join(missing), ','.join(COV_COLUMNS)))
-        idx = [header.index(c) for c in COV_COLUMNS]
+            raise EvalError('%s %s lacks column(s) %s (expected header %s)'
+                            % (what, path, ', '.join(missing), ','.join(columns)))
+        idx = [header.index(c) for c in columns]
         rows = []
         for r in reader:
             try:
                 rows.append([float(r[i]) for i in idx])
             except (ValueError, IndexError):
                 continue
-    a = np.array(rows, dtype=float).reshape(-1, len(COV_COLUMNS))
+    return np.array(rows, dtype=float).reshape(-1, len(columns))
+
+
+def read_covariance(path):
+    """Runner's covariance CSV (header t,xx,xy,yy,yawyaw,xyaw,yyaw) -> (N, 7) array in that column
+    order, sorted by time. Lines that do not parse are skipped; 'nan' is kept (no estimate yet)."""
+    a = read_columns(path, 'covariance file', COV_COLUMNS)
     a = a[np.isfinite(a[:, 0])]
     if len(a) == 0:
         raise EvalError('covariance file %s has no rows' % path)
     return a[np.argsort(a[:, 0], kind='stable')]
+
+
+def read_hypotheses(path):
+    """Runner's hypotheses CSV (header t,rank,x,y,yaw,weight,std_x,std_y) -> (N, 8) array in that
+    column order, sorted by time then rank. Lines that do not parse are skipped."""
+    a = read_columns(path, 'hypotheses file', HYP_COLUMNS)
+    a = a[np.isfinite(a[:, 0])]
+    if len(a) == 0:
+        raise EvalError('hypotheses file %s has no rows' % path)
+    return a[np.lexsort((a[:, 1], a[:, 0]))]
+
+
+def hypotheses_metrics(hyp, ref, max_gap=0.5, interpolate=True, near=HYPOTHESIS_NEAR_M):
+    """Whether the reference pose is among each update's hypotheses (one within `near` m of it).
+    Updates without a reference pose within max_gap are left out (and counted)."""
+    times, first = np.unique(hyp[:, 0], return_index=True)
+    counts = np.diff(np.append(first, len(hyp)))
+    truth, kind = associate(ref, times, max_gap, interpolate)
+    matched = kind > 0
+    contains = np.zeros(len(times), dtype=bool)
+    for k in np.flatnonzero(matched):
+        xy = hyp[first[k]:first[k] + counts[k], 2:4]
+        contains[k] = bool(np.any(np.hypot(xy[:, 0] - truth[k, 0], xy[:, 1] - truth[k, 1]) <= near))
+    several = matched & (counts > 1)
+    share = lambda mask: float(np.mean(contains[mask])) if mask.any() else None
+    return {
+        'updates': int(len(times)), 'updates_matched': int(matched.sum()),
+        'contain_truth_share': share(matched),
+        'updates_with_several': int(several.sum()),
+        'contain_truth_share_with_several': share(several),
+        'most_hypotheses': int(counts.max()),
+        'mean_hypotheses': float(counts.mean()),
+        'misses_s': [float(t - ref[0, 0]) for t in times[matched & ~contains]],
+        'near_m': float(near),
+    }
 
 
 def read_particles(path):
@@ -723,6 +774,7 @@ def parse_args(argv):
     p.add_argument('--particles', help='particle dump (CSV t,x,y,yaw or .bin float64 records)')
     p.add_argument('--out', help='report directory (default: TRAJ without extension + _eval)')
     p.add_argument('--cov', help="runner's covariance CSV (pf_bag_runner --covariance)")
+    p.add_argument('--hypotheses', help="runner's hypotheses CSV (pf_bag_runner --hypotheses)")
     p.add_argument('--ref-std', type=float, default=0.0,
                    help="the reference's own position std dev (m), added as ref_std^2 I to the covariance")
     p.add_argument('--cov-aligned', action='store_true',
@@ -744,6 +796,7 @@ def run(args):
     log = read_update_log(args.log) if args.log else None
     parts = read_particles(args.particles) if args.particles else None
     cov = read_covariance(args.cov) if args.cov else None
+    hyp = read_hypotheses(args.hypotheses) if args.hypotheses else None
     if not (np.isfinite(args.ref_std) and args.ref_std >= 0):
         raise EvalError('--ref-std must be a finite number >= 0, got %g' % args.ref_std)
     out = args.out or os.path.splitext(args.traj)[0] + '_eval'
@@ -760,8 +813,11 @@ def run(args):
     if cov is not None:
         m['covariance'], cov_samples = covariance_metrics(cov, match, args.max_gap, args.ref_std,
                                                           args.cov_aligned)
+    if hyp is not None:
+        m['hypotheses'] = hypotheses_metrics(hyp, ref, args.max_gap, not args.hold)
     m['inputs'] = {k: os.path.abspath(v) for k, v in (('traj', args.traj), ('bag', args.bag), ('ref', args.ref),
-                   ('map', args.map), ('log', args.log), ('particles', args.particles), ('cov', args.cov)) if v}
+                   ('map', args.map), ('log', args.log), ('particles', args.particles), ('cov', args.cov),
+                   ('hypotheses', args.hypotheses)) if v}
     plots = []
     if not args.no_plots:
         import matplotlib
@@ -811,6 +867,8 @@ def describe(m, summary):
                      % (m['confidently_wrong_updates'], m['confidently_wrong_threshold_m']))
     if 'covariance' in m:
         lines.append(describe_covariance(m['covariance']))
+    if 'hypotheses' in m:
+        lines.append(describe_hypotheses(m['hypotheses']))
     for name, v in m.get('sensors_missing', {}).items():
         lines.append('  sensor missing: %s in %.0f %% of the updates (%s s)' % (
             name, 100 * v['share'], ', '.join('%.1f-%.1f' % tuple(x) for x in v['stretches_s'])))
@@ -819,6 +877,16 @@ def describe(m, summary):
                      % (m['cpu_ms_mean'], m['cpu_ms_p95'], m['n_log_rows']))
     lines.append('  report: %s' % summary + (' (+ %s)' % ', '.join(m['plots']) if m['plots'] else ''))
     return '\n'.join(lines)
+
+
+def describe_hypotheses(h):
+    """The text summary's hypotheses line."""
+    pct = lambda v: '-' if v is None else '%.1f %%' % (100 * v)
+    return ('  hypotheses:     the true place within %.1f m of one in %s of %d updates; in %s of the %d '
+            'with several (up to %d, mean %.2f)'
+            % (h['near_m'], pct(h['contain_truth_share']), h['updates_matched'],
+               pct(h['contain_truth_share_with_several']), h['updates_with_several'],
+               h['most_hypotheses'], h['mean_hypotheses']))
 
 
 def describe_covariance(c):

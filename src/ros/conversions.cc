@@ -164,4 +164,18 @@ void toPoseArray(const pf::ParticleSet& particles, std::size_t max_poses,
   }
 }
 
+void toHypothesesMsg(const pf::Hypotheses& hypotheses, pf_localization::PoseHypotheses* out) {
+  out->count = static_cast<uint32_t>(hypotheses.count);
+  out->poses.resize(hypotheses.listed.size());
+  out->weights.resize(hypotheses.listed.size());
+  out->particles.resize(hypotheses.listed.size());
+  for (std::size_t k = 0; k < hypotheses.listed.size(); ++k) {
+    const pf::Hypothesis& h = hypotheses.listed[k];
+    out->poses[k].pose = toPoseMsg(h.pose);
+    out->poses[k].covariance = toRosCovariance(h.covariance);
+    out->weights[k] = h.weight;
+    out->particles[k] = static_cast<uint32_t>(h.particles);
+  }
+}
+
 }  // namespace pf_ros

@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 namespace pf_ros {
 namespace {
@@ -89,6 +90,33 @@ void addSensors(diagnostic_msgs::DiagnosticStatus* status, const pf::SensorHealt
   if (status->level < diagnostic_msgs::DiagnosticStatus::WARN) {
     status->level = diagnostic_msgs::DiagnosticStatus::WARN;
   }
+}
+
+void addHypotheses(diagnostic_msgs::DiagnosticStatus* status, const pf::Hypotheses& hypotheses) {
+  add(status, "hypotheses", static_cast<int>(hypotheses.count));
+  if (hypotheses.count < 2) return;
+  std::string named = "; " + std::to_string(hypotheses.count) + " hypotheses: ";
+  for (std::size_t k = 0; k < hypotheses.listed.size(); ++k) {
+    const pf::Hypothesis& h = hypotheses.listed[k];
+    char text[160];
+    std::snprintf(text, sizeof text,
+                  "x %.2f m, y %.2f m, yaw %.0f deg, %.0f %% of the weight, std %.2f m, %.2f m, "
+                  "%.0f deg, %zu particles",
+                  h.pose.x, h.pose.y, h.pose.yaw * 180.0 / M_PI, 100.0 * h.weight,
+                  std::sqrt(h.covariance(0, 0)), std::sqrt(h.covariance(1, 1)),
+                  std::sqrt(h.covariance(2, 2)) * 180.0 / M_PI, h.particles);
+    diagnostic_msgs::KeyValue kv;
+    kv.key = "hypothesis " + std::to_string(k + 1);
+    kv.value = text;
+    status->values.push_back(kv);
+    if (k < kNamedHypotheses) {
+      std::snprintf(text, sizeof text, "%s(%.2f, %.2f) %.0f %%", k > 0 ? ", " : "", h.pose.x,
+                    h.pose.y, 100.0 * h.weight);
+      named += text;
+    }
+  }
+  if (hypotheses.count > kNamedHypotheses) named += ", ...";
+  status->message += named;
 }
 
 }  // namespace pf_ros

@@ -4,6 +4,7 @@
 #include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 
+#include "pf_localization/ros/conversions.h"
 #include "pf_localization/ros/diagnostics.h"
 
 namespace pf_ros {
@@ -25,6 +26,7 @@ EstimatePublisher::EstimatePublisher(ros::NodeHandle& nh) {
   // amcl's name for the same message, so that its users' tools keep working.
   amcl_pose_pub_ = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("amcl_pose", 2, true);
   cloud_pub_ = nh.advertise<geometry_msgs::PoseArray>("particlecloud", 2, true);
+  hypotheses_pub_ = nh.advertise<pf_localization::PoseHypotheses>("pf_hypotheses", 2, true);
   diagnostics_pub_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 5);
   status_pub_ = nh.advertise<diagnostic_msgs::DiagnosticStatus>("pf_status", 5, true);
 }
@@ -48,11 +50,19 @@ void EstimatePublisher::publishConfidence(const ScanLocalizer& localizer, const 
                                           const pf::UpdateReport& report, int config_generation,
                                           const UpdateTiming& timing, std::uint64_t dropped,
                                           std::size_t cap) {
+  const pf::Hypotheses hypotheses = localizer.filter().hypotheses();
+  pf_localization::PoseHypotheses hypotheses_msg;
+  hypotheses_msg.header.stamp = stamp;
+  hypotheses_msg.header.frame_id = localizer.config().global_frame;
+  toHypothesesMsg(hypotheses, &hypotheses_msg);
+  hypotheses_pub_.publish(hypotheses_msg);
+
   const std::string name = ros::this_node::getName() + ": localization";
   diagnostic_msgs::DiagnosticArray array;
   array.header.stamp = stamp;
   array.status.push_back(toDiagnosticStatus(localizer.filter(), report, name, config_generation));
   timing.addTo(&array.status.front(), dropped, cap);
+  addHypotheses(&array.status.front(), hypotheses);
   addSensors(&array.status.front(), localizer.sensorHealth(), stamp.toSec());
   diagnostics_pub_.publish(array);
   status_pub_.publish(array.status.front());

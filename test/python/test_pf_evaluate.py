@@ -274,6 +274,72 @@ class CovarianceTest(unittest.TestCase):
             self.assertEqual(pfe.main(argv + ['--ref-std', '-1']), 2)
 
 
+class HypothesesTest(unittest.TestCase):
+    """Whether the true place is among the published hypotheses (pf_bag_runner --hypotheses)."""
+    # The robot at x = t along y = 0 for 10 s, a reference pose every 0.5 s.
+    ref = traj([(0.5 * k, 0.5 * k, 0.0, 0.0) for k in range(21)])
+
+    @staticmethod
+    def rows(updates):
+        """(t, [(x, y, weight), ...]) per update -> the runner's rows t,rank,x,y,yaw,weight,sx,sy."""
+        return traj([(t, rank + 1, x, y, 0.0, w, 0.1, 0.1)
+                     for t, listed in updates for rank, (x, y, w) in enumerate(listed)])
+
+    def test_the_truth_among_several_counts_and_a_miss_is_timed(self):
+        hyp = self.rows([
+            (1.0, [(5.75, 0.0, 0.5), (1.2, 0.3, 0.4)]),    # the truth second, 0.36 m off: in
+            (2.25, [(2.25, 0.0, 0.6), (7.0, 0.0, 0.3)]),   # interpolated reference (2.25, 0): in
+            (3.0, [(7.75, 0.0, 0.55), (3.0, 1.1, 0.45)]),  # 1.1 m off: a miss while ambiguous
+            (4.0, [(4.05, 0.0, 1.0)]),                     # one, on the truth
+            (5.0, [(6.5, 0.0, 1.0)]),                      # one, 1.5 m off
+            (30.0, [(30.0, 0.0, 1.0)]),                    # no reference near it: left out
+        ])
+        h = pfe.hypotheses_metrics(hyp, self.ref)
+        self.assertEqual((h['updates'], h['updates_matched'], h['updates_with_several']), (6, 5, 3))
+        self.assertAlmostEqual(h['contain_truth_share'], 3 / 5)
+        self.assertAlmostEqual(h['contain_truth_share_with_several'], 2 / 3)
+        self.assertEqual(h['misses_s'], [3.0, 5.0])
+        self.assertEqual(h['most_hypotheses'], 2)
+        self.assertAlmostEqual(h['mean_hypotheses'], 9 / 6)
+        # A stricter radius drops the 0.36 m one.
+        self.assertAlmostEqual(pfe.hypotheses_metrics(hyp, self.ref, near=0.3)['contain_truth_share'],
+                               2 / 5)
+
+    def test_read_hypotheses_sorts_by_time_and_rank_and_wants_its_columns(self):
+        with tempfile.TemporaryDirectory() as d:
+            path = os.path.join(d, 'hyp.csv')
+            with open(path, 'w') as f:
+                f.write('t,rank,x,y,yaw,weight,std_x,std_y\n2.0,1,5,5,0,1,0.1,0.1\n'
+                        '1.0,2,3,3,0,0.4,0.1,0.1\n1.0,1,1,1,0,0.6,0.1,0.1\n')
+            a = pfe.read_hypotheses(path)
+            self.assertEqual(a[:, :3].tolist(), [[1.0, 1.0, 1.0], [1.0, 2.0, 3.0], [2.0, 1.0, 5.0]])
+            with open(path, 'w') as f:
+                f.write('t,x,y\n1.0,1,1\n')
+            with self.assertRaises(pfe.EvalError):
+                pfe.read_hypotheses(path)
+
+    def test_command_line_reports_the_share_in_summary_and_text(self):
+        est = self.ref.copy()
+        with tempfile.TemporaryDirectory() as d:
+            for name, a in (('traj.tum', est), ('ref.tum', self.ref)):
+                with open(os.path.join(d, name), 'w') as f:
+                    f.writelines('%.6f %.6f %.6f 0 0 0 0 1\n' % tuple(r[:3]) for r in a)
+            with open(os.path.join(d, 'hyp.csv'), 'w') as f:
+                f.write('t,rank,x,y,yaw,weight,std_x,std_y\n')
+                f.writelines(','.join('%.6g' % v for v in r) + '\n' for r in self.rows(
+                    [(1.0, [(1.0, 0.0, 0.5), (5.75, 0.0, 0.5)]), (2.0, [(9.0, 0.0, 1.0)])]))
+            argv = ['--traj', os.path.join(d, 'traj.tum'), '--ref', os.path.join(d, 'ref.tum'),
+                    '--hypotheses', os.path.join(d, 'hyp.csv'), '--out', os.path.join(d, 'eval'),
+                    '--no-plots']
+            m, summary = pfe.run(pfe.parse_args(argv))
+            with open(summary) as f:
+                h = json.load(f)['hypotheses']
+            self.assertAlmostEqual(h['contain_truth_share'], 0.5)
+            self.assertAlmostEqual(h['contain_truth_share_with_several'], 1.0)
+            self.assertIn('the true place within 1.0 m of one in 50.0 % of 2 updates; in 100.0 % of '
+                          'the 1 with several (up to 2, mean 1.50)', pfe.describe(m, summary))
+
+
 class AlignedAteTest(unittest.TestCase):
     def test_rotation_and_translation_are_recovered(self):
         rng = np.random.default_rng(6)

@@ -239,5 +239,42 @@ TEST(ConversionsTest, ParticlesToPoseArray) {
   EXPECT_DOUBLE_EQ(out.poses[1].orientation.z, std::sqrt(0.5));
 }
 
+TEST(ConversionsTest, HypothesesToMsgInTheirOrderWithCountAndCovariance) {
+  pf::Hypotheses twins;
+  twins.count = 3;  // one more than listed: a capped list
+  pf::Hypothesis a;
+  a.pose = {1.0, 7.5, M_PI / 2};
+  a.weight = 0.5;
+  a.covariance << 0.04, 0.01, 0.0, 0.01, 0.09, 0.0, 0.0, 0.0, 0.0025;
+  a.particles = 900;
+  pf::Hypothesis b;
+  b.pose = {11.0, 7.5, -M_PI / 2};
+  b.weight = 0.3;
+  b.particles = 600;
+  twins.listed = {a, b};
+  pf_localization::PoseHypotheses msg;
+  msg.header.frame_id = "map";
+  msg.poses.resize(5);  // stale content from a previous call is replaced
+  toHypothesesMsg(twins, &msg);
+  EXPECT_EQ("map", msg.header.frame_id);
+  EXPECT_EQ(3u, msg.count);
+  ASSERT_EQ(2u, msg.poses.size());
+  ASSERT_EQ(2u, msg.weights.size());
+  ASSERT_EQ(2u, msg.particles.size());
+  EXPECT_EQ(1.0, msg.poses[0].pose.position.x);
+  EXPECT_EQ(7.5, msg.poses[0].pose.position.y);
+  EXPECT_NEAR(M_PI / 2, yawOf(msg.poses[0].pose.orientation), 1e-12);
+  EXPECT_EQ(0.04, msg.poses[0].covariance[0]);
+  EXPECT_EQ(0.01, msg.poses[0].covariance[1]);
+  EXPECT_EQ(0.09, msg.poses[0].covariance[7]);
+  EXPECT_EQ(0.0025, msg.poses[0].covariance[35]);
+  EXPECT_EQ(11.0, msg.poses[1].pose.position.x);
+  EXPECT_NEAR(-M_PI / 2, yawOf(msg.poses[1].pose.orientation), 1e-12);
+  EXPECT_EQ(0.5, msg.weights[0]);
+  EXPECT_EQ(0.3, msg.weights[1]);
+  EXPECT_EQ(900u, msg.particles[0]);
+  EXPECT_EQ(600u, msg.particles[1]);
+}
+
 }  // namespace
 }  // namespace pf_ros

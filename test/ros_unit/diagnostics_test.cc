@@ -80,5 +80,59 @@ TEST(Diagnostics, SeveralSensorsAreListedAndAMissingOneNamed) {
   EXPECT_TRUE(one.values.empty());
 }
 
+pf::Hypothesis hypothesis(double x, double y, double weight) {
+  pf::Hypothesis h;
+  h.pose = {x, y, M_PI / 2};
+  h.weight = weight;
+  h.covariance.diagonal() << 0.04, 0.01, 0.0025;
+  h.particles = 800;
+  return h;
+}
+
+TEST(Diagnostics, SeveralHypothesesAreCountedAndNamedHeaviestFirst) {
+  diagnostic_msgs::DiagnosticStatus status;
+  status.message = "uncertain: 1 rival hypothesis elsewhere";
+  pf::Hypotheses twins;
+  twins.count = 2;
+  twins.listed = {hypothesis(1.2, 7.6, 0.52), hypothesis(11.246, 7.6, 0.47)};
+  addHypotheses(&status, twins);
+  EXPECT_EQ(
+      "uncertain: 1 rival hypothesis elsewhere; 2 hypotheses: (1.20, 7.60) 52 %, (11.25, 7.60) "
+      "47 %",
+      status.message);
+  const auto v = values(status);
+  EXPECT_EQ("2", v.at("hypotheses"));
+  EXPECT_EQ(
+      "x 11.25 m, y 7.60 m, yaw 90 deg, 47 % of the weight, std 0.20 m, 0.10 m, 3 deg, 800 "
+      "particles",
+      v.at("hypothesis 2"));
+  EXPECT_EQ(1u, v.count("hypothesis 1"));
+}
+
+TEST(Diagnostics, ManyHypothesesNameTheFirstFewAndListEveryOne) {
+  diagnostic_msgs::DiagnosticStatus status;
+  pf::Hypotheses aisles;
+  aisles.count = 10;
+  for (int k = 0; k < 10; ++k) aisles.listed.push_back(hypothesis(2.0 * k, 5.0, 0.1));
+  addHypotheses(&status, aisles);
+  EXPECT_EQ(
+      "; 10 hypotheses: (0.00, 5.00) 10 %, (2.00, 5.00) 10 %, (4.00, 5.00) 10 %, (6.00, 5.00) "
+      "10 %, ...",
+      status.message);
+  EXPECT_EQ(1u, values(status).count("hypothesis 10"));
+}
+
+TEST(Diagnostics, OneHypothesisIsACountAndNothingElse) {
+  diagnostic_msgs::DiagnosticStatus status;
+  status.message = "localized: 95 % of the beams fit, one hypothesis";
+  pf::Hypotheses one;
+  one.count = 1;
+  one.listed = {hypothesis(3.0, 4.0, 1.0)};
+  addHypotheses(&status, one);
+  EXPECT_EQ("localized: 95 % of the beams fit, one hypothesis", status.message);
+  ASSERT_EQ(1u, status.values.size());
+  EXPECT_EQ("1", values(status).at("hypotheses"));
+}
+
 }  // namespace
 }  // namespace pf_ros

@@ -30,6 +30,7 @@
 #include "pf_localization/core/confidence.h"
 #include "pf_localization/core/confidence_tracker.h"
 #include "pf_localization/core/estimate_refinement.h"
+#include "pf_localization/core/hypotheses.h"
 #include "pf_localization/core/laser_scan.h"
 #include "pf_localization/core/likelihood_field_model.h"
 #include "pf_localization/core/motion_update.h"
@@ -134,6 +135,12 @@ class ParticleFilter {
   const PoseEstimate& estimate() const { return estimate_; }
   /// How far to trust the estimate, as of the last update.
   const Confidence& confidence() const { return confidence_.confidence(); }
+  /// The places the estimate's clusters hold with real weight: the
+  /// heaviest, every rival confidence() counts, and any cluster with
+  /// kMinHypothesisShare of the weight (hypotheses.h).
+  Hypotheses hypotheses() const {
+    return hypothesesOf(estimate_, params_.confidence.rival_weight_ratio);
+  }
 
   /// map -> odom: the estimate composed with the inverse of the odometry pose
   /// it was computed at, or the latest accepted scan fit since that update

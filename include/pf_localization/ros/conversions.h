@@ -10,6 +10,8 @@
 
 #include <Eigen/Core>
 
+#include "pf_localization/PoseHypotheses.h"
+#include "pf_localization/core/hypotheses.h"
 #include "pf_localization/core/laser_scan.h"
 #include "pf_localization/core/occupancy_grid.h"
 #include "pf_localization/core/particle_set.h"
@@ -53,5 +55,10 @@ void toPoseArray(const pf::ParticleSet& particles, geometry_msgs::PoseArray* out
 /// shape with a few thousand.
 void toPoseArray(const pf::ParticleSet& particles, std::size_t max_poses,
                  geometry_msgs::PoseArray* out);
+
+/// The hypotheses as pf_hypotheses publishes them: the count, and each
+/// listed one's pose with its covariance, weight and particle count, in the
+/// same order (heaviest first); the header is left as it is.
+void toHypothesesMsg(const pf::Hypotheses& hypotheses, pf_localization::PoseHypotheses* out);
 
 }  // namespace pf_ros

@@ -4,8 +4,10 @@
 
 #include <diagnostic_msgs/DiagnosticStatus.h>
 
+#include <cstddef>
 #include <string>
 
+#include "pf_localization/core/hypotheses.h"
 #include "pf_localization/core/particle_filter.h"
 #include "pf_localization/core/sensor_health.h"
 
@@ -27,5 +29,16 @@ diagnostic_msgs::DiagnosticStatus toDiagnosticStatus(const pf::ParticleFilter& f
 /// least WARN. `now` is the time of the stamps (s).
 void addSensors(diagnostic_msgs::DiagnosticStatus* status, const pf::SensorHealth& health,
                 double now);
+
+// How many hypotheses the message names (a status line a monitor shows in
+// one row); the values list every one.
+constexpr std::size_t kNamedHypotheses = 4;
+
+/// The hypotheses (pf_hypotheses): their count as a value and, when there
+/// are several, each listed one as a value ("hypothesis K": pose, share of
+/// the weight, spread, particles) and the first kNamedHypotheses in the
+/// message ("; 2 hypotheses: (1.20, 7.60) 52 %, (11.20, 7.60) 47 %"), so
+/// that a robot monitor shows where the robot may be.
+void addHypotheses(diagnostic_msgs::DiagnosticStatus* status, const pf::Hypotheses& hypotheses);
 
 }  // namespace pf_ros

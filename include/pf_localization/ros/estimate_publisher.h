@@ -1,5 +1,6 @@
 // pf_node's output topics: the estimate on pf_pose and, for amcl's users,
-// amcl_pose; the particles on particlecloud; how far to trust the estimate
+// amcl_pose; the particles on particlecloud; the places the cloud holds
+// with real weight on pf_hypotheses; how far to trust the estimate
 // on /diagnostics (for robot monitors) and pf_status (for anything that only
 // wants this node's verdict); and a log line for each change of the
 // localization state (localized / uncertain / lost), which is news where the
@@ -49,14 +50,16 @@ class EstimatePublisher {
   /// something subscribes to it, as at most `cloud_max_poses` poses.
   void publishEstimate(const ScanLocalizer& localizer, const ros::Time& stamp, bool always);
 
-  /// /diagnostics and pf_status after an update, with `timing`'s figures,
-  /// `dropped` scans and the particle `cap`; logs a change of state.
+  /// pf_hypotheses, /diagnostics and pf_status after an update, with
+  /// `timing`'s figures, `dropped` scans and the particle `cap`; logs a
+  /// change of state.
   void publishConfidence(const ScanLocalizer& localizer, const ros::Time& stamp,
                          const pf::UpdateReport& report, int config_generation,
                          const UpdateTiming& timing, std::uint64_t dropped, std::size_t cap);
 
  private:
-  ros::Publisher pose_pub_, amcl_pose_pub_, cloud_pub_, diagnostics_pub_, status_pub_;
+  ros::Publisher pose_pub_, amcl_pose_pub_, cloud_pub_, hypotheses_pub_, diagnostics_pub_,
+      status_pub_;
   ros::Time last_cloud_stamp_;
   StateChangeLog state_log_;
 };
