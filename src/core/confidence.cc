@@ -2,7 +2,6 @@
 
 #include <cmath>
 #include <iomanip>
-#include <numeric>
 #include <sstream>
 #include <stdexcept>
 
@@ -62,9 +61,7 @@ Confidence assessConfidence(const ParticleSet& particles, const PoseEstimate& es
   }
   c.covariance = first.covariance;
   if (c.rivals > 0) {
-    std::vector<std::size_t> all(particles.size());
-    std::iota(all.begin(), all.end(), 0);
-    c.covariance = summarize(particles, all, threads).covariance;
+    c.covariance = summarize(particles, threads).covariance;
   }
 
   std::ostringstream why;

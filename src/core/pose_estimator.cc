@@ -125,15 +125,19 @@ void packClusterBins(const ParticleSet& particles, double cell_xy, int64_t yaw_b
   packClusterBins(particles, 0, particles.size(), cell_xy, yaw_bins, out);
 }
 
-Cluster summarize(const ParticleSet& particles, const std::vector<std::size_t>& indices,
-                  int threads) {
+namespace {
+
+// summarize() of the `count` particles index(0), index(1), ...
+template <typename Index>
+Cluster summarizeIndexed(const ParticleSet& particles, std::size_t count, Index index,
+                         int threads) {
   struct Sums {
     double w = 0.0, sx = 0.0, sy = 0.0, ss = 0.0, sc = 0.0;
   };
   const Sums sums = reduceBlocks(
-      indices.size(), threads, Sums(),
+      count, threads, Sums(),
       [&](std::size_t k, Sums& a) {
-        const std::size_t i = indices[k];
+        const std::size_t i = index(k);
         const double w = particles.weight[i];
         a.w += w;
         a.sx += w * particles.x[i];
@@ -149,14 +153,14 @@ Cluster summarize(const ParticleSet& particles, const std::vector<std::size_t>& 
         into.sc += from.sc;
       });
   Cluster c;
-  c.count = indices.size();
+  c.count = count;
   c.weight = sums.w;
   if (!(c.weight > 0.0)) return c;
   c.mean = {sums.sx / c.weight, sums.sy / c.weight, normalizeAngle(std::atan2(sums.ss, sums.sc))};
   c.covariance = reduceBlocks(
-      indices.size(), threads, Eigen::Matrix3d(Eigen::Matrix3d::Zero()),
+      count, threads, Eigen::Matrix3d(Eigen::Matrix3d::Zero()),
       [&](std::size_t k, Eigen::Matrix3d& m) {
-        const std::size_t i = indices[k];
+        const std::size_t i = index(k);
         const Eigen::Vector3d d(particles.x[i] - c.mean.x, particles.y[i] - c.mean.y,
                                 angleDiff(particles.yaw[i], c.mean.yaw));
         m += particles.weight[i] * d * d.transpose();
@@ -164,6 +168,19 @@ Cluster summarize(const ParticleSet& particles, const std::vector<std::size_t>& 
       [](Eigen::Matrix3d& into, const Eigen::Matrix3d& from) { into += from; });
   c.covariance /= c.weight;
   return c;
+}
+
+}  // namespace
+
+Cluster summarize(const ParticleSet& particles, const std::vector<std::size_t>& indices,
+                  int threads) {
+  return summarizeIndexed(
+      particles, indices.size(), [&](std::size_t k) { return indices[k]; }, threads);
+}
+
+Cluster summarize(const ParticleSet& particles, int threads) {
+  return summarizeIndexed(
+      particles, particles.size(), [](std::size_t k) { return k; }, threads);
 }
 
 namespace {

@@ -150,11 +150,7 @@ TEST(ParticleBlocks, TheEstimateOfSeveralBlocksAgreesWithOneBlocksSums) {
   // are the same, their sums within rounding.
   const ParticleSet cloud = spreadCloud(2 * kParticleBlock + 100, 6);
   const PoseEstimate whole = estimatePose(cloud, ClusterParams(), 2);
-  const Cluster all_of_it = summarize(cloud, [&] {
-    std::vector<std::size_t> all(cloud.size());
-    for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
-    return all;
-  }());
+  const Cluster all_of_it = summarize(cloud, 2);
   double weight = 0.0;
   std::size_t count = 0;
   for (const Cluster& c : whole.clusters) {

@@ -45,6 +45,8 @@ struct PoseEstimate {
 /// count (particle_blocks.h).
 Cluster summarize(const ParticleSet& particles, const std::vector<std::size_t>& indices,
                   int threads = 1);
+/// The same for the whole cloud (no list of its indices to build).
+Cluster summarize(const ParticleSet& particles, int threads = 1);
 
 /// The histogram bin of every particle that estimatePose clusters by, packed
 /// by BinTable::key: x and y in cells of `cell_xy`, the heading (wrapped into
