@@ -414,22 +414,60 @@ void covariancesFromMoments(const std::vector<double>& moments, std::vector<Clus
   }
 }
 
-// The clusters of a cloud of one block: every sum particle by particle, in
-// order.
-std::vector<Cluster> clustersOfOneBlock(const ParticleSet& particles, const ClusterParams& params,
-                                        int64_t yaw_bins, int threads, EstimatorScratch* s) {
-  binParticles(particles, params.cell_xy, yaw_bins, s);
-  std::vector<double>& bin_weight = s->bin_weight;
-  bin_weight.assign(s->keys.size(), 0.0);
-  accumulateRuns<1>(s->particle_bin, bin_weight.data(),
-                    [&](std::size_t i, double* a) { a[0] += particles.weight[i]; });
+// The sums of a cloud of one block: particle by particle, in order, into
+// the rows of each particle's bin or cluster.
+struct SumsInOrder {
+  EstimatorScratch* s;
+  template <int kWidth, typename Term>
+  void perBin(Term term, double* out) {
+    accumulateRuns<kWidth>(s->particle_bin, out, term);
+  }
+  // Once the bins are labelled: each particle's cluster.
+  void labelled() {
+    s->cluster.resize(s->particle_bin.size());
+    for (std::size_t i = 0; i < s->particle_bin.size(); ++i) {
+      s->cluster[i] = s->cluster_of_bin[s->particle_bin[i]];
+    }
+  }
+  template <int kWidth, typename Term>
+  void perCluster(Term term, double* out) {
+    accumulateRuns<kWidth>(s->cluster, out, term);
+  }
+};
+
+// The sums of a cloud of several blocks: per bin of each block, then in
+// block order (sumByBlockBins), on up to `threads` threads.
+struct SumsByBlock {
+  EstimatorScratch* s;
+  BlockScratch* b;
+  std::size_t n;
+  int threads;
+  template <int kWidth, typename Term>
+  void perBin(Term term, double* out) {
+    sumByBlockBins<kWidth>(
+        n, threads, b, [](int bin) { return bin; }, term, out);
+  }
+  void labelled() {}
+  template <int kWidth, typename Term>
+  void perCluster(Term term, double* out) {
+    const std::vector<int>& cluster_of_bin = s->cluster_of_bin;
+    sumByBlockBins<kWidth>(
+        n, threads, b, [&](int bin) { return cluster_of_bin[bin]; }, term, out);
+  }
+};
+
+// The clusters of the binned cloud (s->keys, s->particle_bin): the bins'
+// weights, the touching ones joined, then each cluster's mean and
+// covariance, every sum taken by `sums`.
+template <typename Sums>
+std::vector<Cluster> clustersOfBins(const ParticleSet& particles, const ClusterParams& params,
+                                    int64_t yaw_bins, int threads, EstimatorScratch* s, Sums sums) {
+  s->bin_weight.assign(s->keys.size(), 0.0);
+  sums.template perBin<1>([&](std::size_t i, double* a) { a[0] += particles.weight[i]; },
+                          s->bin_weight.data());
   joinTouchingBins(params.join_weight_ratio, yaw_bins, s);
   const int clusters = labelBins(s);
-  std::vector<int>& cluster = s->cluster;
-  cluster.resize(particles.size());
-  for (std::size_t i = 0; i < particles.size(); ++i) {
-    cluster[i] = s->cluster_of_bin[s->particle_bin[i]];
-  }
+  sums.labelled();
   // The headings' sines and cosines for the whole cloud at once (sinCos
   // vectorises), for the mean directions.
   const std::size_t n = particles.size();
@@ -441,63 +479,37 @@ std::vector<Cluster> clustersOfOneBlock(const ParticleSet& particles, const Clus
     sinCos(particles.yaw.data() + begin, end - begin, sin_yaw + begin, cos_yaw + begin);
   });
   std::vector<Cluster> c(clusters);
-  std::vector<double>& sums = s->sums;
-  sums.assign(6 * static_cast<std::size_t>(clusters), 0.0);
-  accumulateRuns<6>(cluster, sums.data(), [&](std::size_t i, double* a) {
-    addMeanTerms(particles, sin_yaw, cos_yaw, i, a);
-  });
-  for (int k = 0; k < clusters; ++k) meanFromSums(&sums[6 * static_cast<std::size_t>(k)], &c[k]);
-  std::vector<double>& moments = s->moments;
-  moments.assign(9 * c.size(), 0.0);
-  accumulateRuns<9>(cluster, moments.data(), [&](std::size_t i, double* m) {
-    addMomentTerms(particles, c[cluster[i]], i, m);
-  });
-  covariancesFromMoments(moments, &c);
-  return c;
-}
-
-// The clusters of a cloud of several blocks, on up to `threads` threads:
-// the same steps, every sum block by block (sumByBlockBins).
-std::vector<Cluster> clustersOfBlocks(const ParticleSet& particles, const ClusterParams& params,
-                                      int64_t yaw_bins, int threads, EstimatorScratch* s) {
-  BlockScratch& b = threadScratch<BlockScratch>();
-  const std::size_t n = particles.size();
-  binParticlesByBlock(particles, params.cell_xy, yaw_bins, threads, s, &b);
-  const auto same_bin = [](int bin) { return bin; };
-  s->bin_weight.assign(s->keys.size(), 0.0);
-  sumByBlockBins<1>(
-      n, threads, &b, same_bin, [&](std::size_t i, double* a) { a[0] += particles.weight[i]; },
-      s->bin_weight.data());
-  joinTouchingBins(params.join_weight_ratio, yaw_bins, s);
-  const int clusters = labelBins(s);
-  const std::vector<int>& cluster_of_bin = s->cluster_of_bin;
-  const auto cluster_of = [&](int bin) { return cluster_of_bin[bin]; };
-  s->sin_yaw.resize(n);
-  s->cos_yaw.resize(n);
-  double* sin_yaw = s->sin_yaw.data();
-  double* cos_yaw = s->cos_yaw.data();
-  forEachSlice(n, threads, [&](std::size_t begin, std::size_t end) {
-    sinCos(particles.yaw.data() + begin, end - begin, sin_yaw + begin, cos_yaw + begin);
-  });
-  std::vector<Cluster> c(clusters);
-  std::vector<double>& sums = s->sums;
-  sums.assign(6 * static_cast<std::size_t>(clusters), 0.0);
-  sumByBlockBins<6>(
-      n, threads, &b, cluster_of,
+  s->sums.assign(6 * static_cast<std::size_t>(clusters), 0.0);
+  sums.template perCluster<6>(
       [&](std::size_t i, double* a) { addMeanTerms(particles, sin_yaw, cos_yaw, i, a); },
-      sums.data());
-  for (int k = 0; k < clusters; ++k) meanFromSums(&sums[6 * static_cast<std::size_t>(k)], &c[k]);
-  std::vector<double>& moments = s->moments;
-  moments.assign(9 * c.size(), 0.0);
+      s->sums.data());
+  for (int k = 0; k < clusters; ++k) {
+    meanFromSums(&s->sums[6 * static_cast<std::size_t>(k)], &c[k]);
+  }
+  s->moments.assign(9 * c.size(), 0.0);
+  const std::vector<int>& cluster_of_bin = s->cluster_of_bin;
   const std::vector<int>& particle_bin = s->particle_bin;
-  sumByBlockBins<9>(
-      n, threads, &b, cluster_of,
+  sums.template perCluster<9>(
       [&](std::size_t i, double* m) {
         addMomentTerms(particles, c[cluster_of_bin[particle_bin[i]]], i, m);
       },
-      moments.data());
-  covariancesFromMoments(moments, &c);
+      s->moments.data());
+  covariancesFromMoments(s->moments, &c);
   return c;
+}
+
+// The clusters of the cloud: binned in one pass for one block, block by
+// block for several.
+std::vector<Cluster> clustersOf(const ParticleSet& particles, const ClusterParams& params,
+                                int64_t yaw_bins, int threads, EstimatorScratch* s) {
+  if (blockCount(particles.size()) <= 1) {
+    binParticles(particles, params.cell_xy, yaw_bins, s);
+    return clustersOfBins(particles, params, yaw_bins, threads, s, SumsInOrder{s});
+  }
+  BlockScratch& b = threadScratch<BlockScratch>();
+  binParticlesByBlock(particles, params.cell_xy, yaw_bins, threads, s, &b);
+  return clustersOfBins(particles, params, yaw_bins, threads, s,
+                        SumsByBlock{s, &b, particles.size(), threads});
 }
 
 }  // namespace
@@ -508,9 +520,7 @@ PoseEstimate estimatePose(const ParticleSet& particles, const ClusterParams& par
   // Yaw bins wrap around, so the last bin touches the first.
   const int64_t yaw_bins = std::max<int64_t>(1, std::llround(2.0 * M_PI / params.cell_yaw));
   EstimatorScratch& scratch = threadScratch<EstimatorScratch>();
-  estimate.clusters = blockCount(particles.size()) <= 1
-                          ? clustersOfOneBlock(particles, params, yaw_bins, threads, &scratch)
-                          : clustersOfBlocks(particles, params, yaw_bins, threads, &scratch);
+  estimate.clusters = clustersOf(particles, params, yaw_bins, threads, &scratch);
   // Heaviest first; ties broken by the mean so the order never depends on hashing.
   std::sort(estimate.clusters.begin(), estimate.clusters.end(),
             [](const Cluster& a, const Cluster& b) {
