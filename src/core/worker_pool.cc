@@ -1,8 +1,23 @@
 #include "pf_localization/core/worker_pool.h"
 
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 
 namespace pf {
+namespace {
+
+// The calling thread's nice value (Linux keeps one per thread), or 0.
+int threadNice() {
+  errno = 0;
+  const int nice = ::getpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)));
+  return errno == 0 ? nice : 0;
+}
+
+}  // namespace
 
 WorkerPool& WorkerPool::instance() {
   static WorkerPool pool;
@@ -50,6 +65,7 @@ void WorkerPool::runErased(int threads, std::size_t tasks, Call call, void* task
   next_ = 0;
   unfinished_ = tasks;
   participants_ = helpers;
+  nice_ = threadNice();
   ++generation_;
   wake_.notify_all();
   takeTasks(&lock);
@@ -66,6 +82,9 @@ void WorkerPool::work(std::size_t id) {
     wake_.wait(lock, [&] { return stop_ || (generation_ != seen && id < participants_); });
     if (stop_) return;
     seen = generation_;
+    if (threadNice() != nice_) {
+      ::setpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)), nice_);
+    }
     takeTasks(&lock);
   }
 }

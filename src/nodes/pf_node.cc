@@ -203,10 +203,10 @@ class PfNode {
   // The filter thread: the newest waiting scan, one at a time.
   void filterLoop() {
     // The filter yields the CPU to this node's other threads (map -> odom,
-    // odometry and tf, the clock): a lower priority for this thread (the
-    // update's worker threads, worker_pool.h, keep the priority of the
-    // thread that first needed them). Raising the nice value needs no
-    // privilege; failing, it changes nothing.
+    // odometry and tf, the clock): a lower priority for this thread, which
+    // the update's worker threads take for its jobs (worker_pool.h).
+    // Raising the nice value needs no privilege; failing, it changes
+    // nothing.
     lowerThreadPriority(kFilterNiceIncrement);
     // The destructor's close() wakes the wait; its time-out only bounds how
     // long a shutdown by another way goes unseen (a shorter one would wake

@@ -3,9 +3,15 @@
 #include "pf_localization/core/particle_blocks.h"
 
 #include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
+#include <mutex>
 #include <thread>
 #include <vector>
 
@@ -95,6 +101,26 @@ TEST(WorkerPool, JobsFromTwoThreadsAtOnceBothFinish) {
   b.join();
   EXPECT_EQ(200L * 4950, sums[0].load());
   EXPECT_EQ(200L * 4950, sums[1].load());
+}
+
+TEST(WorkerPool, WorkersRunAtTheirCallersLowerPriority) {
+  // A caller that lowered its own priority, as pf_node's filter thread does.
+  int caller = 0, lowest = 100;
+  std::mutex m;
+  std::thread lowered([&] {
+    const auto tid = static_cast<id_t>(::syscall(SYS_gettid));
+    ::setpriority(PRIO_PROCESS, tid, ::getpriority(PRIO_PROCESS, tid) + 3);
+    caller = ::getpriority(PRIO_PROCESS, tid);
+    auto task = [&](std::size_t) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));  // every worker gets a task
+      const int nice = ::getpriority(PRIO_PROCESS, static_cast<id_t>(::syscall(SYS_gettid)));
+      std::lock_guard<std::mutex> lock(m);
+      lowest = std::min(lowest, nice);
+    };
+    WorkerPool::instance().run(2, 4, task);
+  });
+  lowered.join();
+  EXPECT_EQ(caller, lowest);
 }
 
 // A cloud of `n` particles with uneven weights, spread over a square of

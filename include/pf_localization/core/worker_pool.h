@@ -6,6 +6,11 @@
 // reach the region's end (docs/design.md, "The update on every core"). Here
 // an idle worker sleeps on a condition variable.
 //
+// A job's workers run at its caller's priority (nice value) where they may:
+// pf_node lowers its filter thread's so that tf and odometry come first,
+// and work done for it must not come first either. (Raising a priority
+// back takes a privilege; without it a worker stays as low as it went.)
+//
 // One pool per process, grown to the largest thread count asked for. One
 // job at a time: a job asked for while another runs (a second filter on
 // another thread, or work nested in a job) runs on its caller's thread
@@ -61,6 +66,7 @@ class WorkerPool {
   std::size_t unfinished_ = 0;    // tasks not yet finished
   std::size_t participants_ = 0;  // workers asked to take part in the job
   std::size_t generation_ = 0;    // one per job: tells a worker there is a new one
+  int nice_ = 0;                  // the job's caller's nice value
   bool stop_ = false;
 };
 
