@@ -444,6 +444,14 @@ void finishReading(LocalizerConfig* c) {
 
 // Names that were parameters until they became named constants of the
 // filter's algorithms; a configuration that sets one is told so.
+// Parameters under a new name: a configuration that still sets the old one
+// is told which (nullptr: not renamed).
+const char* renamedTo(const std::string& name) {
+  // Issue 30: the whole update on several threads, not only the scoring.
+  if (name == "sensor_threads") return "threads";
+  return nullptr;
+}
+
 bool isRetired(const std::string& name) {
   static const std::set<std::string> names = {"kld_bin_xy",
                                               "kld_bin_yaw",
@@ -583,6 +591,12 @@ class ParamReader {
     for (const std::string& key : source_.keys()) {
       // "defaults" is the namespace launch/amcl_compatible.launch loads config/pf.yaml into.
       if (known_.count(key) || unused_amcl.count(key) || key == "defaults") continue;
+      if (const char* now = renamedTo(key)) {
+        notes_->warnings.push_back(key + " is now " + now +
+                                   ", which splits the whole update: set " + now + "; " + key +
+                                   " is ignored");
+        continue;
+      }
       std::string& list = isRetired(key) ? retired : unknown;
       list += (list.empty() ? "" : ", ") + key;
     }

@@ -206,6 +206,17 @@ TEST(AmclParams, RetiredParametersAreNamedAndLeftAlone) {
   EXPECT_TRUE(anyContains(notes.infos, "no longer parameters"));
 }
 
+// sensor_threads became threads (issue 30): the old name is answered with
+// the new one, not as a misspelling.
+TEST(AmclParams, ARenamedParameterNamesItsNewName) {
+  ConfigNotes notes;
+  readConfig(*yaml("sensor_threads: 2\n"), nullptr, &notes);
+  ASSERT_EQ(1u, notes.warnings.size());
+  EXPECT_NE(std::string::npos, notes.warnings[0].find("sensor_threads is now threads"))
+      << notes.warnings[0];
+  EXPECT_EQ(std::string::npos, notes.warnings[0].find("unknown")) << notes.warnings[0];
+}
+
 // Issue 15's parameter: read, and refused with the start-up message.
 TEST(AmclParams, MaxUpdateTimeIsReadAndValidated) {
   ConfigNotes notes;
