@@ -24,6 +24,17 @@ void mergeSums(Sums& into, const Sums& from) {
   into.sum_sq += from.sum_sq;
 }
 
+// The sum and sum of squares of v.
+Sums sums(const std::vector<double>& v, int threads) {
+  return reduceBlocks(
+      v.size(), threads, Sums(),
+      [&](std::size_t i, Sums& a) {
+        a.sum += v[i];
+        a.sum_sq += v[i] * v[i];
+      },
+      mergeSums);
+}
+
 // The largest of v(i) over [0, n) (-inf for none).
 template <typename Value>
 double maxBlocks(std::size_t n, int threads, Value&& v) {
@@ -61,25 +72,8 @@ double effectiveSampleSize(const std::vector<double>& log_prior,
     }
     exps(wp + begin, end - begin, wp + begin);
   });
-  const Sums s = reduceBlocks(
-      n, threads, Sums(),
-      [&](std::size_t i, Sums& a) {
-        a.sum += wp[i];
-        a.sum_sq += wp[i] * wp[i];
-      },
-      mergeSums);
+  const Sums s = sums(w, threads);
   return s.sum * s.sum / s.sum_sq;
-}
-
-// The sum and sum of squares of v.
-Sums sums(const std::vector<double>& v, int threads) {
-  return reduceBlocks(
-      v.size(), threads, Sums(),
-      [&](std::size_t i, Sums& a) {
-        a.sum += v[i];
-        a.sum_sq += v[i] * v[i];
-      },
-      mergeSums);
 }
 
 // The prior's effective sample size: after a resampling every weight is the

@@ -28,7 +28,8 @@ namespace pf {
 inline constexpr std::size_t kParticleBlock = std::size_t{1} << 16;
 
 /// Below this many particles per thread, splitting particle-by-particle work
-/// over threads costs more (waking them, OpenMP's barrier) than it saves:
+/// over threads costs more (waking the pool's workers and waiting for them)
+/// than it saves:
 /// about 0.1 ms of work at the motion and weighting steps' few ns per
 /// particle.
 inline constexpr std::size_t kMinParticlesPerThread = 16384;
