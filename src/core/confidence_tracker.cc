@@ -2,6 +2,7 @@
 
 #include <string>
 
+#include "pf_localization/core/hypotheses.h"
 #include "pf_localization/core/scan_refiner.h"
 
 namespace pf {
@@ -24,6 +25,17 @@ void ConfidenceTracker::assess(const ParticleSet& particles, const PoseEstimate&
 void ConfidenceTracker::holdAfterJump(const std::optional<Pose2>& predicted, const Pose2& estimate,
                                       const ConfidenceParams& params) {
   if (predicted) pf::holdAfterJump(*predicted, estimate, params, &settle_left_, &confidence_);
+}
+
+void ConfidenceTracker::holdWhileAmbiguous(const PoseEstimate& estimate,
+                                           double rival_weight_ratio) {
+  if (confidence_.state != LocalizationState::kLocalized) return;
+  const std::size_t places = hypothesesOf(estimate, rival_weight_ratio, 0).count;
+  if (places <= 1) return;
+  confidence_.state = LocalizationState::kUncertain;
+  confidence_.reason =
+      std::to_string(places - 1) + " other place" + (places > 2 ? "s" : "") + " with at least " +
+      std::to_string(static_cast<int>(100 * kMinHypothesisShare)) + " % of the weight";
 }
 
 void ConfidenceTracker::addFit(const Eigen::Matrix3d& fit_covariance) {

@@ -235,6 +235,7 @@ void ParticleFilter::estimateAndJudge(const std::vector<PreparedScan>& scans,
   // Tempering and recovery follow the evidence of this scan (fitState());
   // only the published verdict waits for a jumped estimate to be confirmed.
   confidence_.holdAfterJump(predicted, estimate_.pose, params_.confidence);
+  confidence_.holdWhileAmbiguous(estimate_, params_.confidence.rival_weight_ratio);
 }
 
 void ParticleFilter::weigh(const std::vector<PreparedScan>& scans, UpdateReport* report) {

@@ -1,8 +1,12 @@
-// ConfidenceTracker: the verdict after an initialisation, held after a jump,
-// and demoted while the scans fit worse than usual for too long.
+// ConfidenceTracker: the verdict after an initialisation, held after a jump
+// and while a second place holds real weight, and demoted while the scans fit
+// worse than usual for too long.
 #include "pf_localization/core/confidence_tracker.h"
 
 #include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
 
 namespace pf {
 namespace {
@@ -48,6 +52,35 @@ TEST_F(ConfidenceTrackerTest, AJumpHoldsThePublishedVerdictButNotTheFitState) {
   tracker_.holdAfterJump(compose(at_, {2.0, 0.0, 0.0}), at_, params_);
   EXPECT_EQ(LocalizationState::kUncertain, tracker_.confidence().state);
   EXPECT_EQ(LocalizationState::kLocalized, tracker_.fitState());
+}
+
+// The estimate's clusters with these weights, heaviest first, 3 m apart.
+PoseEstimate placesWithWeights(const std::vector<double>& weights) {
+  PoseEstimate e;
+  for (std::size_t k = 0; k < weights.size(); ++k) {
+    Cluster c;
+    c.weight = weights[k];
+    c.mean = {3.0 * static_cast<double>(k), 0.0, 0.0};
+    c.count = 100;
+    e.clusters.push_back(c);
+  }
+  return e;
+}
+
+TEST_F(ConfidenceTrackerTest, ASecondPlaceWithAShareOfTheWeightHoldsThePublishedVerdict) {
+  // The simulated warehouse's global localization: twin aisles at 0.85 and
+  // 0.15 of the weight, the lighter one the true place. 0.15 / 0.85 is no
+  // rival (rival_weight_ratio 0.2), but pf_hypotheses lists both places.
+  assessLocalized();
+  tracker_.holdWhileAmbiguous(placesWithWeights({0.85, 0.15}), params_.rival_weight_ratio);
+  EXPECT_EQ(LocalizationState::kUncertain, tracker_.confidence().state);
+  EXPECT_NE(std::string::npos, tracker_.confidence().reason.find("1 other place"))
+      << tracker_.confidence().reason;
+  EXPECT_EQ(LocalizationState::kLocalized, tracker_.fitState());
+  // Below kMinHypothesisShare the second cluster is no place of its own.
+  assessLocalized();
+  tracker_.holdWhileAmbiguous(placesWithWeights({0.96, 0.04}), params_.rival_weight_ratio);
+  EXPECT_EQ(LocalizationState::kLocalized, tracker_.confidence().state);
 }
 
 TEST_F(ConfidenceTrackerTest, AFitBelowTheTriggerForLongerThanPatienceDemotes) {

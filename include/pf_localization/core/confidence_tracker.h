@@ -31,6 +31,10 @@ class ConfidenceTracker {
   /// estimate moved by the odometry since; nothing without one.
   void holdAfterJump(const std::optional<Pose2>& predicted, const Pose2& estimate,
                      const ConfidenceParams& params);
+  /// "localized" becomes "uncertain" while `estimate` holds more than one
+  /// hypothesis (hypotheses.h, with `rival_weight_ratio`): the published
+  /// verdict never says "localized" beside a second place on pf_hypotheses.
+  void holdWhileAmbiguous(const PoseEstimate& estimate, double rival_weight_ratio);
   /// Adds a scan fit's covariance to the published one (fusedCovariance),
   /// unless that is the whole cloud's for rival hypotheses, which a fit of
   /// the best one cannot narrow: then it widens it to cover the fit's too.

@@ -10,14 +10,14 @@
 //    so that "uncertain: N rival hypotheses" always comes with those N
 //    listed beside the heaviest, or
 //  - a holder of at least kMinHypothesisShare of the cloud's weight.
-// The last is not the verdict's rule, and cannot be without changing the
-// filter (the rival count steers tempering and the published covariance).
-// It is needed: on bags/global.bag the cloud settled in twin room B, the
-// wrong one, with 86-91 % of the weight for 7 updates, while the true room
-// A kept 9-13 %: 0.09-0.15 of the heaviest, no rival, yet the true place.
-// On the bundled bags (tracking, global, kidnap, crowd, reverse, sparse) no
-// update was "localized" while a second place held 5 %, so the list does
-// not contradict a localized verdict there.
+// The last is not the rival count's rule, and cannot be without changing
+// the filter (the rival count steers tempering and the published
+// covariance). It is needed: on bags/global.bag the cloud settled in twin
+// room B, the wrong one, with 86-91 % of the weight for 7 updates, while the
+// true room A kept 9-13 %: 0.09-0.15 of the heaviest, no rival, yet the true
+// place. The published verdict follows the list instead
+// (ConfidenceTracker::holdWhileAmbiguous): never "localized" while a second
+// place is listed.
 #pragma once
 
 #include <Eigen/Core>
