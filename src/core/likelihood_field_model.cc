@@ -100,11 +100,12 @@ void validate(const LikelihoodFieldModelParams& params) {
 
 LikelihoodFieldModel::LikelihoodFieldModel(const OccupancyGrid& grid,
                                            const LikelihoodFieldModelParams& params)
-    : params_((validate(params), params)), field_(grid, params.max_distance) {
+    : params_((validate(params), params)),
+      field_(std::make_shared<const LikelihoodField>(grid, params.max_distance)) {
   if (!params.beam_skip) return;
   const int stride = grid.width() + 2;
   near_.assign(static_cast<std::size_t>(stride) * (grid.height() + 2), 0);
-  const std::vector<float>& dist = field_.distances();
+  const std::vector<float>& dist = field_->distances();
   for (int y = 0; y < grid.height(); ++y) {
     for (int x = 0; x < grid.width(); ++x) {
       // amcl's test: occ_dist < beam_skip_distance.
@@ -112,6 +113,16 @@ LikelihoodFieldModel::LikelihoodFieldModel(const OccupancyGrid& grid,
           dist[static_cast<std::size_t>(y) * grid.width() + x] < params.beam_skip_distance ? 1 : 0;
     }
   }
+}
+
+LikelihoodFieldModel::LikelihoodFieldModel(const LikelihoodFieldModel& model, double sigma_hit)
+    : params_(model.params_), field_(model.field_), near_(model.near_) {
+  params_.sigma_hit = sigma_hit;
+  validate(params_);
+}
+
+std::unique_ptr<SensorModel> LikelihoodFieldModel::smoothed(double sigma_hit) const {
+  return std::unique_ptr<SensorModel>(new LikelihoodFieldModel(*this, sigma_hit));
 }
 
 double LikelihoodFieldModel::beamLogLikelihood(double distance, double range_max) const {
@@ -122,15 +133,15 @@ double LikelihoodFieldModel::beamLogLikelihood(double distance, double range_max
 
 PreparedScan LikelihoodFieldModel::prepare(const LaserScan& scan, int max_beams) const {
   return prepareScan(scan, max_beams, params_.range_min, params_.range_max,
-                     field_.grid().resolution());
+                     field_->grid().resolution());
 }
 
 void LikelihoodFieldModel::buildTable(double range_max) const {
   if (range_max == table_range_max_) return;
-  const OccupancyGrid& grid = field_.grid();
+  const OccupancyGrid& grid = field_->grid();
   const int stride = grid.width() + 2;
   const double k = params_.likelihood_exponent;
-  const float outside = static_cast<float>(k * beamLogLikelihood(field_.maxDistance(), range_max));
+  const float outside = static_cast<float>(k * beamLogLikelihood(field_->maxDistance(), range_max));
   table_.assign(static_cast<std::size_t>(stride) * (grid.height() + 2), outside);
   // The distances take few values (square roots of whole numbers of cells,
   // and the cap), so each value's exp and log are computed once, not once per
@@ -142,7 +153,7 @@ void LikelihoodFieldModel::buildTable(double range_max) const {
   };
   constexpr int kMemoBits = 14;
   std::vector<Memo> memo(std::size_t{1} << kMemoBits);
-  const std::vector<float>& dist = field_.distances();
+  const std::vector<float>& dist = field_->distances();
   for (int y = 0; y < grid.height(); ++y) {
     for (int x = 0; x < grid.width(); ++x) {
       const float d = dist[static_cast<std::size_t>(y) * grid.width() + x];
@@ -161,7 +172,7 @@ double LikelihoodFieldModel::logLikelihood(const PreparedScan& scan, const Pose2
   one.resize(1);
   one.setPose(0, pose);
   buildTable(scan.range_max);
-  const float inv_res = static_cast<float>(1.0 / field_.grid().resolution());
+  const float inv_res = static_cast<float>(1.0 / field_->grid().resolution());
   std::vector<float> bx(scan.size()), by(scan.size());
   for (std::size_t b = 0; b < scan.size(); ++b) {
     bx[b] = scan.x[b] * inv_res;
@@ -330,7 +341,7 @@ ScoringFrame scoringFrame(const OccupancyGrid& grid, const float* table, const f
 void LikelihoodFieldModel::score(const float* bx, const float* by, std::size_t beams,
                                  const ParticleSet& particles,
                                  std::vector<double>* log_likelihood) const {
-  const ScoringFrame frame = scoringFrame(field_.grid(), table_.data(), bx, by, beams);
+  const ScoringFrame frame = scoringFrame(field_->grid(), table_.data(), bx, by, beams);
   log_likelihood->resize(particles.size());
   // The headings' sines and cosines for the whole cloud at once (sinCos
   // vectorises), not one C library call per particle. Kept per thread: no
@@ -364,7 +375,7 @@ void LikelihoodFieldModel::score(const float* bx, const float* by, std::size_t b
 std::vector<uint8_t> LikelihoodFieldModel::keptBeams(const float* bx, const float* by,
                                                      std::size_t beams,
                                                      const ParticleSet& particles) const {
-  const ScoringFrame frame = scoringFrame(field_.grid(), nullptr, bx, by, beams);
+  const ScoringFrame frame = scoringFrame(field_->grid(), nullptr, bx, by, beams);
   std::vector<std::size_t> agree;
   countAgreeingParticles(frame, near_.data(), particles, &agree);
   std::vector<uint8_t> kept(beams, 1);
@@ -390,7 +401,7 @@ std::size_t LikelihoodFieldModel::logLikelihoods(const PreparedScan& scan,
                                                  const ParticleSet& particles,
                                                  std::vector<double>* log_likelihood) const {
   buildTable(scan.range_max);
-  const float inv_res = static_cast<float>(1.0 / field_.grid().resolution());
+  const float inv_res = static_cast<float>(1.0 / field_->grid().resolution());
   // End points in cell units, so the inner loop needs no division.
   const std::size_t n = scan.size();
   std::vector<float> bx(n), by(n);

@@ -88,15 +88,20 @@ void ParticleFilter::setParams(const ParticleFilterParams& params) {
   params_.seed = seed;
   threads_ = resolvedThreads(params_.threads);
   motion_.setModel(motion);
-  if (model) sensor_.setModel(std::move(model));
+  if (model) {
+    sensor_.setModel(std::move(model));
+    search_.forgetModel();
+  }
 }
 
 bool ParticleFilter::setMap(const OccupancyGrid& grid) {
   if (grid.empty()) throw std::invalid_argument("the map is empty");
   sensor_.setModel(makeSensorModel(grid, params_));
+  search_.forgetModel();
   refinement_.reset();  // fitted to the old map
   if (isInitialized() && grid.isFreeAt(estimate_.pose.x, estimate_.pose.y)) return true;
   particles_.resize(0);  // keeps the reserved storage
+  search_.stop();
   estimate_ = PoseEstimate();
   gate_.restart();  // no estimate until an initialisation and an update
   return false;
@@ -124,6 +129,7 @@ void ParticleFilter::initializeGaussian(const Pose2& mean, const Eigen::Matrix3d
   }
   particles_.setUniformWeights();
   estimate_ = estimatePose(particles_, params_.clusters, threads_);
+  search_.stop();
   restartAfterInitialization();
 }
 
@@ -139,6 +145,8 @@ void ParticleFilter::initializeUniform() {
   }
   particles_.setUniformWeights();
   estimate_ = estimatePose(particles_, params_.clusters, threads_);
+  const double cell = grid.resolution();
+  search_.start(static_cast<double>(grid.freeCells().size()) * cell * cell);
   restartAfterInitialization();
 }
 
@@ -241,8 +249,12 @@ void ParticleFilter::estimateAndJudge(const std::vector<PreparedScan>& scans,
 void ParticleFilter::weigh(const std::vector<PreparedScan>& scans, UpdateReport* report) {
   const double ess_fraction =
       temperingEssFraction(confidence_.fitState(), confidence_.confidence(), params_);
-  const Weighing w =
-      sensor_.weigh(scans, ess_fraction, params_.sensor.likelihood_exponent, &particles_, threads_);
+  const SensorModel* smoothed =
+      search_.model(sensor_.model(), params_.sensor.sigma_hit, params_.sensor.max_distance, scans,
+                    particles_, params_.kld, threads_);
+  const Weighing w = sensor_.weigh(smoothed ? *smoothed : sensor_.model(), scans, ess_fraction,
+                                   params_.sensor.likelihood_exponent, &particles_, threads_);
+  report->search_sigma = search_.sigma();
   report->tempering = w.tempering;
   report->beams_skipped = w.beams_skipped;
   report->mean_beam_likelihood = w.mean_beam_likelihood;

@@ -230,12 +230,7 @@ const KldBins& binWeights(const ParticleSet& particles, const KldParams& params,
 
 }  // namespace
 
-std::size_t kldParticleCount(const ParticleSet& particles, const KldParams& params, int threads) {
-  // A fixed budget (min_particles = max_particles, as amcl is often run) is
-  // the answer whatever the bins say: no need to bin 5000 particles for it.
-  if (params.min_particles == params.max_particles) {
-    return static_cast<std::size_t>(std::max(params.max_particles, 0));
-  }
+std::size_t occupiedBins(const ParticleSet& particles, const KldParams& params, int threads) {
   // A bin counts when its weight promises at least one survivor out of a
   // resample of the current size: bins holding only negligible particles
   // will be empty after resampling and must not inflate k.
@@ -243,6 +238,16 @@ std::size_t kldParticleCount(const ParticleSet& particles, const KldParams& para
   const std::vector<double>& bin_weight = binWeights(particles, params, threads).weight;
   std::size_t k = 0;
   for (double w : bin_weight) k += w >= threshold ? 1 : 0;
+  return k;
+}
+
+std::size_t kldParticleCount(const ParticleSet& particles, const KldParams& params, int threads) {
+  // A fixed budget (min_particles = max_particles, as amcl is often run) is
+  // the answer whatever the bins say: no need to bin 5000 particles for it.
+  if (params.min_particles == params.max_particles) {
+    return static_cast<std::size_t>(std::max(params.max_particles, 0));
+  }
+  const std::size_t k = occupiedBins(particles, params, threads);
   const double n = std::ceil(kldBound(k, params.kld_err, params.confidence));
   const double lo = params.min_particles, hi = params.max_particles;
   return static_cast<std::size_t>(std::clamp(n, lo, hi));

@@ -9,22 +9,34 @@ namespace pf {
 
 Weighing SensorUpdate::weigh(const PreparedScan& scan, double min_ess_fraction,
                              double likelihood_exponent, ParticleSet* particles, int threads) {
-  const std::size_t beams_counted = model_->logLikelihoods(scan, *particles, &log_likelihood_);
-  return finish(scan.size(), beams_counted, min_ess_fraction, likelihood_exponent, particles,
-                threads);
+  return weigh(*model_, scan, min_ess_fraction, likelihood_exponent, particles, threads);
 }
 
 Weighing SensorUpdate::weigh(const std::vector<PreparedScan>& scans, double min_ess_fraction,
                              double likelihood_exponent, ParticleSet* particles, int threads) {
+  return weigh(*model_, scans, min_ess_fraction, likelihood_exponent, particles, threads);
+}
+
+Weighing SensorUpdate::weigh(const SensorModel& model, const PreparedScan& scan,
+                             double min_ess_fraction, double likelihood_exponent,
+                             ParticleSet* particles, int threads) {
+  const std::size_t beams_counted = model.logLikelihoods(scan, *particles, &log_likelihood_);
+  return finish(scan.size(), beams_counted, min_ess_fraction, likelihood_exponent, particles,
+                threads);
+}
+
+Weighing SensorUpdate::weigh(const SensorModel& model, const std::vector<PreparedScan>& scans,
+                             double min_ess_fraction, double likelihood_exponent,
+                             ParticleSet* particles, int threads) {
   if (scans.size() == 1) {
-    return weigh(scans.front(), min_ess_fraction, likelihood_exponent, particles, threads);
+    return weigh(model, scans.front(), min_ess_fraction, likelihood_exponent, particles, threads);
   }
   log_likelihood_.assign(particles->size(), 0.0);
   std::size_t beams = 0, beams_counted = 0;
   for (const PreparedScan& scan : scans) {
     beams += scan.size();
     if (scan.size() == 0) continue;
-    beams_counted += model_->logLikelihoods(scan, *particles, &sensor_log_likelihood_);
+    beams_counted += model.logLikelihoods(scan, *particles, &sensor_log_likelihood_);
     forEachSlice(log_likelihood_.size(), threads, [&](std::size_t begin, std::size_t end) {
       for (std::size_t i = begin; i < end; ++i) {
         log_likelihood_[i] += scan.weight * sensor_log_likelihood_[i];

@@ -258,7 +258,7 @@ void openOutputs(const Options& opt, Outputs* o) {
     if (!o->log) fail(opt.log + ": cannot write");
     o->log << "t,particles,ess,cpu_ms,mean_beam_likelihood,std_x,std_y,std_yaw,updated,injected,"
               "tempering,hit_fraction,rivals,state,refined,refine_translation,refine_rotation,"
-              "refine_rms,refine_matched,fault_fraction,missing\n";
+              "refine_rms,refine_matched,fault_fraction,search_sigma,missing\n";
   }
   if (!opt.particles_out.empty()) {
     o->dump.open(opt.particles_out);
@@ -485,7 +485,8 @@ void Replay::logUpdate(double t, const pf_ros::ScanResult& r, double cpu) {
                << pf::toString(conf.state) << "," << r.report.refinement.accepted << ","
                << r.report.refinement.translation << "," << r.report.refinement.rotation << ","
                << r.report.refinement.rms_distance << "," << r.report.refinement.matched_beams
-               << "," << r.report.fault_fraction << "," << missingNames(t) << "\n";
+               << "," << r.report.fault_fraction << "," << r.report.search_sigma << ","
+               << missingNames(t) << "\n";
 }
 
 void Replay::dumpParticles(double t) {

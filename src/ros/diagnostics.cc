@@ -62,6 +62,8 @@ diagnostic_msgs::DiagnosticStatus toDiagnosticStatus(const pf::ParticleFilter& f
   add(&status, "rival_clusters", c.rivals);
   add(&status, "injected_particles", static_cast<double>(report.injected));
   add(&status, "tempering", report.tempering);
+  // 0 but while a global localization's cloud is too sparse for laser_sigma_hit.
+  add(&status, "search_smoothing_m", report.search_sigma);
   add(&status, "beams_used", report.beams_used);
   const pf::ParticleFilterParams& p = filter.params();
   add(&status, "config_generation", config_generation);

@@ -26,6 +26,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "pf_localization/core/laser_scan.h"
@@ -79,7 +80,11 @@ class LikelihoodFieldModel : public SensorModel {
   LikelihoodFieldModel(const OccupancyGrid& grid, const LikelihoodFieldModelParams& params);
 
   const LikelihoodFieldModelParams& params() const { return params_; }
-  const LikelihoodField& field() const override { return field_; }
+  const LikelihoodField& field() const override { return *field_; }
+
+  /// This model with the hit component's std dev `sigma_hit`, on the same
+  /// likelihood field (shared, not copied: only the table is its own).
+  std::unique_ptr<SensorModel> smoothed(double sigma_hit) const override;
 
   /// The usable beams' end points in the robot frame.
   PreparedScan prepare(const LaserScan& scan) const override {
@@ -102,6 +107,7 @@ class LikelihoodFieldModel : public SensorModel {
   double beamLogLikelihood(double distance, double range_max) const;
 
  private:
+  LikelihoodFieldModel(const LikelihoodFieldModel& model, double sigma_hit);
   void buildTable(double range_max) const;
   void score(const float* bx, const float* by, std::size_t beams, const ParticleSet& particles,
              std::vector<double>* log_likelihood) const;
@@ -109,7 +115,7 @@ class LikelihoodFieldModel : public SensorModel {
                                  const ParticleSet& particles) const;
 
   LikelihoodFieldModelParams params_;
-  LikelihoodField field_;
+  std::shared_ptr<const LikelihoodField> field_;
   // The precomputed table: (width + 2) x (height + 2) with a border of
   // "outside the map" cells, rebuilt only when range_max changes.
   mutable std::vector<float> table_;

@@ -10,7 +10,8 @@
 //
 // One update is a pipeline of named parts: UpdateGate (whether and why),
 // MotionUpdate (the odometry, with OdometryFaultTracker's share of faults),
-// SensorUpdate (the weights, tempered by temperingEssFraction), the estimate
+// SensorUpdate (the weights, tempered by temperingEssFraction, with
+// GlobalSearch's smoothed likelihood while a global cloud is sparse), the estimate
 // and ConfidenceTracker (the verdict), EstimateRefinement (the scan fit, and
 // map -> odom), and Recovery (the resampling, with its strategies). The
 // design decisions behind them, with their evidence: docs/design.md.
@@ -30,6 +31,7 @@
 #include "pf_localization/core/confidence.h"
 #include "pf_localization/core/confidence_tracker.h"
 #include "pf_localization/core/estimate_refinement.h"
+#include "pf_localization/core/global_search.h"
 #include "pf_localization/core/hypotheses.h"
 #include "pf_localization/core/laser_scan.h"
 #include "pf_localization/core/likelihood_field_model.h"
@@ -68,8 +70,9 @@ struct UpdateReport {
   double mean_beam_likelihood = 0.0;  // geometric mean over beams, weighted over particles
   std::size_t injected = 0;           // random particles added by recovery
   double tempering = 1.0;             // exponent applied to this scan's likelihood (1: none)
-  bool expanded = false;              // the survivors were spread by expansion resetting
-  double fault_fraction = 0.0;        // share of particles to assume an odometry fault next step
+  double search_sigma = 0.0;    // the hit std dev of GlobalSearch's smoothed model (0: the model's)
+  bool expanded = false;        // the survivors were spread by expansion resetting
+  double fault_fraction = 0.0;  // share of particles to assume an odometry fault next step
   // The update came before update_min_d / update_min_a because the scan no
   // longer fitted at the pose the odometry predicted (update_fit_drop).
   bool fit_dropped = false;
@@ -162,6 +165,7 @@ class ParticleFilter {
   int threads_;  // params_.threads resolved (resolvedThreads)
   Random random_;
   SensorUpdate sensor_;  // the sensor model (none without a map) and its scratch
+  GlobalSearch search_;  // the smoothed model while a global initialisation's cloud is sparse
   MotionUpdate motion_;  // the motion model and the odometry fault share
   ParticleSet particles_;
   PoseEstimate estimate_;

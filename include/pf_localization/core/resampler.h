@@ -57,6 +57,12 @@ double normalQuantile(double p);
 /// KLD bound on the particle count for k occupied bins (not clamped).
 double kldBound(std::size_t k, double kld_err, double confidence);
 
+/// The bins of KLD-sampling's histogram (bin_xy, bin_yaw) whose weight
+/// promises at least one survivor of a resample of the current size: the
+/// cloud's support, in bins. Counted block by block on up to `threads`
+/// threads: the same for any count.
+std::size_t occupiedBins(const ParticleSet& particles, const KldParams& params, int threads = 1);
+
 /// The particle count KLD-sampling asks for after resampling `particles`:
 /// k counts the bins expected to receive at least one survivor, clamped to
 /// [min_particles, max_particles]. The bins are counted block by block on

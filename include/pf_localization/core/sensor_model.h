@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 #include "pf_localization/core/laser_scan.h"
@@ -64,6 +65,11 @@ class SensorModel {
   /// The fraction of the scan's beams whose end point, placed from `pose`,
   /// lies within `distance` metres of an obstacle (0 for an empty scan).
   virtual double hitFraction(const PreparedScan& scan, const Pose2& pose, double distance) const;
+
+  /// The same model with its hit component widened to the std dev
+  /// `sigma_hit` (m), for a sparse cloud (global_search.h); null when the
+  /// model has no such component to widen.
+  virtual std::unique_ptr<SensorModel> smoothed(double /*sigma_hit*/) const { return nullptr; }
 };
 
 }  // namespace pf

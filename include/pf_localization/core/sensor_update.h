@@ -47,6 +47,14 @@ class SensorUpdate {
   Weighing weigh(const std::vector<PreparedScan>& scans, double min_ess_fraction,
                  double likelihood_exponent, ParticleSet* particles, int threads = 1);
 
+  /// The same two, weighing by `model` instead of the update's own (a
+  /// smoothed copy of it: global_search.h).
+  Weighing weigh(const SensorModel& model, const PreparedScan& scan, double min_ess_fraction,
+                 double likelihood_exponent, ParticleSet* particles, int threads = 1);
+  Weighing weigh(const SensorModel& model, const std::vector<PreparedScan>& scans,
+                 double min_ess_fraction, double likelihood_exponent, ParticleSet* particles,
+                 int threads = 1);
+
   /// Prefaults the scratch for `n` particles.
   void reserve(std::size_t n);
 
