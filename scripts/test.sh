@@ -79,8 +79,9 @@ check "bag_demo.launch from the .deb unpacked with dpkg -x: pf_node publishes pf
 # --- Global localization among the simulated warehouse's twin aisles ---------
 # Issue 30: with a million particles (pf_bag_runner, seed 1: deterministic),
 # never "localized" at the wrong place, and the true place among the published
-# hypotheses in at least 95 % of the updates. Without GlobalSearch's smoothing:
-# 57 updates confidently wrong, the truth listed in 59 %. About 10 s.
+# hypotheses in at least 95 % of the updates. Without GlobalSearch (the smoothed
+# likelihood, then the settling): 57 updates confidently wrong, the truth
+# listed in 59 %. About 10 s.
 warehouse_global() {
   local out="$ws/warehouse_global" lib="$ws/devel/lib/pf_localization"
   rm -rf "$out" && mkdir -p "$out"

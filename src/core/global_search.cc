@@ -31,7 +31,7 @@ double supportOfBins(double bins, double particles, double bin_volume, double ma
 }
 
 void GlobalSearch::start(double free_area) {
-  active_ = true;
+  phase_ = Phase::kSmoothing;
   max_support_ = free_area * 2.0 * M_PI;
   sigma_ = 0.0;
 }
@@ -41,7 +41,7 @@ const SensorModel* GlobalSearch::model(const SensorModel& model, double sigma_hi
                                        const ParticleSet& particles, const KldParams& kld,
                                        int threads) {
   sigma_ = 0.0;
-  if (!active_) return nullptr;
+  if (phase_ != Phase::kSmoothing) return nullptr;
   ranges_.clear();
   for (const PreparedScan& scan : scans) {
     ranges_.insert(ranges_.end(), scan.range.begin(), scan.range.end());
@@ -60,8 +60,7 @@ const SensorModel* GlobalSearch::model(const SensorModel& model, double sigma_hi
   if (s <= sigma_hit || level > kMaxSearchSmoothing * max_distance) {
     // Dense enough for the model, or too sparse for any smoothing that
     // keeps the map's contrast: the model's own, for good.
-    active_ = false;
-    smoothed_.reset();
+    settle();
     return nullptr;
   }
   if (!smoothed_ || smoothed_sigma_ != level) {
@@ -69,7 +68,7 @@ const SensorModel* GlobalSearch::model(const SensorModel& model, double sigma_hi
     smoothed_sigma_ = level;
   }
   if (!smoothed_) {
-    active_ = false;  // a model without a hit component to widen
+    settle();  // a model without a hit component to widen
     return nullptr;
   }
   sigma_ = level;

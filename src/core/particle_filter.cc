@@ -1,6 +1,7 @@
 #include "pf_localization/core/particle_filter.h"
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -225,6 +226,7 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& scans) {
       pinsAlong(report.refinement.covariance, estimate_.pose.yaw, params_.motion.fault_margin));
   resample(&report);
   confidence_.demoteAfterLowFit(recovery_.lowFitUpdates(), params_.recovery.patience);
+  search_.observe(confidence_.confidence().state);
   report.updated = true;
   report.particles = particles_.size();
   return report;
@@ -248,7 +250,8 @@ void ParticleFilter::estimateAndJudge(const std::vector<PreparedScan>& scans,
 
 void ParticleFilter::weigh(const std::vector<PreparedScan>& scans, UpdateReport* report) {
   const double ess_fraction =
-      temperingEssFraction(confidence_.fitState(), confidence_.confidence(), params_);
+      std::max(temperingEssFraction(confidence_.fitState(), confidence_.confidence(), params_),
+               search_.minEssFraction());
   const SensorModel* smoothed =
       search_.model(sensor_.model(), params_.sensor.sigma_hit, params_.sensor.max_distance, scans,
                     particles_, params_.kld, threads_);

@@ -1,5 +1,6 @@
 // GlobalSearch: the smoothing a sparse cloud's density asks for, the support
-// read from KLD's bins, and when the search hands over to the sensor model.
+// read from KLD's bins, when the search hands over to the sensor model, and
+// the cautious tempering until the cloud is localized.
 #include "pf_localization/core/global_search.h"
 
 #include <gtest/gtest.h>
@@ -98,6 +99,7 @@ TEST_F(GlobalSearchTest, ASparseCloudIsWeighedByAWiderLikelihoodUntilItIsDense) 
   EXPECT_EQ(nullptr, search_.model(model_, params_.sigma_hit, params_.max_distance, scans_,
                                    uniform(1000), KldParams{}, 1))
       << "no search before a global initialisation";
+  EXPECT_EQ(0.0, search_.minEssFraction());
   search_.start(freeArea());
   // 100 m^2 of free space, 5 m ranges: 50 000 particles ask for s of about
   // 0.3 m, rounded up to 0.2 * sqrt(2)^2.
@@ -105,7 +107,8 @@ TEST_F(GlobalSearchTest, ASparseCloudIsWeighedByAWiderLikelihoodUntilItIsDense) 
                                             uniform(50000), KldParams{}, 1);
   ASSERT_NE(nullptr, smooth);
   EXPECT_DOUBLE_EQ(0.4, search_.sigma());
-  EXPECT_TRUE(search_.active());
+  EXPECT_TRUE(search_.smoothing());
+  EXPECT_EQ(0.0, search_.minEssFraction());
   // A cloud gathered at one place is dense enough: the model's own, for good.
   ParticleSet tight;
   tight.resize(5000);
@@ -116,7 +119,13 @@ TEST_F(GlobalSearchTest, ASparseCloudIsWeighedByAWiderLikelihoodUntilItIsDense) 
   EXPECT_EQ(nullptr, search_.model(model_, params_.sigma_hit, params_.max_distance, scans_, tight,
                                    KldParams{}, 1));
   EXPECT_EQ(0.0, search_.sigma());
-  EXPECT_FALSE(search_.active());
+  EXPECT_FALSE(search_.smoothing());
+  // The cloud settles: tempered more cautiously until it is localized.
+  EXPECT_EQ(kSettlingEssFraction, search_.minEssFraction());
+  search_.observe(LocalizationState::kUncertain);
+  EXPECT_EQ(kSettlingEssFraction, search_.minEssFraction());
+  search_.observe(LocalizationState::kLocalized);
+  EXPECT_EQ(0.0, search_.minEssFraction());
   EXPECT_EQ(nullptr, search_.model(model_, params_.sigma_hit, params_.max_distance, scans_,
                                    uniform(50000), KldParams{}, 1));
 }
@@ -128,7 +137,8 @@ TEST_F(GlobalSearchTest, ACloudTooSparseForTheMapsContrastKeepsTheModel) {
   search_.start(freeArea());
   EXPECT_EQ(nullptr, search_.model(model_, params_.sigma_hit, params_.max_distance, scans_,
                                    uniform(500), KldParams{}, 1));
-  EXPECT_FALSE(search_.active());
+  EXPECT_FALSE(search_.smoothing());
+  EXPECT_EQ(kSettlingEssFraction, search_.minEssFraction());
 }
 
 TEST(ParticleFilterSearch, OnlyAGlobalInitialisationSearches) {

@@ -22,16 +22,20 @@
 // s is rounded up to sigma_hit times a power of sqrt(2), so that a new table
 // is built only when that level changes, a few times per search. Once s falls
 // to sigma_hit the cloud is dense enough for the model itself, which takes
-// over for good: the search ends, until the next global initialisation. It
-// ends too, leaving the model's likelihood and tempering as they were, when
-// the cloud is too sparse for a smoothing that keeps the map's contrast
-// (kMaxSearchSmoothing): a budget of particles too small for the map.
+// over for good. The smoothing ends too, leaving the model's likelihood as it
+// is, when the cloud is too sparse for a smoothing that keeps the map's
+// contrast (kMaxSearchSmoothing): a budget of particles too small for the map.
+//
+// Then the cloud settles: until the verdict first says "localized", a scan
+// is tempered to leave at least kSettlingEssFraction of the effective sample,
+// so that the look-alike places the smoothing kept are not decided by noise.
 #pragma once
 
 #include <cstddef>
 #include <memory>
 #include <vector>
 
+#include "pf_localization/core/confidence.h"
 #include "pf_localization/core/particle_set.h"
 #include "pf_localization/core/resampler.h"
 #include "pf_localization/core/sensor_model.h"
@@ -61,21 +65,33 @@ double searchSmoothing(double particles, double support, double range);
 /// particles spread uniformly over B.
 double supportOfBins(double bins, double particles, double bin_volume, double max_support);
 
+/// While a global initialisation's cloud settles after the smoothing, a scan
+/// may leave no fewer than this share of its effective particles (tempering,
+/// weighting.h): among look-alike places the scans' differences between
+/// them are noise (unmapped pallets, where each place's particles happen to
+/// lie), and at the 10 % of an uncertain cloud the true aisle's cluster died
+/// out within seconds on 3 of 10 seeds (docs/design.md, "A sparse cloud is
+/// weighed by a wider likelihood"); at 30 % on none. Until the verdict first
+/// says localized.
+inline constexpr double kSettlingEssFraction = 0.3;
+
 class GlobalSearch {
  public:
   /// Starts a search over `free_area` m^2 of free space (a global initialisation).
   void start(double free_area);
   /// Ends the search (an initialisation at a pose).
-  void stop() { active_ = false; }
-  bool active() const { return active_; }
+  void stop() { phase_ = Phase::kDone; }
+  /// Whether the cloud is still weighed by a smoothed likelihood.
+  bool smoothing() const { return phase_ == Phase::kSmoothing; }
   /// Drops the smoothed model (the sensor model or its map was replaced).
   void forgetModel() { smoothed_.reset(); }
 
   /// The model to weigh `particles` by `scans` with: a smoothed copy of
   /// `model` (whose hit std dev is `sigma_hit`, its distance cap
-  /// `max_distance`) while the search is on and the cloud too sparse for
-  /// `model`; null otherwise. A cloud dense enough ends the search, as do one
-  /// too sparse for kMaxSearchSmoothing and a model with no smoothed form.
+  /// `max_distance`) while smoothing and the cloud too sparse for `model`;
+  /// null otherwise. A cloud dense enough ends the smoothing, as do one too
+  /// sparse for kMaxSearchSmoothing and a model with no smoothed form: the
+  /// cloud then settles.
   const SensorModel* model(const SensorModel& model, double sigma_hit, double max_distance,
                            const std::vector<PreparedScan>& scans, const ParticleSet& particles,
                            const KldParams& kld, int threads);
@@ -83,8 +99,22 @@ class GlobalSearch {
   /// returned null.
   double sigma() const { return sigma_; }
 
+  /// The least share of the effective sample a scan may leave:
+  /// kSettlingEssFraction while the cloud settles, 0 otherwise.
+  double minEssFraction() const { return phase_ == Phase::kSettling ? kSettlingEssFraction : 0.0; }
+  /// Takes the update's published verdict: "localized" ends the search.
+  void observe(LocalizationState state) {
+    if (state == LocalizationState::kLocalized) phase_ = Phase::kDone;
+  }
+
  private:
-  bool active_ = false;
+  enum class Phase { kSmoothing, kSettling, kDone };
+  void settle() {
+    phase_ = Phase::kSettling;
+    smoothed_.reset();
+  }
+
+  Phase phase_ = Phase::kDone;
   double max_support_ = 0.0;  // m^2 rad: the free space times 2 pi
   double sigma_ = 0.0;
   std::unique_ptr<SensorModel> smoothed_;
