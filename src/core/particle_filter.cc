@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include "pf_localization/core/hypotheses.h"
 #include "pf_localization/core/prefault.h"
 #include "pf_localization/core/random_free_pose.h"
 #include "pf_localization/core/tempering.h"
@@ -226,7 +227,7 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& scans) {
       pinsAlong(report.refinement.covariance, estimate_.pose.yaw, params_.motion.fault_margin));
   resample(&report);
   confidence_.demoteAfterLowFit(recovery_.lowFitUpdates(), params_.recovery.patience);
-  search_.observe(confidence_.confidence().state);
+  search_.observe(hypothesesOf(estimate_, params_.confidence.rival_weight_ratio, 0).count);
   report.updated = true;
   report.particles = particles_.size();
   return report;

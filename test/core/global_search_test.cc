@@ -122,9 +122,9 @@ TEST_F(GlobalSearchTest, ASparseCloudIsWeighedByAWiderLikelihoodUntilItIsDense) 
   EXPECT_FALSE(search_.smoothing());
   // The cloud settles: tempered more cautiously until it is localized.
   EXPECT_EQ(kSettlingEssFraction, search_.minEssFraction());
-  search_.observe(LocalizationState::kUncertain);
+  search_.observe(2);  // two look-alike places
   EXPECT_EQ(kSettlingEssFraction, search_.minEssFraction());
-  search_.observe(LocalizationState::kLocalized);
+  search_.observe(1);
   EXPECT_EQ(0.0, search_.minEssFraction());
   EXPECT_EQ(nullptr, search_.model(model_, params_.sigma_hit, params_.max_distance, scans_,
                                    uniform(50000), KldParams{}, 1));

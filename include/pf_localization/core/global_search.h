@@ -26,8 +26,8 @@
 // is, when the cloud is too sparse for a smoothing that keeps the map's
 // contrast (kMaxSearchSmoothing): a budget of particles too small for the map.
 //
-// Then the cloud settles: until the verdict first says "localized", a scan
-// is tempered to leave at least kSettlingEssFraction of the effective sample,
+// Then the cloud settles: until it holds one place (hypotheses.h), a scan is
+// tempered to leave at least kSettlingEssFraction of the effective sample,
 // so that the look-alike places the smoothing kept are not decided by noise.
 #pragma once
 
@@ -35,7 +35,7 @@
 #include <memory>
 #include <vector>
 
-#include "pf_localization/core/confidence.h"
+#include "pf_localization/core/particle_filter_params.h"
 #include "pf_localization/core/particle_set.h"
 #include "pf_localization/core/resampler.h"
 #include "pf_localization/core/sensor_model.h"
@@ -67,13 +67,14 @@ double supportOfBins(double bins, double particles, double bin_volume, double ma
 
 /// While a global initialisation's cloud settles after the smoothing, a scan
 /// may leave no fewer than this share of its effective particles (tempering,
-/// weighting.h): among look-alike places the scans' differences between
-/// them are noise (unmapped pallets, where each place's particles happen to
-/// lie), and at the 10 % of an uncertain cloud the true aisle's cluster died
-/// out within seconds on 3 of 10 seeds (docs/design.md, "A sparse cloud is
-/// weighed by a wider likelihood"); at 30 % on none. Until the verdict first
-/// says localized.
-inline constexpr double kSettlingEssFraction = 0.3;
+/// weighting.h): among look-alike places the differences between their fits
+/// are noise (unmapped pallets, where each place's particles happen to lie),
+/// so the evidence must come from several scans. Half, resample_ess_fraction:
+/// no single scan makes the cloud resample. Until one place is left: within
+/// one place the floor would only keep the cloud wide. (At the uncertain cloud's 10 % the true
+/// aisle died out within seconds on 3 of 10 seeds, at 30 % on 1: docs/design.md, "A sparse cloud is
+/// weighed by a wider likelihood".)
+inline constexpr double kSettlingEssFraction = kResampleEssFraction;
 
 class GlobalSearch {
  public:
@@ -102,9 +103,10 @@ class GlobalSearch {
   /// The least share of the effective sample a scan may leave:
   /// kSettlingEssFraction while the cloud settles, 0 otherwise.
   double minEssFraction() const { return phase_ == Phase::kSettling ? kSettlingEssFraction : 0.0; }
-  /// Takes the update's published verdict: "localized" ends the search.
-  void observe(LocalizationState state) {
-    if (state == LocalizationState::kLocalized) phase_ = Phase::kDone;
+  /// Takes the number of places the update's cloud holds (hypotheses.h):
+  /// one ends the settling.
+  void observe(std::size_t places) {
+    if (phase_ == Phase::kSettling && places <= 1) phase_ = Phase::kDone;
   }
 
  private:
