@@ -21,22 +21,21 @@ int find(std::vector<int>& parent, int i) {
   return i;
 }
 
-// Adds term(i, row) for every particle i into the row (kWidth values) of
-// its group, group[i], in `rows`. Runs of particles in one group (nearly
-// the whole cloud when tracking) add in registers, starting from and
-// returning to the group's row: the additions are the same, in the same
-// order, as adding each term to the row in memory, which made every
-// particle wait for the one before through a store and a load.
+// Adds term(i, row) for every particle i in [begin, end) into the row
+// (kWidth values) of its group, group[i], in `rows`. Runs of particles in
+// one group (nearly the whole cloud when tracking) add in registers,
+// starting from and returning to the group's row: the additions are the
+// same, in the same order, as adding each term to the row in memory, which
+// made every particle wait for the one before through a store and a load.
 template <int kWidth, typename Term>
-void accumulateRuns(const std::vector<int>& group, double* rows, Term term) {
-  const std::size_t n = group.size();
-  std::size_t i = 0;
-  while (i < n) {
+void accumulateRuns(const int* group, std::size_t begin, std::size_t end, double* rows, Term term) {
+  std::size_t i = begin;
+  while (i < end) {
     const int g = group[i];
     double* row = rows + static_cast<std::size_t>(kWidth) * g;
     double acc[kWidth];
     std::copy(row, row + kWidth, acc);
-    for (; i < n && group[i] == g; ++i) term(i, acc);
+    for (; i < end && group[i] == g; ++i) term(i, acc);
     std::copy(acc, acc + kWidth, row);
   }
 }
@@ -127,6 +126,22 @@ void packClusterBins(const ParticleSet& particles, double cell_xy, int64_t yaw_b
 
 namespace {
 
+// Adds particle i's second moments about the mean of `k` (its cluster, or
+// the whole cloud) (in
+// plain arrays: an Eigen temporary per particle went through the stack and
+// stalled on store forwarding), with the same products in the same order
+// as w d d^T.
+inline void addMomentTerms(const ParticleSet& particles, const Cluster& k, std::size_t i,
+                           double* m) {
+  const double d[3] = {particles.x[i] - k.mean.x, particles.y[i] - k.mean.y,
+                       angleDiff(particles.yaw[i], k.mean.yaw)};
+  const double w = particles.weight[i];
+  for (int r = 0; r < 3; ++r) {
+    const double wd = w * d[r];
+    for (int col = 0; col < 3; ++col) m[3 * col + r] += wd * d[col];
+  }
+}
+
 // summarize() of the `count` particles index(0), index(1), ...
 template <typename Index>
 Cluster summarizeIndexed(const ParticleSet& particles, std::size_t count, Index index,
@@ -157,16 +172,18 @@ Cluster summarizeIndexed(const ParticleSet& particles, std::size_t count, Index 
   c.weight = sums.w;
   if (!(c.weight > 0.0)) return c;
   c.mean = {sums.sx / c.weight, sums.sy / c.weight, normalizeAngle(std::atan2(sums.ss, sums.sc))};
-  c.covariance = reduceBlocks(
-      count, threads, Eigen::Matrix3d(Eigen::Matrix3d::Zero()),
-      [&](std::size_t k, Eigen::Matrix3d& m) {
-        const std::size_t i = index(k);
-        const Eigen::Vector3d d(particles.x[i] - c.mean.x, particles.y[i] - c.mean.y,
-                                angleDiff(particles.yaw[i], c.mean.yaw));
-        m += particles.weight[i] * d * d.transpose();
-      },
-      [](Eigen::Matrix3d& into, const Eigen::Matrix3d& from) { into += from; });
-  c.covariance /= c.weight;
+  // The moments in plain arrays (addMomentTerms), not an Eigen matrix per
+  // particle: the same products and sums.
+  struct Moments {
+    double m[9] = {};
+  };
+  const Moments moments = reduceBlocks(
+      count, threads, Moments(),
+      [&](std::size_t k, Moments& a) { addMomentTerms(particles, c, index(k), a.m); },
+      [](Moments& into, const Moments& from) {
+        for (int e = 0; e < 9; ++e) into.m[e] += from.m[e];
+      });
+  c.covariance = Eigen::Map<const Eigen::Matrix3d>(moments.m) / c.weight;
   return c;
 }
 
@@ -302,10 +319,8 @@ void sumByBlockBins(std::size_t n, int threads, BlockScratch* b, Target target, 
   const std::size_t rows = b->blocks[blocks - 1].row + b->blocks[blocks - 1].keys.size();
   b->rows.assign(kWidth * rows, 0.0);
   forEachBlock(n, threads, [&](std::size_t k, std::size_t begin, std::size_t end) {
-    double* block_rows = b->rows.data() + kWidth * b->blocks[k].row;
-    for (std::size_t i = begin; i < end; ++i) {
-      term(i, block_rows + static_cast<std::size_t>(kWidth) * b->local_bin[i]);
-    }
+    accumulateRuns<kWidth>(b->local_bin.data(), begin, end,
+                           b->rows.data() + kWidth * b->blocks[k].row, term);
   });
   for (std::size_t k = 0; k < blocks; ++k) {
     const BlockBins& block = b->blocks[k];
@@ -390,21 +405,6 @@ inline void addMeanTerms(const ParticleSet& particles, const double* sin_yaw, co
   a[5] += w * cos_yaw[i];
 }
 
-// Adds particle i's second moments about the mean of its cluster `k` (in
-// plain arrays: an Eigen temporary per particle went through the stack and
-// stalled on store forwarding), with the same products in the same order
-// as w d d^T.
-inline void addMomentTerms(const ParticleSet& particles, const Cluster& k, std::size_t i,
-                           double* m) {
-  const double d[3] = {particles.x[i] - k.mean.x, particles.y[i] - k.mean.y,
-                       angleDiff(particles.yaw[i], k.mean.yaw)};
-  const double w = particles.weight[i];
-  for (int r = 0; r < 3; ++r) {
-    const double wd = w * d[r];
-    for (int col = 0; col < 3; ++col) m[3 * col + r] += wd * d[col];
-  }
-}
-
 // Each cluster's covariance from its summed second moments.
 void covariancesFromMoments(const std::vector<double>& moments, std::vector<Cluster>* clusters) {
   std::vector<Cluster>& c = *clusters;
@@ -420,7 +420,7 @@ struct SumsInOrder {
   EstimatorScratch* s;
   template <int kWidth, typename Term>
   void perBin(Term term, double* out) {
-    accumulateRuns<kWidth>(s->particle_bin, out, term);
+    accumulateRuns<kWidth>(s->particle_bin.data(), 0, s->particle_bin.size(), out, term);
   }
   // Once the bins are labelled: each particle's cluster.
   void labelled() {
@@ -431,7 +431,7 @@ struct SumsInOrder {
   }
   template <int kWidth, typename Term>
   void perCluster(Term term, double* out) {
-    accumulateRuns<kWidth>(s->cluster, out, term);
+    accumulateRuns<kWidth>(s->cluster.data(), 0, s->cluster.size(), out, term);
   }
 };
 

@@ -52,27 +52,34 @@ void forEachParticle(std::size_t n, int threads, F&& f) {
   });
 }
 
-// ESS of the weights prior * likelihood^beta, from their logarithms.
+// ESS of the weights prior * likelihood^beta, from their logarithms. The
+// weights are made, exponentiated and summed a chunk at a time, in cache,
+// instead of in three passes over the cloud: the tempering's bisection
+// takes twenty of these. The sums are the same, in the same order.
 double effectiveSampleSize(const std::vector<double>& log_prior,
                            const std::vector<double>& log_likelihood, double beta, int threads) {
   const std::size_t n = log_prior.size();
   const double max_log =
       maxBlocks(n, threads, [&](std::size_t i) { return log_prior[i] + beta * log_likelihood[i]; });
   if (!std::isfinite(max_log)) return 0.0;
-  struct WScratch {
-    std::vector<double> w;
-  };  // kept: no allocation per update
-  WScratch& w_scratch = threadScratch<WScratch>();
-  std::vector<double>& w = w_scratch.w;
-  w.resize(n);
-  double* wp = w.data();
-  forEachSlice(n, threads, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      wp[i] = log_prior[i] + beta * log_likelihood[i] - max_log;
-    }
-    exps(wp + begin, end - begin, wp + begin);
-  });
-  const Sums s = sums(w, threads);
+  const Sums s = reduceBlockRanges(
+      n, threads, Sums(),
+      [&](std::size_t begin, std::size_t end, Sums& a) {
+        constexpr std::size_t kChunk = 1024;
+        double w[kChunk];
+        for (std::size_t from = begin; from < end; from += kChunk) {
+          const std::size_t len = std::min(kChunk, end - from);
+          for (std::size_t j = 0; j < len; ++j) {
+            w[j] = log_prior[from + j] + beta * log_likelihood[from + j] - max_log;
+          }
+          exps(w, len, w);
+          for (std::size_t j = 0; j < len; ++j) {
+            a.sum += w[j];
+            a.sum_sq += w[j] * w[j];
+          }
+        }
+      },
+      mergeSums);
   return s.sum * s.sum / s.sum_sq;
 }
 

@@ -60,16 +60,18 @@ void forEachBlock(std::size_t n, int threads, F&& f) {
 }
 
 /// Reduces the particles [0, n) block by block: each block's State starts
-/// from `init` and takes its particles in order (add(i, state)); the
-/// blocks' States are then merged in block order (merge(into, from)). One
-/// block's State is the result as it is, so a cloud of one block gives the
-/// bits of the plain sequential loop.
-template <typename State, typename Add, typename Merge>
-State reduceBlocks(std::size_t n, int threads, const State& init, Add&& add, Merge&& merge) {
+/// from `init` and takes its particles in order, in one or more calls
+/// add(begin, end, state) over consecutive ranges; the blocks' States are
+/// then merged in block order (merge(into, from)). One block's State is the
+/// result as it is, so a cloud of one block gives the bits of the plain
+/// sequential loop.
+template <typename State, typename AddRange, typename Merge>
+State reduceBlockRanges(std::size_t n, int threads, const State& init, AddRange&& add,
+                        Merge&& merge) {
   const std::size_t blocks = blockCount(n);
   if (blocks <= 1) {
     State state = init;
-    for (std::size_t i = 0; i < n; ++i) add(i, state);
+    add(std::size_t{0}, n, state);
     return state;
   }
   struct Partial {
@@ -80,12 +82,23 @@ State reduceBlocks(std::size_t n, int threads, const State& init, Add&& add, Mer
   Partial* out = partial.data();
   forEachBlock(n, threads, [&](std::size_t b, std::size_t begin, std::size_t end) {
     State state = init;
-    for (std::size_t i = begin; i < end; ++i) add(i, state);
+    add(begin, end, state);
     out[b].state = state;
   });
   State state = partial[0].state;
   for (std::size_t b = 1; b < blocks; ++b) merge(state, partial[b].state);
   return state;
+}
+
+/// reduceBlockRanges particle by particle: add(i, state) for each i in turn.
+template <typename State, typename Add, typename Merge>
+State reduceBlocks(std::size_t n, int threads, const State& init, Add&& add, Merge&& merge) {
+  return reduceBlockRanges(
+      n, threads, init,
+      [&](std::size_t begin, std::size_t end, State& state) {
+        for (std::size_t i = begin; i < end; ++i) add(i, state);
+      },
+      merge);
 }
 
 /// The sum of term(i) over [0, n), added block by block (reduceBlocks).
