@@ -126,15 +126,14 @@ void packClusterBins(const ParticleSet& particles, double cell_xy, int64_t yaw_b
 
 namespace {
 
-// Adds particle i's second moments about the mean of `k` (its cluster, or
-// the whole cloud) (in
-// plain arrays: an Eigen temporary per particle went through the stack and
-// stalled on store forwarding), with the same products in the same order
-// as w d d^T.
-inline void addMomentTerms(const ParticleSet& particles, const Cluster& k, std::size_t i,
+// Adds particle i's second moments about `mean` (its cluster's, or the
+// whole cloud's) (in plain arrays: an Eigen temporary per particle went
+// through the stack and stalled on store forwarding), with the same
+// products in the same order as w d d^T.
+inline void addMomentTerms(const ParticleSet& particles, const Pose2& mean, std::size_t i,
                            double* m) {
-  const double d[3] = {particles.x[i] - k.mean.x, particles.y[i] - k.mean.y,
-                       angleDiff(particles.yaw[i], k.mean.yaw)};
+  const double d[3] = {particles.x[i] - mean.x, particles.y[i] - mean.y,
+                       angleDiff(particles.yaw[i], mean.yaw)};
   const double w = particles.weight[i];
   for (int r = 0; r < 3; ++r) {
     const double wd = w * d[r];
@@ -179,7 +178,7 @@ Cluster summarizeIndexed(const ParticleSet& particles, std::size_t count, Index 
   };
   const Moments moments = reduceBlocks(
       count, threads, Moments(),
-      [&](std::size_t k, Moments& a) { addMomentTerms(particles, c, index(k), a.m); },
+      [&](std::size_t k, Moments& a) { addMomentTerms(particles, c.mean, index(k), a.m); },
       [](Moments& into, const Moments& from) {
         for (int e = 0; e < 9; ++e) into.m[e] += from.m[e];
       });
@@ -210,6 +209,7 @@ struct EstimatorScratch {
   std::vector<BinTable::Bin> keys;
   std::vector<int> particle_bin, parent, cluster_of_root, cluster, cluster_of_bin;
   std::vector<double> bin_weight, sin_yaw, cos_yaw, sums, moments;
+  std::vector<Pose2> bin_mean;
 };
 
 // A cloud of several blocks (particle_blocks.h) is binned block by block:
@@ -319,8 +319,14 @@ void sumByBlockBins(std::size_t n, int threads, BlockScratch* b, Target target, 
   const std::size_t rows = b->blocks[blocks - 1].row + b->blocks[blocks - 1].keys.size();
   b->rows.assign(kWidth * rows, 0.0);
   forEachBlock(n, threads, [&](std::size_t k, std::size_t begin, std::size_t end) {
-    accumulateRuns<kWidth>(b->local_bin.data(), begin, end,
-                           b->rows.data() + kWidth * b->blocks[k].row, term);
+    // Straight into the rows, not in runs (accumulateRuns): a cloud of
+    // several blocks is a large one, rarely converged, whose runs of one
+    // bin are short, and a branch at every end of a run cost more than
+    // going through memory.
+    double* block_rows = b->rows.data() + kWidth * b->blocks[k].row;
+    for (std::size_t i = begin; i < end; ++i) {
+      term(i, block_rows + static_cast<std::size_t>(kWidth) * b->local_bin[i]);
+    }
   });
   for (std::size_t k = 0; k < blocks; ++k) {
     const BlockBins& block = b->blocks[k];
@@ -486,13 +492,15 @@ std::vector<Cluster> clustersOfBins(const ParticleSet& particles, const ClusterP
   for (int k = 0; k < clusters; ++k) {
     meanFromSums(&s->sums[6 * static_cast<std::size_t>(k)], &c[k]);
   }
+  // Each bin's cluster mean, so that a particle finds its mean in one small
+  // table, not through its cluster's id into the clusters.
+  s->bin_mean.resize(s->keys.size());
+  for (std::size_t b = 0; b < s->keys.size(); ++b) s->bin_mean[b] = c[s->cluster_of_bin[b]].mean;
   s->moments.assign(9 * c.size(), 0.0);
-  const std::vector<int>& cluster_of_bin = s->cluster_of_bin;
-  const std::vector<int>& particle_bin = s->particle_bin;
+  const Pose2* bin_mean = s->bin_mean.data();
+  const int* particle_bin = s->particle_bin.data();
   sums.template perCluster<9>(
-      [&](std::size_t i, double* m) {
-        addMomentTerms(particles, c[cluster_of_bin[particle_bin[i]]], i, m);
-      },
+      [&](std::size_t i, double* m) { addMomentTerms(particles, bin_mean[particle_bin[i]], i, m); },
       s->moments.data());
   covariancesFromMoments(s->moments, &c);
   return c;
