@@ -52,25 +52,24 @@ void forEachParticle(std::size_t n, int threads, F&& f) {
   });
 }
 
-// ESS of the weights prior * likelihood^beta, from their logarithms. The
-// weights are made, exponentiated and summed a chunk at a time, in cache,
-// instead of in three passes over the cloud: the tempering's bisection
-// takes twenty of these. The sums are the same, in the same order.
-double effectiveSampleSize(const std::vector<double>& log_prior,
-                           const std::vector<double>& log_likelihood, double beta, int threads) {
-  const std::size_t n = log_prior.size();
-  const double max_log =
-      maxBlocks(n, threads, [&](std::size_t i) { return log_prior[i] + beta * log_likelihood[i]; });
-  if (!std::isfinite(max_log)) return 0.0;
+// ESS of the weights prior * likelihood^beta, from their logarithms
+// (log_prior(i) and log_likelihood), given the largest log weight max_log
+// (finite). The weights are made, exponentiated and summed a chunk at a
+// time, in cache, instead of in three passes over the cloud: the
+// tempering's bisection takes twenty of these. The sums are the same, in
+// the same order.
+template <typename LogPrior>
+double effectiveSampleSize(LogPrior log_prior, const std::vector<double>& log_likelihood,
+                           double beta, double max_log, int threads) {
   const Sums s = reduceBlockRanges(
-      n, threads, Sums(),
+      log_likelihood.size(), threads, Sums(),
       [&](std::size_t begin, std::size_t end, Sums& a) {
         constexpr std::size_t kChunk = 1024;
         double w[kChunk];
         for (std::size_t from = begin; from < end; from += kChunk) {
           const std::size_t len = std::min(kChunk, end - from);
           for (std::size_t j = 0; j < len; ++j) {
-            w[j] = log_prior[from + j] + beta * log_likelihood[from + j] - max_log;
+            w[j] = log_prior(from + j) + beta * log_likelihood[from + j] - max_log;
           }
           exps(w, len, w);
           for (std::size_t j = 0; j < len; ++j) {
@@ -81,6 +80,30 @@ double effectiveSampleSize(const std::vector<double>& log_prior,
       },
       mergeSums);
   return s.sum * s.sum / s.sum_sq;
+}
+
+// ESS of the weights prior * likelihood^beta (beta > 0), from their
+// logarithms; `uniform` when every log prior is zero, and then max_ll is
+// the largest log likelihood. The largest log weight is then beta * max_ll
+// without a pass over the cloud: rounding is monotone, so the largest
+// rounded beta * ll is beta * max_ll rounded (and 0 + x is x but for the
+// sign of a zero, which the weights do not see); the log prior is not read
+// either. The same ESS, bit for bit.
+double effectiveSampleSize(const std::vector<double>& log_prior,
+                           const std::vector<double>& log_likelihood, double beta, bool uniform,
+                           double max_ll, int threads) {
+  const std::size_t n = log_likelihood.size();
+  if (uniform) {
+    const double max_log = beta * max_ll;
+    if (!std::isfinite(max_log)) return 0.0;
+    return effectiveSampleSize([](std::size_t) { return 0.0; }, log_likelihood, beta, max_log,
+                               threads);
+  }
+  const double max_log =
+      maxBlocks(n, threads, [&](std::size_t i) { return log_prior[i] + beta * log_likelihood[i]; });
+  if (!std::isfinite(max_log)) return 0.0;
+  return effectiveSampleSize([&](std::size_t i) { return log_prior[i]; }, log_likelihood, beta,
+                             max_log, threads);
 }
 
 // The prior's effective sample size: after a resampling every weight is the
@@ -183,16 +206,17 @@ double untemperedPosterior(const std::vector<double>& log_prior, const std::vect
 // keeps min_ess particles (by bisection): *posterior holds prior *
 // likelihood^beta / max, *total its sum. Returns beta, and the log of the
 // max in *max_log_out (-inf when every particle scores zero: the weights
-// are then the prior again).
+// are then the prior again). `uniform`: every log prior is zero.
 double temperedPosterior(const std::vector<double>& log_prior, const std::vector<double>& ll,
-                         double min_ess, std::vector<double>* posterior, double* total_out,
-                         double* max_log_out, int threads) {
+                         bool uniform, double min_ess, std::vector<double>* posterior,
+                         double* total_out, double* max_log_out, int threads) {
   double* e = posterior->data();
   const std::size_t n = posterior->size();
+  const double max_ll = uniform ? maxBlocks(n, threads, [&](std::size_t i) { return ll[i]; }) : 0.0;
   double lo = 0.0, hi = 1.0;
   for (int k = 0; k < 20; ++k) {
     const double mid = 0.5 * (lo + hi);
-    (effectiveSampleSize(log_prior, ll, mid, threads) >= min_ess ? lo : hi) = mid;
+    (effectiveSampleSize(log_prior, ll, mid, uniform, max_ll, threads) >= min_ess ? lo : hi) = mid;
   }
   const double beta = lo;
   const double max_log = maxBlocks(n, threads, [&](std::size_t i) {
@@ -218,9 +242,12 @@ double applyLikelihood(const std::vector<double>& ll, double min_ess_fraction,
                        std::vector<double>* weights, WeightingScratch* scratch, int threads) {
   std::vector<double>& w = *weights;
   const std::size_t n = w.size();
-  const bool uniform = reduceBlocks(
-      n, threads, true, [&](std::size_t i, bool& same) { same = same && w[i] == w.front(); },
-      [](bool& into, bool from) { into = into && from; });
+  // (An unsigned flag and &, not a bool and &&: the loop vectorises.)
+  const double first = n > 0 ? w[0] : 0.0;
+  const bool uniform =
+      reduceBlocks(
+          n, threads, 1u, [&](std::size_t i, unsigned& same) { same &= w[i] == first ? 1u : 0u; },
+          [](unsigned& into, unsigned from) { into &= from; }) != 0;
   // A share of the effective particles before the scan, not of all of them:
   // recovery's barely weighted guesses count as particles but not as
   // effective ones, and measured against N a cloud salted with them could
@@ -236,7 +263,7 @@ double applyLikelihood(const std::vector<double>& ll, double min_ess_fraction,
   double max_log = untemperedPosterior(log_prior, ll, &e, &total, &ess, threads);
   double beta = 1.0;
   if (min_ess > 0.0 && ess < min_ess) {
-    beta = temperedPosterior(log_prior, ll, min_ess, &e, &total, &max_log, threads);
+    beta = temperedPosterior(log_prior, ll, uniform, min_ess, &e, &total, &max_log, threads);
   }
   // Evidence that rules out every particle alike: the weights stay.
   if (!std::isfinite(max_log)) return beta;
