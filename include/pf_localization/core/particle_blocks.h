@@ -109,8 +109,9 @@ double sumBlocks(std::size_t n, int threads, Term&& term) {
       [](double& into, double from) { into += from; });
 }
 
-/// Calls f(begin, end) on one even slice of [0, n) per thread: particle by
-/// particle work, whose result does not depend on how it is split.
+/// Calls f(begin, end) on even slices of [0, n) that cover it, on up to
+/// `threads` threads: particle by particle work, whose result does not
+/// depend on how it is split. On one thread, one slice: f(0, n).
 template <typename F>
 void forEachSlice(std::size_t n, int threads, F&& f) {
   const std::size_t t = static_cast<std::size_t>(threadsFor(n, threads));
@@ -118,8 +119,13 @@ void forEachSlice(std::size_t n, int threads, F&& f) {
     f(std::size_t{0}, n);
     return;
   }
-  auto slice = [&](std::size_t k) { f(n * k / t, n * (k + 1) / t); };
-  WorkerPool::instance().run(static_cast<int>(t), t, slice);
+  // Slices of about kMinParticlesPerThread, many more than threads, taken
+  // in turn by whichever thread is free: a thread that the OS leaves
+  // waiting (the cores are shared) then holds the others up for one small
+  // slice, not for a 1/t share of the work.
+  const std::size_t slices = std::max(t, n / kMinParticlesPerThread);
+  auto slice = [&](std::size_t k) { f(n * k / slices, n * (k + 1) / slices); };
+  WorkerPool::instance().run(static_cast<int>(t), slices, slice);
 }
 
 /// The random streams of the blocks of a cloud: block 0 draws from the
