@@ -52,17 +52,40 @@ void forEachParticle(std::size_t n, int threads, F&& f) {
   });
 }
 
-// ESS of the weights prior * likelihood^beta, from their logarithms
-// (log_prior(i) and log_likelihood), given the largest log weight max_log
-// (finite). The weights are made, exponentiated and summed a chunk at a
-// time, in cache, instead of in three passes over the cloud: the
-// tempering's bisection takes twenty of these. The sums are the same, in
-// the same order.
+// The log prior of every particle, without storing a uniform prior's: a
+// constant prior does not change the normalised result, and zeros spare N
+// logarithms, N stores and a read of them in every pass.
+struct ZeroLogPrior {
+  static constexpr bool kUniform = true;
+  double operator()(std::size_t) const { return 0.0; }
+};
+struct StoredLogPrior {
+  static constexpr bool kUniform = false;
+  const double* log_prior;
+  double operator()(std::size_t i) const { return log_prior[i]; }
+};
+
+// ESS of the weights prior * likelihood^beta (beta > 0), from their
+// logarithms; max_ll is the largest log likelihood. The weights are made,
+// exponentiated and summed a chunk at a time, in cache, instead of in
+// three passes over the cloud: the tempering's bisection takes twenty of
+// these. The sums are the same, in the same order.
+//
+// With a uniform prior the largest log weight is beta * max_ll without a
+// pass over the cloud: rounding is monotone, so the largest rounded
+// beta * ll is beta * max_ll rounded (and 0 + x is x but for the sign of a
+// zero, which the weights do not see). The same ESS, bit for bit.
 template <typename LogPrior>
 double effectiveSampleSize(LogPrior log_prior, const std::vector<double>& log_likelihood,
-                           double beta, double max_log, int threads) {
+                           double beta, double max_ll, int threads) {
+  const std::size_t n = log_likelihood.size();
+  const double max_log =
+      LogPrior::kUniform ? beta * max_ll : maxBlocks(n, threads, [&](std::size_t i) {
+        return log_prior(i) + beta * log_likelihood[i];
+      });
+  if (!std::isfinite(max_log)) return 0.0;
   const Sums s = reduceBlockRanges(
-      log_likelihood.size(), threads, Sums(),
+      n, threads, Sums(),
       [&](std::size_t begin, std::size_t end, Sums& a) {
         constexpr std::size_t kChunk = 1024;
         double w[kChunk];
@@ -80,30 +103,6 @@ double effectiveSampleSize(LogPrior log_prior, const std::vector<double>& log_li
       },
       mergeSums);
   return s.sum * s.sum / s.sum_sq;
-}
-
-// ESS of the weights prior * likelihood^beta (beta > 0), from their
-// logarithms; `uniform` when every log prior is zero, and then max_ll is
-// the largest log likelihood. The largest log weight is then beta * max_ll
-// without a pass over the cloud: rounding is monotone, so the largest
-// rounded beta * ll is beta * max_ll rounded (and 0 + x is x but for the
-// sign of a zero, which the weights do not see); the log prior is not read
-// either. The same ESS, bit for bit.
-double effectiveSampleSize(const std::vector<double>& log_prior,
-                           const std::vector<double>& log_likelihood, double beta, bool uniform,
-                           double max_ll, int threads) {
-  const std::size_t n = log_likelihood.size();
-  if (uniform) {
-    const double max_log = beta * max_ll;
-    if (!std::isfinite(max_log)) return 0.0;
-    return effectiveSampleSize([](std::size_t) { return 0.0; }, log_likelihood, beta, max_log,
-                               threads);
-  }
-  const double max_log =
-      maxBlocks(n, threads, [&](std::size_t i) { return log_prior[i] + beta * log_likelihood[i]; });
-  if (!std::isfinite(max_log)) return 0.0;
-  return effectiveSampleSize([&](std::size_t i) { return log_prior[i]; }, log_likelihood, beta,
-                             max_log, threads);
 }
 
 // The prior's effective sample size: after a resampling every weight is the
@@ -157,31 +156,25 @@ bool multiplyDirectly(const std::vector<double>& ll, double min_ess, std::vector
   return false;
 }
 
-// The prior's logarithms. A constant prior does not change the normalised
-// result: zeros spare N logarithms.
-void logPrior(const std::vector<double>& w, bool uniform, std::vector<double>* log_prior,
-              int threads) {
-  const std::size_t n = w.size();
-  if (uniform) {
-    log_prior->assign(n, 0.0);
-  } else {
-    log_prior->resize(n);
-    double* lp = log_prior->data();
-    forEachParticle(n, threads, [&](std::size_t i) { lp[i] = std::log(w[i]); });
-  }
+// The logarithms of a prior that is not uniform.
+void logPrior(const std::vector<double>& w, std::vector<double>* log_prior, int threads) {
+  log_prior->resize(w.size());
+  double* lp = log_prior->data();
+  forEachParticle(w.size(), threads, [&](std::size_t i) { lp[i] = std::log(w[i]); });
 }
 
 // The untempered posterior, in one pass of exponentials that serves both
 // the tempering test and (nearly always) the result: *posterior holds
 // prior * likelihood / max, *total its sum. Returns the log of the max, and
 // its effective sample size in *ess.
-double untemperedPosterior(const std::vector<double>& log_prior, const std::vector<double>& ll,
+template <typename LogPrior>
+double untemperedPosterior(LogPrior log_prior, const std::vector<double>& ll,
                            std::vector<double>* posterior, double* total_out, double* ess,
                            int threads) {
   double* e = posterior->data();
   const std::size_t n = posterior->size();
   const double max_log = maxBlocks(n, threads, [&](std::size_t i) {
-    e[i] = log_prior[i] + ll[i];
+    e[i] = log_prior(i) + ll[i];
     return e[i];
   });
   // When every particle scores zero (possible with z_rand = 0: an end point
@@ -206,21 +199,22 @@ double untemperedPosterior(const std::vector<double>& log_prior, const std::vect
 // keeps min_ess particles (by bisection): *posterior holds prior *
 // likelihood^beta / max, *total its sum. Returns beta, and the log of the
 // max in *max_log_out (-inf when every particle scores zero: the weights
-// are then the prior again). `uniform`: every log prior is zero.
-double temperedPosterior(const std::vector<double>& log_prior, const std::vector<double>& ll,
-                         bool uniform, double min_ess, std::vector<double>* posterior,
-                         double* total_out, double* max_log_out, int threads) {
+// are then the prior again). max_ll: the largest log likelihood, which for
+// a uniform prior is the untempered posterior's largest log.
+template <typename LogPrior>
+double temperedPosterior(LogPrior log_prior, const std::vector<double>& ll, double max_ll,
+                         double min_ess, std::vector<double>* posterior, double* total_out,
+                         double* max_log_out, int threads) {
   double* e = posterior->data();
   const std::size_t n = posterior->size();
-  const double max_ll = uniform ? maxBlocks(n, threads, [&](std::size_t i) { return ll[i]; }) : 0.0;
   double lo = 0.0, hi = 1.0;
   for (int k = 0; k < 20; ++k) {
     const double mid = 0.5 * (lo + hi);
-    (effectiveSampleSize(log_prior, ll, mid, uniform, max_ll, threads) >= min_ess ? lo : hi) = mid;
+    (effectiveSampleSize(log_prior, ll, mid, max_ll, threads) >= min_ess ? lo : hi) = mid;
   }
   const double beta = lo;
   const double max_log = maxBlocks(n, threads, [&](std::size_t i) {
-    e[i] = log_prior[i] + beta * ll[i];
+    e[i] = log_prior(i) + beta * ll[i];
     return e[i];
   });
   double total = 0.0;
@@ -233,6 +227,25 @@ double temperedPosterior(const std::vector<double>& log_prior, const std::vector
   }
   *total_out = total;
   *max_log_out = max_log;
+  return beta;
+}
+
+// applyLikelihood in logarithms, with the prior's (log_prior); *e is
+// working storage of N values. Returns beta.
+template <typename LogPrior>
+double weighInLogarithms(LogPrior log_prior, const std::vector<double>& ll, double min_ess,
+                         std::vector<double>* weights, std::vector<double>* e, int threads) {
+  double total = 0.0, ess = 0.0;
+  double max_log = untemperedPosterior(log_prior, ll, e, &total, &ess, threads);
+  double beta = 1.0;
+  if (min_ess > 0.0 && ess < min_ess) {
+    beta = temperedPosterior(log_prior, ll, max_log, min_ess, e, &total, &max_log, threads);
+  }
+  // Evidence that rules out every particle alike: the weights stay.
+  if (!std::isfinite(max_log)) return beta;
+  double* w = weights->data();
+  const double* p = e->data();
+  forEachParticle(weights->size(), threads, [&](std::size_t i) { w[i] = p[i] / total; });
   return beta;
 }
 
@@ -255,20 +268,11 @@ double applyLikelihood(const std::vector<double>& ll, double min_ess_fraction,
   const double min_ess = min_ess_fraction * priorEffectiveSampleSize(w, uniform, threads);
   std::vector<double>& e = scratch->log_posterior;
   e.resize(n);
-  if (!uniform && multiplyDirectly(ll, min_ess, &w, &e, threads)) return 1.0;
+  if (uniform) return weighInLogarithms(ZeroLogPrior(), ll, min_ess, &w, &e, threads);
+  if (multiplyDirectly(ll, min_ess, &w, &e, threads)) return 1.0;
   // Otherwise in logarithms.
-  std::vector<double>& log_prior = scratch->log_prior;
-  logPrior(w, uniform, &log_prior, threads);
-  double total = 0.0, ess = 0.0;
-  double max_log = untemperedPosterior(log_prior, ll, &e, &total, &ess, threads);
-  double beta = 1.0;
-  if (min_ess > 0.0 && ess < min_ess) {
-    beta = temperedPosterior(log_prior, ll, uniform, min_ess, &e, &total, &max_log, threads);
-  }
-  // Evidence that rules out every particle alike: the weights stay.
-  if (!std::isfinite(max_log)) return beta;
-  forEachParticle(n, threads, [&](std::size_t i) { w[i] = e[i] / total; });
-  return beta;
+  logPrior(w, &scratch->log_prior, threads);
+  return weighInLogarithms(StoredLogPrior{scratch->log_prior.data()}, ll, min_ess, &w, &e, threads);
 }
 
 double meanBeamLikelihood(const std::vector<double>& weights,
