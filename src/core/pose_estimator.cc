@@ -309,12 +309,10 @@ void binParticlesByBlock(const ParticleSet& particles, double cell_xy, int64_t y
   });
 }
 
-// Adds term(i, row) of every particle i into the kWidth-wide row
-// out[target(bin)] of its bin (`bin` a bin of the whole cloud): per bin of
-// each block, then those sums in block order. `out` holds zeros.
-template <int kWidth, typename Target, typename Term>
-void sumByBlockBins(std::size_t n, int threads, BlockScratch* b, Target target, Term term,
-                    double* out) {
+// The first half of sumByBlockBins: adds term(i, row) of every particle i
+// into the kWidth-wide row of its bin in its block, in b->rows.
+template <int kWidth, typename Term>
+void sumIntoBlockRows(std::size_t n, int threads, BlockScratch* b, Term term) {
   const std::size_t blocks = blockCount(n);
   const std::size_t rows = b->blocks[blocks - 1].row + b->blocks[blocks - 1].keys.size();
   b->rows.assign(kWidth * rows, 0.0);
@@ -328,14 +326,32 @@ void sumByBlockBins(std::size_t n, int threads, BlockScratch* b, Target target, 
       term(i, block_rows + static_cast<std::size_t>(kWidth) * b->local_bin[i]);
     }
   });
-  for (std::size_t k = 0; k < blocks; ++k) {
-    const BlockBins& block = b->blocks[k];
+}
+
+// The second half: adds the columns [kFirst, kFirst + kCount) of the
+// blocks' kWidth-wide rows (sumIntoBlockRows) into the kCount-wide row
+// out[target(bin)] of each one's bin (a bin of the whole cloud), block
+// after block.
+template <int kWidth, int kFirst, int kCount, typename Target>
+void mergeBlockRows(std::size_t n, const BlockScratch& b, Target target, double* out) {
+  for (std::size_t k = 0; k < blockCount(n); ++k) {
+    const BlockBins& block = b.blocks[k];
     for (std::size_t l = 0; l < block.keys.size(); ++l) {
-      const double* from = b->rows.data() + kWidth * (block.row + l);
-      double* to = out + static_cast<std::size_t>(kWidth) * target(block.global[l]);
-      for (int c = 0; c < kWidth; ++c) to[c] += from[c];
+      const double* from = b.rows.data() + kWidth * (block.row + l) + kFirst;
+      double* to = out + static_cast<std::size_t>(kCount) * target(block.global[l]);
+      for (int c = 0; c < kCount; ++c) to[c] += from[c];
     }
   }
+}
+
+// Adds term(i, row) of every particle i into the kWidth-wide row
+// out[target(bin)] of its bin (`bin` a bin of the whole cloud): per bin of
+// each block, then those sums in block order. `out` holds zeros.
+template <int kWidth, typename Target, typename Term>
+void sumByBlockBins(std::size_t n, int threads, BlockScratch* b, Target target, Term term,
+                    double* out) {
+  sumIntoBlockRows<kWidth>(n, threads, b, term);
+  mergeBlockRows<kWidth, 0, kWidth>(n, *b, target, out);
 }
 
 // Joins occupied bins that touch (26-neighbourhood) into clusters, but only
@@ -424,16 +440,20 @@ void covariancesFromMoments(const std::vector<double>& moments, std::vector<Clus
 // the rows of each particle's bin or cluster.
 struct SumsInOrder {
   EstimatorScratch* s;
-  template <int kWidth, typename Term>
-  void perBin(Term term, double* out) {
-    accumulateRuns<kWidth>(s->particle_bin.data(), 0, s->particle_bin.size(), out, term);
+  // Each bin's weight (weight_term); the means' terms are summed later,
+  // per cluster.
+  template <typename WeightTerm, typename MeanTerm>
+  void binWeights(WeightTerm weight_term, MeanTerm, double* out) {
+    accumulateRuns<1>(s->particle_bin.data(), 0, s->particle_bin.size(), out, weight_term);
   }
-  // Once the bins are labelled: each particle's cluster.
-  void labelled() {
+  // Once the bins are labelled: each cluster's sums of mean_term (six wide).
+  template <typename MeanTerm>
+  void clusterMeans(MeanTerm mean_term, double* out) {
     s->cluster.resize(s->particle_bin.size());
     for (std::size_t i = 0; i < s->particle_bin.size(); ++i) {
       s->cluster[i] = s->cluster_of_bin[s->particle_bin[i]];
     }
+    perCluster<6>(mean_term, out);
   }
   template <int kWidth, typename Term>
   void perCluster(Term term, double* out) {
@@ -448,12 +468,20 @@ struct SumsByBlock {
   BlockScratch* b;
   std::size_t n;
   int threads;
-  template <int kWidth, typename Term>
-  void perBin(Term term, double* out) {
-    sumByBlockBins<kWidth>(
-        n, threads, b, [](int bin) { return bin; }, term, out);
+  // The means' terms per bin of each block, in one pass, kept for
+  // clusterMeans; the bins' weights are their second column (mean_term
+  // adds the weight there, as weight_term would: the same sums).
+  template <typename WeightTerm, typename MeanTerm>
+  void binWeights(WeightTerm, MeanTerm mean_term, double* out) {
+    sumIntoBlockRows<6>(n, threads, b, mean_term);
+    mergeBlockRows<6, 1, 1>(
+        n, *b, [](int bin) { return bin; }, out);
   }
-  void labelled() {}
+  template <typename MeanTerm>
+  void clusterMeans(MeanTerm, double* out) {
+    mergeBlockRows<6, 0, 6>(
+        n, *b, [&](int bin) { return s->cluster_of_bin[bin]; }, out);
+  }
   template <int kWidth, typename Term>
   void perCluster(Term term, double* out) {
     const std::vector<int>& cluster_of_bin = s->cluster_of_bin;
@@ -468,12 +496,6 @@ struct SumsByBlock {
 template <typename Sums>
 std::vector<Cluster> clustersOfBins(const ParticleSet& particles, const ClusterParams& params,
                                     int64_t yaw_bins, int threads, EstimatorScratch* s, Sums sums) {
-  s->bin_weight.assign(s->keys.size(), 0.0);
-  sums.template perBin<1>([&](std::size_t i, double* a) { a[0] += particles.weight[i]; },
-                          s->bin_weight.data());
-  joinTouchingBins(params.join_weight_ratio, yaw_bins, s);
-  const int clusters = labelBins(s);
-  sums.labelled();
   // The headings' sines and cosines for the whole cloud at once (sinCos
   // vectorises), for the mean directions.
   const std::size_t n = particles.size();
@@ -484,11 +506,17 @@ std::vector<Cluster> clustersOfBins(const ParticleSet& particles, const ClusterP
   forEachSlice(n, threads, [&](std::size_t begin, std::size_t end) {
     sinCos(particles.yaw.data() + begin, end - begin, sin_yaw + begin, cos_yaw + begin);
   });
+  const auto mean_terms = [&](std::size_t i, double* a) {
+    addMeanTerms(particles, sin_yaw, cos_yaw, i, a);
+  };
+  s->bin_weight.assign(s->keys.size(), 0.0);
+  sums.binWeights([&](std::size_t i, double* a) { a[0] += particles.weight[i]; }, mean_terms,
+                  s->bin_weight.data());
+  joinTouchingBins(params.join_weight_ratio, yaw_bins, s);
+  const int clusters = labelBins(s);
   std::vector<Cluster> c(clusters);
   s->sums.assign(6 * static_cast<std::size_t>(clusters), 0.0);
-  sums.template perCluster<6>(
-      [&](std::size_t i, double* a) { addMeanTerms(particles, sin_yaw, cos_yaw, i, a); },
-      s->sums.data());
+  sums.clusterMeans(mean_terms, s->sums.data());
   for (int k = 0; k < clusters; ++k) {
     meanFromSums(&s->sums[6 * static_cast<std::size_t>(k)], &c[k]);
   }
