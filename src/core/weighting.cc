@@ -6,7 +6,6 @@
 
 #include "pf_localization/core/fast_math.h"
 #include "pf_localization/core/particle_blocks.h"
-#include "pf_localization/core/thread_scratch.h"
 
 namespace pf {
 namespace {
@@ -52,6 +51,21 @@ void forEachParticle(std::size_t n, int threads, F&& f) {
   });
 }
 
+// Calls add(i, exp(x(i))) for each i in [begin, end) in turn, the
+// exponentials taken a chunk at a time in cache (exps vectorises) rather
+// than written for the whole cloud and read back in another pass.
+template <typename X, typename Add>
+void addExps(std::size_t begin, std::size_t end, X x, Add add) {
+  constexpr std::size_t kChunk = 1024;
+  double e[kChunk];
+  for (std::size_t from = begin; from < end; from += kChunk) {
+    const std::size_t len = std::min(kChunk, end - from);
+    for (std::size_t j = 0; j < len; ++j) e[j] = x(from + j);
+    exps(e, len, e);
+    for (std::size_t j = 0; j < len; ++j) add(from + j, e[j]);
+  }
+}
+
 // The log prior of every particle, without storing a uniform prior's: a
 // constant prior does not change the normalised result, and zeros spare N
 // logarithms, N stores and a read of them in every pass.
@@ -67,9 +81,9 @@ struct StoredLogPrior {
 
 // ESS of the weights prior * likelihood^beta (beta > 0), from their
 // logarithms; max_ll is the largest log likelihood. The weights are made,
-// exponentiated and summed a chunk at a time, in cache, instead of in
-// three passes over the cloud: the tempering's bisection takes twenty of
-// these. The sums are the same, in the same order.
+// exponentiated and summed a chunk at a time (addExps) instead of in three
+// passes over the cloud: the tempering's bisection takes twenty of these.
+// The sums are the same, in the same order.
 //
 // With a uniform prior the largest log weight is beta * max_ll without a
 // pass over the cloud: rounding is monotone, so the largest rounded
@@ -87,19 +101,13 @@ double effectiveSampleSize(LogPrior log_prior, const std::vector<double>& log_li
   const Sums s = reduceBlockRanges(
       n, threads, Sums(),
       [&](std::size_t begin, std::size_t end, Sums& a) {
-        constexpr std::size_t kChunk = 1024;
-        double w[kChunk];
-        for (std::size_t from = begin; from < end; from += kChunk) {
-          const std::size_t len = std::min(kChunk, end - from);
-          for (std::size_t j = 0; j < len; ++j) {
-            w[j] = log_prior(from + j) + beta * log_likelihood[from + j] - max_log;
-          }
-          exps(w, len, w);
-          for (std::size_t j = 0; j < len; ++j) {
-            a.sum += w[j];
-            a.sum_sq += w[j] * w[j];
-          }
-        }
+        addExps(
+            begin, end,
+            [&](std::size_t i) { return log_prior(i) + beta * log_likelihood[i] - max_log; },
+            [&](std::size_t, double w) {
+              a.sum += w;
+              a.sum_sq += w * w;
+            });
       },
       mergeSums);
   return s.sum * s.sum / s.sum_sq;
@@ -277,19 +285,16 @@ double applyLikelihood(const std::vector<double>& ll, double min_ess_fraction,
 
 double meanBeamLikelihood(const std::vector<double>& weights,
                           const std::vector<double>& log_likelihood, double beams, int threads) {
-  struct PerBeamScratch {
-    std::vector<double> per_beam;
-  };  // kept: no allocation per update
-  PerBeamScratch& per_beam_scratch = threadScratch<PerBeamScratch>();
-  std::vector<double>& per_beam = per_beam_scratch.per_beam;
-  const std::size_t n = weights.size();
-  per_beam.resize(n);
-  double* pb = per_beam.data();
-  forEachSlice(n, threads, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) pb[i] = log_likelihood[i] / beams;
-    exps(pb + begin, end - begin, pb + begin);
-  });
-  return sumBlocks(n, threads, [&](std::size_t i) { return weights[i] * pb[i]; });
+  // The per-beam likelihoods a chunk at a time (addExps), summed as they
+  // come: the same sum as writing them all and summing them after.
+  return reduceBlockRanges(
+      weights.size(), threads, 0.0,
+      [&](std::size_t begin, std::size_t end, double& sum) {
+        addExps(
+            begin, end, [&](std::size_t i) { return log_likelihood[i] / beams; },
+            [&](std::size_t i, double per_beam) { sum += weights[i] * per_beam; });
+      },
+      [](double& into, double from) { into += from; });
 }
 
 }  // namespace pf
