@@ -137,20 +137,21 @@ bool multiplyDirectly(const std::vector<double>& ll, double min_ess, std::vector
   const std::size_t n = weights->size();
   const double max_ll = maxBlocks(ll.size(), threads, [&](std::size_t i) { return ll[i]; });
   if (!std::isfinite(max_ll)) return false;
-  forEachSlice(n, threads, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) e[i] = ll[i] - max_ll;
-    exps(e + begin, end - begin, e + begin);
-  });
   struct Product {
     double total = 0.0, total_sq = 0.0, peak = 0.0;
   };
-  const Product p = reduceBlocks(
+  // The exponentials, the products and their sums in one pass (addExps).
+  const Product p = reduceBlockRanges(
       n, threads, Product(),
-      [&](std::size_t i, Product& a) {
-        e[i] *= w[i];
-        a.total += e[i];
-        a.total_sq += e[i] * e[i];
-        a.peak = std::max(a.peak, e[i]);
+      [&](std::size_t begin, std::size_t end, Product& a) {
+        addExps(
+            begin, end, [&](std::size_t i) { return ll[i] - max_ll; },
+            [&](std::size_t i, double likelihood) {
+              e[i] = likelihood * w[i];
+              a.total += e[i];
+              a.total_sq += e[i] * e[i];
+              a.peak = std::max(a.peak, e[i]);
+            });
       },
       [](Product& into, const Product& from) {
         into.total += from.total;
@@ -192,11 +193,19 @@ double untemperedPosterior(LogPrior log_prior, const std::vector<double>& ll,
   // none: the caller leaves the weights as they were.
   Sums s;
   if (std::isfinite(max_log)) {
-    forEachSlice(n, threads, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) e[i] -= max_log;
-      exps(e + begin, end - begin, e + begin);
-    });
-    s = sums(*posterior, threads);
+    // The exponentials and their sums in one pass (addExps).
+    s = reduceBlockRanges(
+        n, threads, Sums(),
+        [&](std::size_t begin, std::size_t end, Sums& a) {
+          addExps(
+              begin, end, [&](std::size_t i) { return e[i] - max_log; },
+              [&](std::size_t i, double v) {
+                e[i] = v;
+                a.sum += v;
+                a.sum_sq += v * v;
+              });
+        },
+        mergeSums);
   }
   *total_out = s.sum;
   *ess = s.sum_sq > 0.0 ? s.sum * s.sum / s.sum_sq : 0.0;
@@ -227,11 +236,17 @@ double temperedPosterior(LogPrior log_prior, const std::vector<double>& ll, doub
   });
   double total = 0.0;
   if (std::isfinite(max_log)) {
-    forEachSlice(n, threads, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) e[i] -= max_log;
-      exps(e + begin, end - begin, e + begin);
-    });
-    total = sumBlocks(n, threads, [&](std::size_t i) { return e[i]; });
+    total = reduceBlockRanges(
+        n, threads, 0.0,
+        [&](std::size_t begin, std::size_t end, double& sum) {
+          addExps(
+              begin, end, [&](std::size_t i) { return e[i] - max_log; },
+              [&](std::size_t i, double v) {
+                e[i] = v;
+                sum += v;
+              });
+        },
+        [](double& into, double from) { into += from; });
   }
   *total_out = total;
   *max_log_out = max_log;
