@@ -68,10 +68,15 @@ constexpr double kP1 = 1.66666666666666019037e-01, kP2 = -2.77777777770155933842
                  kP3 = 6.61375632143793436117e-05, kP4 = -1.65339022054652515390e-06,
                  kP5 = 4.13813679705723846039e-08;
 
+// expKernel's range: [-708, 709] by the approximation, and below -746,
+// where exp rounds to zero (e^-746 is less than half the least subnormal).
+constexpr double kExpKernelLow = -708.0, kExpKernelHigh = 709.0, kExpZeroBelow = -746.0;
+
 __attribute__((target_clones("avx2", "default"))) void expKernel(const double* x, std::size_t n,
                                                                  double* out) {
   for (std::size_t i = 0; i < n; ++i) {
-    // Outside [-708, 709] the result is wrong here, and replaced by exps().
+    // Within [-746, -708), above 709 and for NaN the result is wrong
+    // here, and replaced by exps(); below -746 it is exp's, zero.
     const double v = x[i];
     // v = k ln2 + r, |r| <= ln2 / 2.
     const double k = (v * kInvLn2 + kShifter) - kShifter;
@@ -87,13 +92,44 @@ __attribute__((target_clones("avx2", "default"))) void expKernel(const double* x
     const double k1 = (k * 0.5 + kShifter) - kShifter, k2 = k - k1;
     const double scale1 = fromBits(toBits(k1 + (1023.0 + kShifter)) << 52);
     const double scale2 = fromBits(toBits(k2 + (1023.0 + kShifter)) << 52);
-    out[i] = y * scale1 * scale2;
+    // Zero below kExpZeroBelow by a mask, not a branch: the loop vectorises.
+    const uint64_t keep = v < kExpZeroBelow ? 0 : ~uint64_t{0};
+    out[i] = fromBits(toBits(y * scale1 * scale2) & keep);
   }
+}
+
+// 1 when exp(v) is one that expKernel does not give (see there), else 0;
+// comparisons combined as integers, not && and ||, so that loops over it
+// vectorise.
+inline unsigned needsLibraryExp(double v) {
+  return static_cast<unsigned>(!(v < kExpZeroBelow)) &
+         (static_cast<unsigned>(!(v >= kExpKernelLow)) |
+          static_cast<unsigned>(!(v <= kExpKernelHigh)));
+}
+
+// Whether any of x[0, n) needsLibraryExp, or (sinCos) is beyond kLimit or
+// NaN: one vectorised pass with no early exit, so that the common case
+// (none) costs a compare per value, not a branch and a list.
+__attribute__((target_clones("avx2", "default"))) bool anyNeedsLibraryExp(const double* x,
+                                                                          std::size_t n) {
+  unsigned any = 0;
+  for (std::size_t i = 0; i < n; ++i) any |= needsLibraryExp(x[i]);
+  return any != 0;
+}
+__attribute__((target_clones("avx2", "default"))) bool anyBeyondLimit(const double* x,
+                                                                      std::size_t n) {
+  unsigned any = 0;
+  for (std::size_t i = 0; i < n; ++i) any |= std::fabs(x[i]) <= kLimit ? 0 : 1;
+  return any != 0;
 }
 
 }  // namespace
 
 void exps(const double* x, std::size_t n, double* out) {
+  if (!anyNeedsLibraryExp(x, n)) {
+    expKernel(x, n, out);
+    return;
+  }
   // Saved first: out may be x.
   struct Scratch {
     std::vector<std::size_t> outside;
@@ -104,7 +140,7 @@ void exps(const double* x, std::size_t n, double* out) {
   std::vector<double>& saved = scratch.saved;
   outside.clear();
   for (std::size_t i = 0; i < n; ++i) {
-    if (!(x[i] >= -708.0 && x[i] <= 709.0)) outside.push_back(i);
+    if (needsLibraryExp(x[i])) outside.push_back(i);
   }
   saved.clear();
   for (std::size_t i : outside) saved.push_back(x[i]);
@@ -114,6 +150,7 @@ void exps(const double* x, std::size_t n, double* out) {
 
 void sinCos(const double* angle, std::size_t n, double* s, double* c) {
   sinCosKernel(angle, n, s, c);
+  if (!anyBeyondLimit(angle, n)) return;
   for (std::size_t i = 0; i < n; ++i) {
     if (!(std::fabs(angle[i]) <= kLimit)) {
       s[i] = std::sin(angle[i]);

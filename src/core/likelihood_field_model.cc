@@ -250,10 +250,11 @@ __attribute__((target("avx2"))) std::size_t scoreBlocksAvx2(
           _mm256_sub_ps(_mm256_add_ps(px, _mm256_mul_ps(c, ux)), _mm256_mul_ps(s, uy));
       const __m256 ey =
           _mm256_add_ps(_mm256_add_ps(py, _mm256_mul_ps(s, ux)), _mm256_mul_ps(c, uy));
-      const __m256 gx =
-          _mm256_and_ps(_mm256_cmp_ps(ex, zero, _CMP_GT_OQ), _mm256_min_ps(max_x, ex));
-      const __m256 gy =
-          _mm256_and_ps(_mm256_cmp_ps(ey, zero, _CMP_GT_OQ), _mm256_min_ps(max_y, ey));
+      // endPointCell's clamp in two instructions, not three: min and max
+      // return their second operand for NaN (and max for two zeros), so
+      // NaN, zero and below all become +0, as there.
+      const __m256 gx = _mm256_max_ps(_mm256_min_ps(max_x, ex), zero);
+      const __m256 gy = _mm256_max_ps(_mm256_min_ps(max_y, ey), zero);
       const __m256i cell = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_cvttps_epi32(gy), stride),
                                             _mm256_cvttps_epi32(gx));
       // One gather for the eight cells: 0.55 ns per particle and beam here,

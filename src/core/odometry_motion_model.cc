@@ -25,8 +25,11 @@ double rotationMagnitude(double rot) {
 // or, for the share fault_fraction of the particles, half the time the
 // reversed one (with the same noise) and half the time none (uniform within
 // +-margin). *fault says which. See the header.
-double sampleTranslation(double trans, double sigma, double fault_fraction, double margin,
-                         Random* random, uint8_t* fault) {
+// (Always inlined: the loops below draw from a local copy of their stream,
+// which must not have its address escape into a call; see random.h.)
+__attribute__((always_inline)) inline double sampleTranslation(double trans, double sigma,
+                                                               double fault_fraction, double margin,
+                                                               Random* random, uint8_t* fault) {
   if (fault_fraction > 0.0) {
     const double u = random->uniform();
     *fault = u < fault_fraction ? 1 : 0;
@@ -36,6 +39,34 @@ double sampleTranslation(double trans, double sigma, double fault_fraction, doub
     *fault = 0;
   }
   return trans - random->gaussian(sigma);
+}
+
+// What a differential step draws from (see applyDifferential): the
+// odometry's rotations and translation, their noise, and the fault share.
+struct DifferentialDraws {
+  OdometryStep step;
+  double sigma_rot1, sigma_trans, sigma_rot2;
+  double fault_fraction, fault_margin;
+};
+
+// The random part of a differential step for particles [begin, end), one
+// particle after the other from `stream`: each heading turned by its first
+// rotation (the heading of travel), its translation, its second rotation,
+// and whether it took a fault. Everything the loop reads is a local or a
+// value here, the stream too (copied in and back): a store through the
+// char pointer `faulty` might otherwise change it, and the stream's state
+// and every other operand were reloaded for each particle.
+void drawDifferential(const DifferentialDraws d, Random* stream, std::size_t begin, std::size_t end,
+                      double* yaw, double* trans, double* turn2, uint8_t* faulty) {
+  Random random = *stream;
+  for (std::size_t i = begin; i < end; ++i) {
+    const double r1 = d.step.rot1 - random.gaussian(d.sigma_rot1);
+    trans[i] = sampleTranslation(d.step.trans, d.sigma_trans, d.fault_fraction, d.fault_margin,
+                                 &random, &faulty[i]);
+    turn2[i] = d.step.rot2 - random.gaussian(d.sigma_rot2);
+    yaw[i] += r1;
+  }
+  *stream = random;
 }
 
 std::string kindName(OdometryMotionParams::Kind kind) {
@@ -126,10 +157,13 @@ void OdometryMotionModel::applyDifferential(const Pose2& from, const Pose2& to,
   const double rot1 = rotationMagnitude(step.rot1);
   const double rot2 = rotationMagnitude(step.rot2);
   const double trans2 = step.trans * step.trans;
-  const double sigma_rot1 = std::sqrt(params_.alpha1 * rot1 * rot1 + params_.alpha2 * trans2);
-  const double sigma_trans =
-      std::sqrt(params_.alpha3 * trans2 + params_.alpha4 * (rot1 * rot1 + rot2 * rot2));
-  const double sigma_rot2 = std::sqrt(params_.alpha1 * rot2 * rot2 + params_.alpha2 * trans2);
+  const DifferentialDraws draws{
+      step,
+      std::sqrt(params_.alpha1 * rot1 * rot1 + params_.alpha2 * trans2),
+      std::sqrt(params_.alpha3 * trans2 + params_.alpha4 * (rot1 * rot1 + rot2 * rot2)),
+      std::sqrt(params_.alpha1 * rot2 * rot2 + params_.alpha2 * trans2),
+      fault_fraction,
+      params_.fault_margin};
 
   // Two passes per block: the random draws, one particle after the other
   // (the random stream is the same as drawing and moving each particle in
@@ -151,14 +185,9 @@ void OdometryMotionModel::applyDifferential(const Pose2& from, const Pose2& to,
   s.resize(n);
   c.resize(n);
   forEachBlock(n, threads, [&](std::size_t b, std::size_t begin, std::size_t end) {
-    Random* random = streams->stream(b);
-    for (std::size_t i = begin; i < end; ++i) {
-      const double r1 = step.rot1 - random->gaussian(sigma_rot1);
-      trans[i] = sampleTranslation(step.trans, sigma_trans, fault_fraction, params_.fault_margin,
-                                   random, &faulty[i]);
-      turn2[i] = step.rot2 - random->gaussian(sigma_rot2);
-      p.yaw[i] += r1;  // the heading of travel, until the last pass
-    }
+    // p.yaw becomes the heading of travel until the last pass.
+    drawDifferential(draws, streams->stream(b), begin, end, p.yaw.data(), trans.data(),
+                     turn2.data(), faulty);
     sinCos(p.yaw.data() + begin, end - begin, s.data() + begin, c.data() + begin);
     for (std::size_t i = begin; i < end; ++i) {
       p.x[i] += trans[i] * c[i];
@@ -185,16 +214,17 @@ void OdometryMotionModel::applyOmni(const Pose2& from, const Pose2& to, double f
 
   ParticleSet& p = *particles;
   forEachBlock(p.size(), threads, [&](std::size_t b, std::size_t begin, std::size_t end) {
-    Random* random = streams->stream(b);
+    Random random = *streams->stream(b);  // in registers, as in applyDifferential
     for (std::size_t i = begin; i < end; ++i) {
       const double t = sampleTranslation(trans, sigma_trans, fault_fraction, params_.fault_margin,
-                                         random, &faulty[i]);
-      const double s = random->gaussian(sigma_strafe);
+                                         &random, &faulty[i]);
+      const double s = random.gaussian(sigma_strafe);
       const double heading = p.yaw[i] + bearing;
       p.x[i] += t * std::cos(heading) - s * std::sin(heading);
       p.y[i] += t * std::sin(heading) + s * std::cos(heading);
-      p.yaw[i] = normalizeAngle(p.yaw[i] + rot + random->gaussian(sigma_rot));
+      p.yaw[i] = normalizeAngle(p.yaw[i] + rot + random.gaussian(sigma_rot));
     }
+    *streams->stream(b) = random;
   });
 }
 

@@ -21,22 +21,21 @@ int find(std::vector<int>& parent, int i) {
   return i;
 }
 
-// Adds term(i, row) for every particle i into the row (kWidth values) of
-// its group, group[i], in `rows`. Runs of particles in one group (nearly
-// the whole cloud when tracking) add in registers, starting from and
-// returning to the group's row: the additions are the same, in the same
-// order, as adding each term to the row in memory, which made every
-// particle wait for the one before through a store and a load.
+// Adds term(i, row) for every particle i in [begin, end) into the row
+// (kWidth values) of its group, group[i], in `rows`. Runs of particles in
+// one group (nearly the whole cloud when tracking) add in registers,
+// starting from and returning to the group's row: the additions are the
+// same, in the same order, as adding each term to the row in memory, which
+// made every particle wait for the one before through a store and a load.
 template <int kWidth, typename Term>
-void accumulateRuns(const std::vector<int>& group, double* rows, Term term) {
-  const std::size_t n = group.size();
-  std::size_t i = 0;
-  while (i < n) {
+void accumulateRuns(const int* group, std::size_t begin, std::size_t end, double* rows, Term term) {
+  std::size_t i = begin;
+  while (i < end) {
     const int g = group[i];
     double* row = rows + static_cast<std::size_t>(kWidth) * g;
     double acc[kWidth];
     std::copy(row, row + kWidth, acc);
-    for (; i < n && group[i] == g; ++i) term(i, acc);
+    for (; i < end && group[i] == g; ++i) term(i, acc);
     std::copy(acc, acc + kWidth, row);
   }
 }
@@ -127,6 +126,21 @@ void packClusterBins(const ParticleSet& particles, double cell_xy, int64_t yaw_b
 
 namespace {
 
+// Adds particle i's second moments about `mean` (its cluster's, or the
+// whole cloud's) (in plain arrays: an Eigen temporary per particle went
+// through the stack and stalled on store forwarding), with the same
+// products in the same order as w d d^T.
+inline void addMomentTerms(const ParticleSet& particles, const Pose2& mean, std::size_t i,
+                           double* m) {
+  const double d[3] = {particles.x[i] - mean.x, particles.y[i] - mean.y,
+                       angleDiff(particles.yaw[i], mean.yaw)};
+  const double w = particles.weight[i];
+  for (int r = 0; r < 3; ++r) {
+    const double wd = w * d[r];
+    for (int col = 0; col < 3; ++col) m[3 * col + r] += wd * d[col];
+  }
+}
+
 // summarize() of the `count` particles index(0), index(1), ...
 template <typename Index>
 Cluster summarizeIndexed(const ParticleSet& particles, std::size_t count, Index index,
@@ -157,16 +171,18 @@ Cluster summarizeIndexed(const ParticleSet& particles, std::size_t count, Index 
   c.weight = sums.w;
   if (!(c.weight > 0.0)) return c;
   c.mean = {sums.sx / c.weight, sums.sy / c.weight, normalizeAngle(std::atan2(sums.ss, sums.sc))};
-  c.covariance = reduceBlocks(
-      count, threads, Eigen::Matrix3d(Eigen::Matrix3d::Zero()),
-      [&](std::size_t k, Eigen::Matrix3d& m) {
-        const std::size_t i = index(k);
-        const Eigen::Vector3d d(particles.x[i] - c.mean.x, particles.y[i] - c.mean.y,
-                                angleDiff(particles.yaw[i], c.mean.yaw));
-        m += particles.weight[i] * d * d.transpose();
-      },
-      [](Eigen::Matrix3d& into, const Eigen::Matrix3d& from) { into += from; });
-  c.covariance /= c.weight;
+  // The moments in plain arrays (addMomentTerms), not an Eigen matrix per
+  // particle: the same products and sums.
+  struct Moments {
+    double m[9] = {};
+  };
+  const Moments moments = reduceBlocks(
+      count, threads, Moments(),
+      [&](std::size_t k, Moments& a) { addMomentTerms(particles, c.mean, index(k), a.m); },
+      [](Moments& into, const Moments& from) {
+        for (int e = 0; e < 9; ++e) into.m[e] += from.m[e];
+      });
+  c.covariance = Eigen::Map<const Eigen::Matrix3d>(moments.m) / c.weight;
   return c;
 }
 
@@ -193,6 +209,7 @@ struct EstimatorScratch {
   std::vector<BinTable::Bin> keys;
   std::vector<int> particle_bin, parent, cluster_of_root, cluster, cluster_of_bin;
   std::vector<double> bin_weight, sin_yaw, cos_yaw, sums, moments;
+  std::vector<Pose2> bin_mean;
 };
 
 // A cloud of several blocks (particle_blocks.h) is binned block by block:
@@ -292,29 +309,49 @@ void binParticlesByBlock(const ParticleSet& particles, double cell_xy, int64_t y
   });
 }
 
+// The first half of sumByBlockBins: adds term(i, row) of every particle i
+// into the kWidth-wide row of its bin in its block, in b->rows.
+template <int kWidth, typename Term>
+void sumIntoBlockRows(std::size_t n, int threads, BlockScratch* b, Term term) {
+  const std::size_t blocks = blockCount(n);
+  const std::size_t rows = b->blocks[blocks - 1].row + b->blocks[blocks - 1].keys.size();
+  b->rows.assign(kWidth * rows, 0.0);
+  forEachBlock(n, threads, [&](std::size_t k, std::size_t begin, std::size_t end) {
+    // Straight into the rows, not in runs (accumulateRuns): a cloud of
+    // several blocks is a large one, rarely converged, whose runs of one
+    // bin are short, and a branch at every end of a run cost more than
+    // going through memory.
+    double* block_rows = b->rows.data() + kWidth * b->blocks[k].row;
+    for (std::size_t i = begin; i < end; ++i) {
+      term(i, block_rows + static_cast<std::size_t>(kWidth) * b->local_bin[i]);
+    }
+  });
+}
+
+// The second half: adds the columns [kFirst, kFirst + kCount) of the
+// blocks' kWidth-wide rows (sumIntoBlockRows) into the kCount-wide row
+// out[target(bin)] of each one's bin (a bin of the whole cloud), block
+// after block.
+template <int kWidth, int kFirst, int kCount, typename Target>
+void mergeBlockRows(std::size_t n, const BlockScratch& b, Target target, double* out) {
+  for (std::size_t k = 0; k < blockCount(n); ++k) {
+    const BlockBins& block = b.blocks[k];
+    for (std::size_t l = 0; l < block.keys.size(); ++l) {
+      const double* from = b.rows.data() + kWidth * (block.row + l) + kFirst;
+      double* to = out + static_cast<std::size_t>(kCount) * target(block.global[l]);
+      for (int c = 0; c < kCount; ++c) to[c] += from[c];
+    }
+  }
+}
+
 // Adds term(i, row) of every particle i into the kWidth-wide row
 // out[target(bin)] of its bin (`bin` a bin of the whole cloud): per bin of
 // each block, then those sums in block order. `out` holds zeros.
 template <int kWidth, typename Target, typename Term>
 void sumByBlockBins(std::size_t n, int threads, BlockScratch* b, Target target, Term term,
                     double* out) {
-  const std::size_t blocks = blockCount(n);
-  const std::size_t rows = b->blocks[blocks - 1].row + b->blocks[blocks - 1].keys.size();
-  b->rows.assign(kWidth * rows, 0.0);
-  forEachBlock(n, threads, [&](std::size_t k, std::size_t begin, std::size_t end) {
-    double* block_rows = b->rows.data() + kWidth * b->blocks[k].row;
-    for (std::size_t i = begin; i < end; ++i) {
-      term(i, block_rows + static_cast<std::size_t>(kWidth) * b->local_bin[i]);
-    }
-  });
-  for (std::size_t k = 0; k < blocks; ++k) {
-    const BlockBins& block = b->blocks[k];
-    for (std::size_t l = 0; l < block.keys.size(); ++l) {
-      const double* from = b->rows.data() + kWidth * (block.row + l);
-      double* to = out + static_cast<std::size_t>(kWidth) * target(block.global[l]);
-      for (int c = 0; c < kWidth; ++c) to[c] += from[c];
-    }
-  }
+  sumIntoBlockRows<kWidth>(n, threads, b, term);
+  mergeBlockRows<kWidth, 0, kWidth>(n, *b, target, out);
 }
 
 // Joins occupied bins that touch (26-neighbourhood) into clusters, but only
@@ -390,21 +427,6 @@ inline void addMeanTerms(const ParticleSet& particles, const double* sin_yaw, co
   a[5] += w * cos_yaw[i];
 }
 
-// Adds particle i's second moments about the mean of its cluster `k` (in
-// plain arrays: an Eigen temporary per particle went through the stack and
-// stalled on store forwarding), with the same products in the same order
-// as w d d^T.
-inline void addMomentTerms(const ParticleSet& particles, const Cluster& k, std::size_t i,
-                           double* m) {
-  const double d[3] = {particles.x[i] - k.mean.x, particles.y[i] - k.mean.y,
-                       angleDiff(particles.yaw[i], k.mean.yaw)};
-  const double w = particles.weight[i];
-  for (int r = 0; r < 3; ++r) {
-    const double wd = w * d[r];
-    for (int col = 0; col < 3; ++col) m[3 * col + r] += wd * d[col];
-  }
-}
-
 // Each cluster's covariance from its summed second moments.
 void covariancesFromMoments(const std::vector<double>& moments, std::vector<Cluster>* clusters) {
   std::vector<Cluster>& c = *clusters;
@@ -418,20 +440,24 @@ void covariancesFromMoments(const std::vector<double>& moments, std::vector<Clus
 // the rows of each particle's bin or cluster.
 struct SumsInOrder {
   EstimatorScratch* s;
-  template <int kWidth, typename Term>
-  void perBin(Term term, double* out) {
-    accumulateRuns<kWidth>(s->particle_bin, out, term);
+  // Each bin's weight (weight_term); the means' terms are summed later,
+  // per cluster.
+  template <typename WeightTerm, typename MeanTerm>
+  void binWeights(WeightTerm weight_term, MeanTerm, double* out) {
+    accumulateRuns<1>(s->particle_bin.data(), 0, s->particle_bin.size(), out, weight_term);
   }
-  // Once the bins are labelled: each particle's cluster.
-  void labelled() {
+  // Once the bins are labelled: each cluster's sums of mean_term (six wide).
+  template <typename MeanTerm>
+  void clusterMeans(MeanTerm mean_term, double* out) {
     s->cluster.resize(s->particle_bin.size());
     for (std::size_t i = 0; i < s->particle_bin.size(); ++i) {
       s->cluster[i] = s->cluster_of_bin[s->particle_bin[i]];
     }
+    perCluster<6>(mean_term, out);
   }
   template <int kWidth, typename Term>
   void perCluster(Term term, double* out) {
-    accumulateRuns<kWidth>(s->cluster, out, term);
+    accumulateRuns<kWidth>(s->cluster.data(), 0, s->cluster.size(), out, term);
   }
 };
 
@@ -442,12 +468,20 @@ struct SumsByBlock {
   BlockScratch* b;
   std::size_t n;
   int threads;
-  template <int kWidth, typename Term>
-  void perBin(Term term, double* out) {
-    sumByBlockBins<kWidth>(
-        n, threads, b, [](int bin) { return bin; }, term, out);
+  // The means' terms per bin of each block, in one pass, kept for
+  // clusterMeans; the bins' weights are their second column (mean_term
+  // adds the weight there, as weight_term would: the same sums).
+  template <typename WeightTerm, typename MeanTerm>
+  void binWeights(WeightTerm, MeanTerm mean_term, double* out) {
+    sumIntoBlockRows<6>(n, threads, b, mean_term);
+    mergeBlockRows<6, 1, 1>(
+        n, *b, [](int bin) { return bin; }, out);
   }
-  void labelled() {}
+  template <typename MeanTerm>
+  void clusterMeans(MeanTerm, double* out) {
+    mergeBlockRows<6, 0, 6>(
+        n, *b, [&](int bin) { return s->cluster_of_bin[bin]; }, out);
+  }
   template <int kWidth, typename Term>
   void perCluster(Term term, double* out) {
     const std::vector<int>& cluster_of_bin = s->cluster_of_bin;
@@ -462,12 +496,6 @@ struct SumsByBlock {
 template <typename Sums>
 std::vector<Cluster> clustersOfBins(const ParticleSet& particles, const ClusterParams& params,
                                     int64_t yaw_bins, int threads, EstimatorScratch* s, Sums sums) {
-  s->bin_weight.assign(s->keys.size(), 0.0);
-  sums.template perBin<1>([&](std::size_t i, double* a) { a[0] += particles.weight[i]; },
-                          s->bin_weight.data());
-  joinTouchingBins(params.join_weight_ratio, yaw_bins, s);
-  const int clusters = labelBins(s);
-  sums.labelled();
   // The headings' sines and cosines for the whole cloud at once (sinCos
   // vectorises), for the mean directions.
   const std::size_t n = particles.size();
@@ -478,21 +506,29 @@ std::vector<Cluster> clustersOfBins(const ParticleSet& particles, const ClusterP
   forEachSlice(n, threads, [&](std::size_t begin, std::size_t end) {
     sinCos(particles.yaw.data() + begin, end - begin, sin_yaw + begin, cos_yaw + begin);
   });
+  const auto mean_terms = [&](std::size_t i, double* a) {
+    addMeanTerms(particles, sin_yaw, cos_yaw, i, a);
+  };
+  s->bin_weight.assign(s->keys.size(), 0.0);
+  sums.binWeights([&](std::size_t i, double* a) { a[0] += particles.weight[i]; }, mean_terms,
+                  s->bin_weight.data());
+  joinTouchingBins(params.join_weight_ratio, yaw_bins, s);
+  const int clusters = labelBins(s);
   std::vector<Cluster> c(clusters);
   s->sums.assign(6 * static_cast<std::size_t>(clusters), 0.0);
-  sums.template perCluster<6>(
-      [&](std::size_t i, double* a) { addMeanTerms(particles, sin_yaw, cos_yaw, i, a); },
-      s->sums.data());
+  sums.clusterMeans(mean_terms, s->sums.data());
   for (int k = 0; k < clusters; ++k) {
     meanFromSums(&s->sums[6 * static_cast<std::size_t>(k)], &c[k]);
   }
+  // Each bin's cluster mean, so that a particle finds its mean in one small
+  // table, not through its cluster's id into the clusters.
+  s->bin_mean.resize(s->keys.size());
+  for (std::size_t b = 0; b < s->keys.size(); ++b) s->bin_mean[b] = c[s->cluster_of_bin[b]].mean;
   s->moments.assign(9 * c.size(), 0.0);
-  const std::vector<int>& cluster_of_bin = s->cluster_of_bin;
-  const std::vector<int>& particle_bin = s->particle_bin;
+  const Pose2* bin_mean = s->bin_mean.data();
+  const int* particle_bin = s->particle_bin.data();
   sums.template perCluster<9>(
-      [&](std::size_t i, double* m) {
-        addMomentTerms(particles, c[cluster_of_bin[particle_bin[i]]], i, m);
-      },
+      [&](std::size_t i, double* m) { addMomentTerms(particles, bin_mean[particle_bin[i]], i, m); },
       s->moments.data());
   covariancesFromMoments(s->moments, &c);
   return c;

@@ -53,7 +53,7 @@ Random::Random(uint64_t seed) : zig_(&ziggurat()) {
   for (uint64_t& word : s_) word = splitmix64(&seed);
 }
 
-double Random::normalTail(int64_t hz, int layer) {
+Random::Tail Random::normalTail(int64_t hz, int layer, Random stream) {
   const Ziggurat& z = ziggurat();
   while (true) {
     const double x = static_cast<double>(hz) * z.w[layer];
@@ -61,17 +61,20 @@ double Random::normalTail(int64_t hz, int layer) {
       // Beyond r: Marsaglia's exponential method for the normal tail.
       double tx, ty;
       do {
-        tx = -std::log(1.0 - uniform()) / Ziggurat::kR;
-        ty = -std::log(1.0 - uniform());
+        tx = -std::log(1.0 - stream.uniform()) / Ziggurat::kR;
+        ty = -std::log(1.0 - stream.uniform());
       } while (ty + ty < tx * tx);
-      return hz > 0 ? Ziggurat::kR + tx : -Ziggurat::kR - tx;
+      return {hz > 0 ? Ziggurat::kR + tx : -Ziggurat::kR - tx, stream.s_};
     }
-    if (z.f[layer] + uniform() * (z.f[layer - 1] - z.f[layer]) < std::exp(-0.5 * x * x)) return x;
-    const uint64_t r = bits();
+    if (z.f[layer] + stream.uniform() * (z.f[layer - 1] - z.f[layer]) < std::exp(-0.5 * x * x)) {
+      return {x, stream.s_};
+    }
+    const uint64_t r = stream.bits();
     layer = static_cast<int>(r & 127);
     hz = static_cast<int32_t>(r >> 32);
-    if (static_cast<uint64_t>(std::llabs(hz)) < z.k[layer])
-      return static_cast<double>(hz) * z.w[layer];
+    if (static_cast<uint64_t>(std::llabs(hz)) < z.k[layer]) {
+      return {static_cast<double>(hz) * z.w[layer], stream.s_};
+    }
   }
 }
 

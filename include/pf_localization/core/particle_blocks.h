@@ -60,16 +60,18 @@ void forEachBlock(std::size_t n, int threads, F&& f) {
 }
 
 /// Reduces the particles [0, n) block by block: each block's State starts
-/// from `init` and takes its particles in order (add(i, state)); the
-/// blocks' States are then merged in block order (merge(into, from)). One
-/// block's State is the result as it is, so a cloud of one block gives the
-/// bits of the plain sequential loop.
-template <typename State, typename Add, typename Merge>
-State reduceBlocks(std::size_t n, int threads, const State& init, Add&& add, Merge&& merge) {
+/// from `init` and takes its particles in order, in one or more calls
+/// add(begin, end, state) over consecutive ranges; the blocks' States are
+/// then merged in block order (merge(into, from)). One block's State is the
+/// result as it is, so a cloud of one block gives the bits of the plain
+/// sequential loop.
+template <typename State, typename AddRange, typename Merge>
+State reduceBlockRanges(std::size_t n, int threads, const State& init, AddRange&& add,
+                        Merge&& merge) {
   const std::size_t blocks = blockCount(n);
   if (blocks <= 1) {
     State state = init;
-    for (std::size_t i = 0; i < n; ++i) add(i, state);
+    add(std::size_t{0}, n, state);
     return state;
   }
   struct Partial {
@@ -80,12 +82,23 @@ State reduceBlocks(std::size_t n, int threads, const State& init, Add&& add, Mer
   Partial* out = partial.data();
   forEachBlock(n, threads, [&](std::size_t b, std::size_t begin, std::size_t end) {
     State state = init;
-    for (std::size_t i = begin; i < end; ++i) add(i, state);
+    add(begin, end, state);
     out[b].state = state;
   });
   State state = partial[0].state;
   for (std::size_t b = 1; b < blocks; ++b) merge(state, partial[b].state);
   return state;
+}
+
+/// reduceBlockRanges particle by particle: add(i, state) for each i in turn.
+template <typename State, typename Add, typename Merge>
+State reduceBlocks(std::size_t n, int threads, const State& init, Add&& add, Merge&& merge) {
+  return reduceBlockRanges(
+      n, threads, init,
+      [&](std::size_t begin, std::size_t end, State& state) {
+        for (std::size_t i = begin; i < end; ++i) add(i, state);
+      },
+      merge);
 }
 
 /// The sum of term(i) over [0, n), added block by block (reduceBlocks).
@@ -96,8 +109,9 @@ double sumBlocks(std::size_t n, int threads, Term&& term) {
       [](double& into, double from) { into += from; });
 }
 
-/// Calls f(begin, end) on one even slice of [0, n) per thread: particle by
-/// particle work, whose result does not depend on how it is split.
+/// Calls f(begin, end) on even slices of [0, n) that cover it, on up to
+/// `threads` threads: particle by particle work, whose result does not
+/// depend on how it is split. On one thread, one slice: f(0, n).
 template <typename F>
 void forEachSlice(std::size_t n, int threads, F&& f) {
   const std::size_t t = static_cast<std::size_t>(threadsFor(n, threads));
@@ -105,8 +119,13 @@ void forEachSlice(std::size_t n, int threads, F&& f) {
     f(std::size_t{0}, n);
     return;
   }
-  auto slice = [&](std::size_t k) { f(n * k / t, n * (k + 1) / t); };
-  WorkerPool::instance().run(static_cast<int>(t), t, slice);
+  // Slices of about kMinParticlesPerThread, many more than threads, taken
+  // in turn by whichever thread is free: a thread that the OS leaves
+  // waiting (the cores are shared) then holds the others up for one small
+  // slice, not for a 1/t share of the work.
+  const std::size_t slices = std::max(t, n / kMinParticlesPerThread);
+  auto slice = [&](std::size_t k) { f(n * k / slices, n * (k + 1) / slices); };
+  WorkerPool::instance().run(static_cast<int>(t), slices, slice);
 }
 
 /// The random streams of the blocks of a cloud: block 0 draws from the

@@ -57,14 +57,26 @@ class Random {
     const int64_t hz = static_cast<int32_t>(r >> 32);
     const uint64_t magnitude = static_cast<uint64_t>(hz < 0 ? -hz : hz);
     if (magnitude < zig_->k[layer]) return static_cast<double>(hz) * zig_->w[layer];
-    return normalTail(hz, layer);
+    const Tail tail = normalTail(hz, layer, *this);
+    s_ = tail.state;
+    return tail.value;
   }
   /// Zero-mean normal with standard deviation sigma (sigma <= 0 gives 0).
   double gaussian(double sigma) { return sigma > 0.0 ? sigma * normal() : 0.0; }
 
  private:
   static uint64_t rotl(uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
-  double normalTail(int64_t hz, int layer);
+  // The rare case of normal(), out of line. It takes a copy of the stream
+  // and returns the state it leaves, rather than taking `this`: a Random
+  // whose address never escapes can live in registers, as one copied into
+  // a local for a loop of draws does (a stream behind a pointer is stored
+  // and reloaded around each draw when the loop also stores through a
+  // char pointer).
+  struct Tail {
+    double value;
+    std::array<uint64_t, 4> state;
+  };
+  static Tail normalTail(int64_t hz, int layer, Random stream);
 
   std::array<uint64_t, 4> s_;
   const ZigguratTables* zig_;
