@@ -27,11 +27,8 @@ void ConfidenceTracker::holdAfterJump(const std::optional<Pose2>& predicted, con
   if (predicted) pf::holdAfterJump(*predicted, estimate, params, &settle_left_, &confidence_);
 }
 
-void ConfidenceTracker::holdWhileAmbiguous(const PoseEstimate& estimate,
-                                           double rival_weight_ratio) {
-  if (confidence_.state != LocalizationState::kLocalized) return;
-  const std::size_t places = hypothesesOf(estimate, rival_weight_ratio, 0).count;
-  if (places <= 1) return;
+void ConfidenceTracker::holdWhileAmbiguous(std::size_t places) {
+  if (confidence_.state != LocalizationState::kLocalized || places <= 1) return;
   confidence_.state = LocalizationState::kUncertain;
   confidence_.reason =
       std::to_string(places - 1) + " other place" + (places > 2 ? "s" : "") + " with at least " +

@@ -227,7 +227,6 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& scans) {
       pinsAlong(report.refinement.covariance, estimate_.pose.yaw, params_.motion.fault_margin));
   resample(&report);
   confidence_.demoteAfterLowFit(recovery_.lowFitUpdates(), params_.recovery.patience);
-  search_.observe(hypothesesOf(estimate_, params_.confidence.rival_weight_ratio, 0).count);
   report.updated = true;
   report.particles = particles_.size();
   return report;
@@ -246,7 +245,10 @@ void ParticleFilter::estimateAndJudge(const std::vector<PreparedScan>& scans,
   // Tempering and recovery follow the evidence of this scan (fitState());
   // only the published verdict waits for a jumped estimate to be confirmed.
   confidence_.holdAfterJump(predicted, estimate_.pose, params_.confidence);
-  confidence_.holdWhileAmbiguous(estimate_, params_.confidence.rival_weight_ratio);
+  const std::size_t places =
+      hypothesesOf(estimate_, params_.confidence.rival_weight_ratio, 0).count;
+  confidence_.holdWhileAmbiguous(places);
+  search_.observe(places);
 }
 
 void ParticleFilter::weigh(const std::vector<PreparedScan>& scans, UpdateReport* report) {

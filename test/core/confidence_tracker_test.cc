@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "pf_localization/core/hypotheses.h"
+
 namespace pf {
 namespace {
 
@@ -72,14 +74,16 @@ TEST_F(ConfidenceTrackerTest, ASecondPlaceWithAShareOfTheWeightHoldsThePublished
   // 0.15 of the weight, the lighter one the true place. 0.15 / 0.85 is no
   // rival (rival_weight_ratio 0.2), but pf_hypotheses lists both places.
   assessLocalized();
-  tracker_.holdWhileAmbiguous(placesWithWeights({0.85, 0.15}), params_.rival_weight_ratio);
+  tracker_.holdWhileAmbiguous(
+      hypothesesOf(placesWithWeights({0.85, 0.15}), params_.rival_weight_ratio).count);
   EXPECT_EQ(LocalizationState::kUncertain, tracker_.confidence().state);
   EXPECT_NE(std::string::npos, tracker_.confidence().reason.find("1 other place"))
       << tracker_.confidence().reason;
   EXPECT_EQ(LocalizationState::kLocalized, tracker_.fitState());
   // Below kMinHypothesisShare the second cluster is no place of its own.
   assessLocalized();
-  tracker_.holdWhileAmbiguous(placesWithWeights({0.96, 0.04}), params_.rival_weight_ratio);
+  tracker_.holdWhileAmbiguous(
+      hypothesesOf(placesWithWeights({0.96, 0.04}), params_.rival_weight_ratio).count);
   EXPECT_EQ(LocalizationState::kLocalized, tracker_.confidence().state);
 }
 

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <optional>
 
 #include "pf_localization/core/confidence.h"
@@ -31,10 +32,10 @@ class ConfidenceTracker {
   /// estimate moved by the odometry since; nothing without one.
   void holdAfterJump(const std::optional<Pose2>& predicted, const Pose2& estimate,
                      const ConfidenceParams& params);
-  /// "localized" becomes "uncertain" while `estimate` holds more than one
-  /// hypothesis (hypotheses.h, with `rival_weight_ratio`): the published
-  /// verdict never says "localized" beside a second place on pf_hypotheses.
-  void holdWhileAmbiguous(const PoseEstimate& estimate, double rival_weight_ratio);
+  /// "localized" becomes "uncertain" while the cloud holds more than one
+  /// place (`places`, hypothesesOf's count): the published verdict never
+  /// says "localized" beside a second place on pf_hypotheses.
+  void holdWhileAmbiguous(std::size_t places);
   /// Adds a scan fit's covariance to the published one (fusedCovariance),
   /// unless that is the whole cloud's for rival hypotheses, which a fit of
   /// the best one cannot narrow: then it widens it to cover the fit's too.

@@ -71,9 +71,8 @@ double supportOfBins(double bins, double particles, double bin_volume, double ma
 /// are noise (unmapped pallets, where each place's particles happen to lie),
 /// so the evidence must come from several scans. Half, resample_ess_fraction:
 /// no single scan makes the cloud resample. Until one place is left: within
-/// one place the floor would only keep the cloud wide. (At the uncertain cloud's 10 % the true
-/// aisle died out within seconds on 3 of 10 seeds, at 30 % on 1: docs/design.md, "A sparse cloud is
-/// weighed by a wider likelihood".)
+/// one place the floor would only keep the cloud wide. The evidence:
+/// docs/design.md, "A sparse cloud is weighed by a wider likelihood".
 inline constexpr double kSettlingEssFraction = kResampleEssFraction;
 
 class GlobalSearch {
