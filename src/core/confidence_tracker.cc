@@ -27,8 +27,15 @@ void ConfidenceTracker::holdAfterJump(const std::optional<Pose2>& predicted, con
   if (predicted) pf::holdAfterJump(*predicted, estimate, params, &settle_left_, &confidence_);
 }
 
-void ConfidenceTracker::holdWhileAmbiguous(std::size_t places) {
-  if (confidence_.state != LocalizationState::kLocalized || places <= 1) return;
+void ConfidenceTracker::holdWhileAmbiguous(std::size_t places, std::size_t look_alikes) {
+  if (confidence_.state != LocalizationState::kLocalized) return;
+  if (places <= 1 && look_alikes > 0) {
+    confidence_.state = LocalizationState::kUncertain;
+    confidence_.reason = "the scan fits " + std::to_string(look_alikes) + " look-alike place" +
+                         (look_alikes > 1 ? "s" : "") + " of the map as well";
+    return;
+  }
+  if (places <= 1) return;
   confidence_.state = LocalizationState::kUncertain;
   confidence_.reason =
       std::to_string(places - 1) + " other place" + (places > 2 ? "s" : "") + " with at least " +

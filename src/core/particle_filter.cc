@@ -99,6 +99,7 @@ void ParticleFilter::setParams(const ParticleFilterParams& params) {
 bool ParticleFilter::setMap(const OccupancyGrid& grid) {
   if (grid.empty()) throw std::invalid_argument("the map is empty");
   sensor_.setModel(makeSensorModel(grid, params_));
+  look_alikes_.setMap(sensor_.model().field());
   search_.forgetModel();
   refinement_.reset();  // fitted to the old map
   if (isInitialized() && grid.isFreeAt(estimate_.pose.x, estimate_.pose.y)) return true;
@@ -159,6 +160,7 @@ void ParticleFilter::restartAfterInitialization() {
   refinement_.reset();
   confidence_.restart(estimate_.covariance);
   recovery_.restart();
+  look_alikes_.restart();
   motion_.faults().restart(params_.motion);
 }
 
@@ -217,7 +219,7 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& scans) {
   }
   report.fault_fraction = motion_.faults().fraction();
   report.ess = effectiveSampleSize(particles_.weight, threads_);
-  estimateAndJudge(*gate.scans, predicted);
+  estimateAndJudge(*gate.scans, predicted, &report);
   report.refinement = refinement_.atUpdate(sensor_.model(), scans, odom, predicted,
                                            confidence_.confidence().state, params_, &estimate_);
   if (report.refinement.accepted) confidence_.addFit(report.refinement.covariance);
@@ -233,7 +235,7 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& scans) {
 }
 
 void ParticleFilter::estimateAndJudge(const std::vector<PreparedScan>& scans,
-                                      const std::optional<Pose2>& predicted) {
+                                      const std::optional<Pose2>& predicted, UpdateReport* report) {
   // The estimate comes from the weighted cloud, before resampling: resampling
   // only adds noise, and the random particles recovery injects must not count.
   estimate_ = estimatePose(particles_, params_.clusters, threads_);
@@ -247,8 +249,12 @@ void ParticleFilter::estimateAndJudge(const std::vector<PreparedScan>& scans,
   confidence_.holdAfterJump(predicted, estimate_.pose, params_.confidence);
   const std::size_t places =
       hypothesesOf(estimate_, params_.confidence.rival_weight_ratio, 0).count;
-  confidence_.holdWhileAmbiguous(places);
+  const LookAlikeView view = look_alikes_.judge(model, scans, estimate_.pose);
+  confidence_.holdWhileAmbiguous(places, view.as_good);
   search_.observe(places);
+  report->look_alikes = view.as_good;
+  report->look_alikes_better = view.better.size();
+  recovery_.observeLookAlikes(view.better);
 }
 
 void ParticleFilter::weigh(const std::vector<PreparedScan>& scans, UpdateReport* report) {
@@ -276,6 +282,7 @@ void ParticleFilter::resample(UpdateReport* report) {
       recovery_.resample(plan, report->ess, params_, grid, &random_, &particles_, threads_);
   report->resampled = out.resampled;
   report->injected = out.injected;
+  report->moved = out.moved;
   report->expanded = out.expanded;
 }
 

@@ -64,8 +64,32 @@ void ExpansionResetting::spread(const RecoveryParams& params, std::size_t n, Ran
   }
 }
 
+void LookAlikeMove::contribute(const RecoveryContext& context, const RecoveryParams& params,
+                               RecoveryPlan* plan) {
+  // Only while the scans fit worse than usual, as AugmentedMclInjection
+  // asks: a look-alike that wins one scan while the tracked place fits as
+  // it always did has won by an object that is not on the map.
+  if (context.fast < params.trigger_ratio * context.slow) plan->moves = context.better_look_alikes;
+}
+
+std::size_t LookAlikeMove::move(const std::vector<Pose2>& moves, std::size_t n,
+                                ParticleSet* particles) {
+  if (moves.empty()) return 0;
+  std::size_t moved = 0;
+  const auto period =
+      static_cast<std::size_t>(std::ceil(static_cast<double>(moves.size()) / kLookAlikeShare));
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t k = i % period;
+    if (k >= moves.size()) continue;
+    particles->setPose(i, compose(moves[k], particles->pose(i)));
+    ++moved;
+  }
+  return moved;
+}
+
 void Recovery::restart() {
   context_.slow = context_.fast = 0.0;
+  context_.better_look_alikes.clear();
   injection_.restart();
   lost_share_.restart();
   expansion_.restart();
@@ -94,7 +118,8 @@ RecoveryPlan Recovery::plan(LocalizationState state, std::size_t particles,
   RecoveryPlan plan;
   for (RecoveryStrategy* strategy :
        {static_cast<RecoveryStrategy*>(&injection_), static_cast<RecoveryStrategy*>(&lost_share_),
-        static_cast<RecoveryStrategy*>(&expansion_)}) {
+        static_cast<RecoveryStrategy*>(&expansion_),
+        static_cast<RecoveryStrategy*>(&look_alike_move_)}) {
     strategy->contribute(context_, params, &plan);
   }
   return plan;
@@ -106,7 +131,9 @@ ResampleOutcome Recovery::resample(const RecoveryPlan& plan, double ess,
   ResampleOutcome out;
   const std::size_t n = particles->size();
   const double p = plan.inject_probability;
-  if (ess >= params.resample_ess_fraction * n && p < 0.01 && !plan.spread) return out;
+  if (ess >= params.resample_ess_fraction * n && p < 0.01 && !plan.spread && plan.moves.empty()) {
+    return out;
+  }
 
   const std::size_t target = kldParticleCount(*particles, params.kld, threads);
   // Random particles are spread over the whole map, so they are counted
@@ -120,6 +147,7 @@ ResampleOutcome Recovery::resample(const RecoveryPlan& plan, double ess,
   systematicResample(*particles, kept, random, &spare_, threads);
   std::swap(*particles, spare_);
   if (plan.spread) ExpansionResetting::spread(params.recovery, kept, random, particles);
+  out.moved = LookAlikeMove::move(plan.moves, kept, particles);
   particles->resize(kept + injected);
   for (std::size_t i = kept; i < kept + injected; ++i) {
     particles->setPose(i, randomFreePose(grid, random));

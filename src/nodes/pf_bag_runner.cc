@@ -258,7 +258,8 @@ void openOutputs(const Options& opt, Outputs* o) {
     if (!o->log) fail(opt.log + ": cannot write");
     o->log << "t,particles,ess,cpu_ms,mean_beam_likelihood,std_x,std_y,std_yaw,updated,injected,"
               "tempering,hit_fraction,rivals,state,refined,refine_translation,refine_rotation,"
-              "refine_rms,refine_matched,fault_fraction,search_sigma,missing\n";
+              "refine_rms,refine_matched,fault_fraction,search_sigma,look_alikes,"
+              "look_alikes_better,missing\n";
   }
   if (!opt.particles_out.empty()) {
     o->dump.open(opt.particles_out);
@@ -486,6 +487,7 @@ void Replay::logUpdate(double t, const pf_ros::ScanResult& r, double cpu) {
                << r.report.refinement.translation << "," << r.report.refinement.rotation << ","
                << r.report.refinement.rms_distance << "," << r.report.refinement.matched_beams
                << "," << r.report.fault_fraction << "," << r.report.search_sigma << ","
+               << r.report.look_alikes << "," << r.report.look_alikes_better << ","
                << missingNames(t) << "\n";
 }
 

@@ -34,8 +34,9 @@ class ConfidenceTracker {
                      const ConfidenceParams& params);
   /// "localized" becomes "uncertain" while the cloud holds more than one
   /// place (`places`, hypothesesOf's count): the published verdict never
-  /// says "localized" beside a second place on pf_hypotheses.
-  void holdWhileAmbiguous(std::size_t places);
+  /// says "localized" beside a second place on pf_hypotheses. Nor while the
+  /// scan fits `look_alikes` other places of the map as well (look_alikes.h).
+  void holdWhileAmbiguous(std::size_t places, std::size_t look_alikes = 0);
   /// Adds a scan fit's covariance to the published one (fusedCovariance),
   /// unless that is the whole cloud's for rival hypotheses, which a fit of
   /// the best one cannot narrow: then it widens it to cover the fit's too.

@@ -35,6 +35,7 @@
 #include "pf_localization/core/hypotheses.h"
 #include "pf_localization/core/laser_scan.h"
 #include "pf_localization/core/likelihood_field_model.h"
+#include "pf_localization/core/look_alikes.h"
 #include "pf_localization/core/motion_update.h"
 #include "pf_localization/core/occupancy_grid.h"
 #include "pf_localization/core/particle_filter_params.h"
@@ -70,8 +71,13 @@ struct UpdateReport {
   double mean_beam_likelihood = 0.0;  // geometric mean over beams, weighted over particles
   std::size_t injected = 0;           // random particles added by recovery
   double tempering = 1.0;             // exponent applied to this scan's likelihood (1: none)
-  double search_sigma = 0.0;    // the hit std dev of GlobalSearch's smoothed model (0: the model's)
-  bool expanded = false;        // the survivors were spread by expansion resetting
+  double search_sigma = 0.0;  // the hit std dev of GlobalSearch's smoothed model (0: the model's)
+  bool expanded = false;      // the survivors were spread by expansion resetting
+  // Look-alike places (look_alikes.h) the scan fits as well as the estimate,
+  // and those it fits clearly better, where recovery moved `moved` particles.
+  std::size_t look_alikes = 0;
+  std::size_t look_alikes_better = 0;
+  std::size_t moved = 0;
   double fault_fraction = 0.0;  // share of particles to assume an odometry fault next step
   // The update came before update_min_d / update_min_a because the scan no
   // longer fitted at the pose the odometry predicted (update_fit_drop).
@@ -156,7 +162,7 @@ class ParticleFilter {
   // The estimate of the weighted cloud and the verdict on it; `predicted`:
   // the last estimate moved by the odometry since (none on a first update).
   void estimateAndJudge(const std::vector<PreparedScan>& scans,
-                        const std::optional<Pose2>& predicted);
+                        const std::optional<Pose2>& predicted, UpdateReport* report);
   void resample(UpdateReport* report);
   void restartAfterInitialization();
   void reserveStorage(std::size_t max_particles);
@@ -171,6 +177,7 @@ class ParticleFilter {
   PoseEstimate estimate_;
   UpdateGate gate_;  // holds the odometry of the last update
   ConfidenceTracker confidence_;
+  LookAlikes look_alikes_;  // the map's symmetries, and what each scan says of them
   EstimateRefinement refinement_;
   Recovery recovery_;
 };

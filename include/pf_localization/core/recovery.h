@@ -15,12 +15,18 @@
 //   fatal error in Monte Carlo localization" (IROS 2004): a single scan
 //   fitting below expansion_ratio times the long-term average spreads the
 //   survivors of the resampling.
+// - LookAlikeMove: where the scan fits a look-alike of the estimate clearly
+//   better (look_alikes.h), kLookAlikeShare of the survivors are carried
+//   there by the map's motion, keeping the cloud's shape: the twin a robot
+//   was kidnapped into, or the one a global search missed, is tried at once.
 // Injected particles weigh kidnap_prior together (a mixture proposal: Thrun,
 // Fox, Burgard & Dellaert, AIJ 128, 2001). See docs/design.md, "Recovery
 // waits while localized".
 #pragma once
 
 #include <cstddef>
+#include <utility>
+#include <vector>
 
 #include "pf_localization/core/confidence.h"
 #include "pf_localization/core/occupancy_grid.h"
@@ -39,13 +45,15 @@ struct RecoveryContext {
   LocalizationState state = LocalizationState::kLost;  // this scan's verdict
   std::size_t particles = 0;                           // in the cloud now
   std::size_t max_particles = 0;                       // the budget (kld.max_particles)
-  bool has_free_space = false;  // the map has free cells to draw random particles from
+  bool has_free_space = false;            // the map has free cells to draw random particles from
+  std::vector<Pose2> better_look_alikes;  // map motions to look-alikes the scan fits clearly better
 };
 
 /// What the resampling is to do.
 struct RecoveryPlan {
   double inject_probability = 0.0;  // share of max_particles drawn at random
   bool spread = false;              // spread the survivors (expansion resetting)
+  std::vector<Pose2> moves;         // map motions a share of the survivors take (LookAlikeMove)
 };
 
 class RecoveryStrategy {
@@ -87,11 +95,26 @@ class ExpansionResetting final : public RecoveryStrategy {
                      ParticleSet* particles);
 };
 
+class LookAlikeMove final : public RecoveryStrategy {
+ public:
+  /// The share of the survivors moved, split evenly among the look-alikes:
+  /// enough to be weighed by the next scan, while the rest keep the place
+  /// the filter tracked should the look-alike's lead be noise.
+  static constexpr double kLookAlikeShare = 0.5;
+  void contribute(const RecoveryContext& context, const RecoveryParams& params,
+                  RecoveryPlan* plan) override;
+  /// Moves every particle whose index i has i mod P < moves.size() by
+  /// moves[i mod P], of the first `n`, with P = ceil(moves / kLookAlikeShare).
+  /// Returns how many moved.
+  static std::size_t move(const std::vector<Pose2>& moves, std::size_t n, ParticleSet* particles);
+};
+
 /// What Recovery::resample did.
 struct ResampleOutcome {
   bool resampled = false;
   std::size_t injected = 0;  // random particles added
   bool expanded = false;     // the survivors were spread
+  std::size_t moved = 0;     // survivors carried to look-alikes
 };
 
 class Recovery {
@@ -107,6 +130,10 @@ class Recovery {
   /// `max_particles`.
   RecoveryPlan plan(LocalizationState state, std::size_t particles, std::size_t max_particles,
                     bool has_free_space, const RecoveryParams& params);
+  /// The look-alikes this scan fits clearly better, for the next plan().
+  void observeLookAlikes(std::vector<Pose2> better) {
+    context_.better_look_alikes = std::move(better);
+  }
   /// Consecutive updates with a fit below the trigger (AugmentedMclInjection).
   int lowFitUpdates() const { return injection_.lowFitUpdates(); }
 
@@ -129,6 +156,7 @@ class Recovery {
   AugmentedMclInjection injection_;
   LostShareInjection lost_share_;
   ExpansionResetting expansion_;
+  LookAlikeMove look_alike_move_;
   ParticleSet spare_;  // the resampler's output, swapped with the cloud
 };
 
