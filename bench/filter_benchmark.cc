@@ -16,6 +16,7 @@
 #include "pf_localization/core/cloud_scan.h"
 #include "pf_localization/core/confidence.h"
 #include "pf_localization/core/likelihood_field_model.h"
+#include "pf_localization/core/look_alikes.h"
 #include "pf_localization/core/odometry_motion_model.h"
 #include "pf_localization/core/particle_filter.h"
 #include "pf_localization/core/pose_estimator.h"
@@ -112,6 +113,23 @@ BENCHMARK(BM_FullUpdate)
     ->ArgsProduct({{1000, 10000, 100000, 1000000}, {60, 360}, {1, 2}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+
+// LookAlikes::judge, which every update runs on a map with symmetries:
+// the scan placed at the estimate and at each look-alike. The pillar hall is
+// a worst case, a lattice with a look-alike every 2 m (128 symmetries kept).
+void BM_LookAlikeJudge(benchmark::State& state) {
+  const pf::OccupancyGrid grid = pillarMap(static_cast<int>(state.range(0)));
+  pf::LikelihoodFieldModelParams params;
+  params.max_beams = 60;
+  const pf::LikelihoodFieldModel model(grid, params);
+  pf::LookAlikes look_alikes;
+  look_alikes.setMap(model.field());
+  const pf::Pose2 pose{9.0, 9.0, 0.3};
+  const std::vector<pf::PreparedScan> scans{model.prepare(fullScan(360))};
+  for (auto _ : state) benchmark::DoNotOptimize(look_alikes.judge(model, scans, pose));
+  state.counters["symmetries"] = static_cast<double>(look_alikes.symmetries().size());
+}
+BENCHMARK(BM_LookAlikeJudge)->Arg(400)->Arg(2000)->Unit(benchmark::kMicrosecond);
 
 // The whole update at the size issue 17 measures against amcl: 5000 fixed
 // particles, 60 beams, an update on every call. The scan is ray cast from

@@ -231,32 +231,21 @@ void LookAlikes::restart() { streaks_.assign(symmetries_.size(), 0); }
 
 namespace {
 
-// The one-cell search around each pose: the offsets, in cells.
-constexpr int kNearOffsets = 9;
-
-// The scans' log-likelihood at each of `poses` moved by at most one cell,
-// the best of the nine: one batch through the model's particle scoring.
-std::vector<double> bestFitsNear(const SensorModel& model, const std::vector<PreparedScan>& scans,
-                                 const std::vector<Pose2>& poses) {
-  const double step = model.field().grid().resolution();
+// The scans' log-likelihood at each of `poses`: one batch through the
+// model's particle scoring. No search around them: the symmetries are
+// refined to a cell, and half a cell (2.5 cm) moves 60 beams' tempered
+// log-likelihood by about 0.4 at sigma_hit 0.2 m, far below the margins.
+std::vector<double> fitsAt(const SensorModel& model, const std::vector<PreparedScan>& scans,
+                           const std::vector<Pose2>& poses) {
   ParticleSet placed;
-  placed.resize(poses.size() * kNearOffsets);
-  for (std::size_t i = 0; i < poses.size(); ++i) {
-    for (int k = 0; k < kNearOffsets; ++k) {
-      placed.setPose(i * kNearOffsets + k, {poses[i].x + (k % 3 - 1) * step,
-                                            poses[i].y + (k / 3 - 1) * step, poses[i].yaw});
-    }
-  }
-  std::vector<double> sum(placed.size(), 0.0), one;
+  placed.resize(poses.size());
+  for (std::size_t i = 0; i < poses.size(); ++i) placed.setPose(i, poses[i]);
+  std::vector<double> sum(poses.size(), 0.0), one;
   for (const PreparedScan& scan : scans) {
     model.logLikelihoods(scan, placed, &one);
     for (std::size_t j = 0; j < sum.size(); ++j) sum[j] += one[j];
   }
-  std::vector<double> best(poses.size(), -std::numeric_limits<double>::infinity());
-  for (std::size_t j = 0; j < sum.size(); ++j) {
-    best[j / kNearOffsets] = std::max(best[j / kNearOffsets], sum[j]);
-  }
-  return best;
+  return sum;
 }
 
 }  // namespace
@@ -274,7 +263,7 @@ LookAlikeView LookAlikes::judge(const SensorModel& model, const std::vector<Prep
     poses.push_back(twin);
     index.push_back(i);
   }
-  const std::vector<double> fits = bestFitsNear(model, scans, poses);
+  const std::vector<double> fits = fitsAt(model, scans, poses);
   view.fit = fits[0];
   view.best_fit = -std::numeric_limits<double>::infinity();
   for (std::size_t j = 1; j < fits.size(); ++j) view.best_fit = std::max(view.best_fit, fits[j]);

@@ -36,7 +36,7 @@ std::vector<MapSymmetry> findMapSymmetries(const LikelihoodField& field);
 
 /// What one scan says about the estimate's look-alikes.
 struct LookAlikeView {
-  double fit = 0.0;         // the scans' log-likelihood at the estimate (best of a one-cell search)
+  double fit = 0.0;         // the scans' log-likelihood at the estimate
   std::size_t as_good = 0;  // look-alikes fitting within kAsGoodMargin of it, or better
   // Motions whose look-alike fits kBetterMargin more than the estimate and
   // within kAsGoodMargin of the best look-alike.
@@ -73,8 +73,7 @@ class LookAlikes {
   const std::vector<MapSymmetry>& symmetries() const { return symmetries_; }
 
   /// Places `scans` at the estimate and at each of its look-alikes (those in
-  /// free space), each the best of a one-cell search, and compares the
-  /// model's log-likelihoods.
+  /// free space) and compares the model's log-likelihoods.
   LookAlikeView judge(const SensorModel& model, const std::vector<PreparedScan>& scans,
                       const Pose2& estimate);
 
