@@ -1,5 +1,10 @@
 #include "pf_localization/core/hypotheses.h"
 
+#include <algorithm>
+#include <cmath>
+
+#include "pf_localization/core/look_alikes.h"
+
 namespace pf {
 
 Hypotheses hypothesesOf(const PoseEstimate& estimate, double rival_weight_ratio,
@@ -20,6 +25,22 @@ Hypotheses hypothesesOf(const PoseEstimate& estimate, double rival_weight_ratio,
       out.listed.push_back({c.mean, share, c.covariance, c.count});
   }
   return out;
+}
+
+void addLookAlikes(const std::vector<Pose2>& places, Hypotheses* hypotheses) {
+  if (hypotheses->listed.empty()) return;
+  const Eigen::Matrix3d covariance = hypotheses->listed.front().covariance;
+  for (const Pose2& place : places) {
+    const bool held =
+        std::any_of(hypotheses->listed.begin(), hypotheses->listed.end(), [&](const Hypothesis& h) {
+          return std::hypot(h.pose.x - place.x, h.pose.y - place.y) < LookAlikes::kMinShift;
+        });
+    if (held) continue;
+    ++hypotheses->count;
+    if (hypotheses->listed.size() < kMaxListedHypotheses) {
+      hypotheses->listed.push_back({place, 0.0, covariance, 0});
+    }
+  }
 }
 
 }  // namespace pf

@@ -272,7 +272,10 @@ LookAlikeView LookAlikes::judge(const SensorModel& model, const std::vector<Prep
   std::vector<int> streaks(symmetries_.size(), 0);
   for (std::size_t j = 1; j < fits.size(); ++j) {
     const std::size_t i = index[j - 1];
-    if (fits[j] >= view.fit - kAsGoodMargin) ++view.as_good;
+    if (fits[j] >= view.fit - kAsGoodMargin) {
+      ++view.as_good;
+      view.places.push_back(poses[j]);
+    }
     if (fits[j] >= better) {
       streaks[i] = streaks_[i] + 1;
       if (streaks[i] >= kBetterUpdates) view.better.push_back(symmetries_[i].motion);

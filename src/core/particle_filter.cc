@@ -100,6 +100,7 @@ bool ParticleFilter::setMap(const OccupancyGrid& grid) {
   if (grid.empty()) throw std::invalid_argument("the map is empty");
   sensor_.setModel(makeSensorModel(grid, params_));
   look_alikes_.setMap(sensor_.model().field());
+  look_alike_places_.clear();
   search_.forgetModel();
   refinement_.reset();  // fitted to the old map
   if (isInitialized() && grid.isFreeAt(estimate_.pose.x, estimate_.pose.y)) return true;
@@ -161,6 +162,7 @@ void ParticleFilter::restartAfterInitialization() {
   confidence_.restart(estimate_.covariance);
   recovery_.restart();
   look_alikes_.restart();
+  look_alike_places_.clear();
   motion_.faults().restart(params_.motion);
 }
 
@@ -252,6 +254,7 @@ void ParticleFilter::estimateAndJudge(const std::vector<PreparedScan>& scans,
   const LookAlikeView view = look_alikes_.judge(model, scans, estimate_.pose);
   confidence_.holdWhileAmbiguous(places, view.as_good);
   search_.observe(places);
+  look_alike_places_ = view.places;
   report->look_alikes = view.as_good;
   report->look_alikes_better = view.better.size();
   recovery_.observeLookAlikes(view.better);
@@ -284,6 +287,12 @@ void ParticleFilter::resample(UpdateReport* report) {
   report->injected = out.injected;
   report->moved = out.moved;
   report->expanded = out.expanded;
+}
+
+Hypotheses ParticleFilter::hypotheses() const {
+  Hypotheses h = hypothesesOf(estimate_, params_.confidence.rival_weight_ratio);
+  addLookAlikes(look_alike_places_, &h);
+  return h;
 }
 
 std::optional<Pose2> ParticleFilter::mapToOdom() const {

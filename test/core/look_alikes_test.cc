@@ -8,6 +8,7 @@
 #include <cmath>
 #include <vector>
 
+#include "pf_localization/core/hypotheses.h"
 #include "pf_localization/core/likelihood_field_model.h"
 #include "pf_localization/core/particle_filter.h"
 #include "pf_localization/core/random.h"
@@ -114,6 +115,30 @@ TEST_F(LookAlikesInTwinRooms, AScanThatCannotTellTheRoomsApartFitsTheTwinAsWell)
   EXPECT_GE(view.as_good, 1u);
   EXPECT_TRUE(view.better.empty());
   EXPECT_NEAR(view.fit, view.best_fit, LookAlikes::kAsGoodMargin);
+  ASSERT_EQ(view.as_good, view.places.size());
+  const Pose2 twin = compose(kEastShift, west);
+  bool listed = false;
+  for (const Pose2& p : view.places)
+    listed = listed || std::hypot(p.x - twin.x, p.y - twin.y) < 0.06;
+  EXPECT_TRUE(listed);
+}
+
+TEST(AddLookAlikes, ListsThePlacesTheCloudDoesNotHoldWithNoWeight) {
+  Hypotheses h;
+  h.count = 1;
+  h.listed.push_back({{2.0, 1.5, 0.3}, 1.0, Eigen::Vector3d(0.01, 0.02, 0.001).asDiagonal(), 800});
+  // One look-alike the cloud holds already (within kMinShift), one it does not.
+  addLookAlikes({{2.5, 1.5, 0.3}, {6.0, 1.5, 0.3}}, &h);
+  EXPECT_EQ(2u, h.count);
+  ASSERT_EQ(2u, h.listed.size());
+  EXPECT_DOUBLE_EQ(6.0, h.listed[1].pose.x);
+  EXPECT_EQ(0.0, h.listed[1].weight);
+  EXPECT_EQ(0u, h.listed[1].particles);
+  EXPECT_TRUE(h.listed[1].covariance.isApprox(h.listed[0].covariance));
+  // Without a hypothesis of the cloud there is nothing to be like.
+  Hypotheses none;
+  addLookAlikes({{6.0, 1.5, 0.3}}, &none);
+  EXPECT_EQ(0u, none.count);
 }
 
 TEST_F(LookAlikesInTwinRooms, TheCabinetTellsThemApart) {
@@ -195,8 +220,12 @@ TEST(LookAlikes, AFilterCarriedIntoTheTwinRoomDoubtsAndThenFindsItselfThere) {
     return filter.update(odom, lidar.scanFrom(truth));
   };
   for (int k = 0; k < 5; ++k) drive(0.1);
-  // Tracked in the west room, where a twin fits as well: not "localized".
+  // Tracked in the west room, where a twin fits as well: not "localized",
+  // and the twin is listed among the hypotheses.
   EXPECT_NE(LocalizationState::kLocalized, filter.confidence().state);
+  const Hypotheses h = filter.hypotheses();
+  ASSERT_GE(h.listed.size(), 2u);
+  EXPECT_NEAR(truth.x + kEastShift.x, h.listed.back().pose.x, 0.1);
   EXPECT_LT(std::hypot(filter.estimate().pose.x - truth.x, filter.estimate().pose.y - truth.y),
             0.1);
   // Carried to the same place in the east room; the odometry does not see it.

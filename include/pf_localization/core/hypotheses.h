@@ -45,8 +45,8 @@ constexpr double kMinHypothesisShare = 0.05;
 constexpr std::size_t kMaxListedHypotheses = 32;
 
 struct Hypothesis {
-  Pose2 pose;                                            // the cluster's weighted mean
-  double weight = 0.0;                                   // its share of the cloud's weight, (0, 1]
+  Pose2 pose;           // the cluster's weighted mean
+  double weight = 0.0;  // its share of the cloud's weight, (0, 1]; 0 for a look-alike place
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  // x, y, yaw: the cluster's
   std::size_t particles = 0;                             // in the cluster
 };
@@ -67,5 +67,12 @@ inline bool isRival(const Cluster& cluster, const Cluster& heaviest, double riva
 /// weight) give none.
 Hypotheses hypothesesOf(const PoseEstimate& estimate, double rival_weight_ratio,
                         std::size_t max_listed = kMaxListedHypotheses);
+
+/// Lists after the cloud's hypotheses the look-alike `places` the scan fits
+/// as well as the estimate (look_alikes.h) that the cloud does not hold (no
+/// hypothesis within LookAlikes::kMinShift): weight 0, no particles, the
+/// heaviest hypothesis's covariance (a shift or half turn leaves an x-y
+/// covariance as it is). Counted, and listed up to kMaxListedHypotheses.
+void addLookAlikes(const std::vector<Pose2>& places, Hypotheses* hypotheses);
 
 }  // namespace pf

@@ -36,8 +36,9 @@ std::vector<MapSymmetry> findMapSymmetries(const LikelihoodField& field);
 
 /// What one scan says about the estimate's look-alikes.
 struct LookAlikeView {
-  double fit = 0.0;         // the scans' log-likelihood at the estimate
-  std::size_t as_good = 0;  // look-alikes fitting within kAsGoodMargin of it, or better
+  double fit = 0.0;           // the scans' log-likelihood at the estimate
+  std::size_t as_good = 0;    // look-alikes fitting within kAsGoodMargin of it, or better
+  std::vector<Pose2> places;  // those look-alikes' poses
   // Motions whose look-alike fits kBetterMargin more than the estimate and
   // within kAsGoodMargin of the best look-alike.
   std::vector<Pose2> better;

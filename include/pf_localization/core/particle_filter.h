@@ -146,10 +146,9 @@ class ParticleFilter {
   const Confidence& confidence() const { return confidence_.confidence(); }
   /// The places the estimate's clusters hold with real weight: the
   /// heaviest, every rival confidence() counts, and any cluster with
-  /// kMinHypothesisShare of the weight (hypotheses.h).
-  Hypotheses hypotheses() const {
-    return hypothesesOf(estimate_, params_.confidence.rival_weight_ratio);
-  }
+  /// kMinHypothesisShare of the weight (hypotheses.h); then the look-alike
+  /// places the last scan fitted as well that the cloud does not hold.
+  Hypotheses hypotheses() const;
 
   /// map -> odom: the estimate composed with the inverse of the odometry pose
   /// it was computed at, or the latest accepted scan fit since that update
@@ -177,7 +176,8 @@ class ParticleFilter {
   PoseEstimate estimate_;
   UpdateGate gate_;  // holds the odometry of the last update
   ConfidenceTracker confidence_;
-  LookAlikes look_alikes_;  // the map's symmetries, and what each scan says of them
+  LookAlikes look_alikes_;                // the map's symmetries, and what each scan says of them
+  std::vector<Pose2> look_alike_places_;  // the last scan's, fitting as well as the estimate
   EstimateRefinement refinement_;
   Recovery recovery_;
 };
