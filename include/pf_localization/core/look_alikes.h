@@ -48,8 +48,8 @@ struct LookAlikeView {
 class LookAlikes {
  public:
   /// A half turn or shift must put at least this share of the obstacle cells
-  /// on obstacles: twin racks and halls do (0.7-0.9 in maps/warehouse), while
-  /// the offices of fr079 and the Intel lab reach at most 0.25 (design.md).
+  /// on obstacles: twin racks and symmetric halls do, office buildings do
+  /// not (design.md, "Look-alike places", gives the figures).
   static constexpr double kMinSymmetryOverlap = 0.4;
   /// Look-alikes closer than this to the estimate are the same place.
   static constexpr double kMinShift = 1.0;  // m
