@@ -12,7 +12,8 @@
 // MotionUpdate (the odometry, with OdometryFaultTracker's share of faults),
 // SensorUpdate (the weights, tempered by temperingEssFraction, with
 // GlobalSearch's smoothed likelihood while a global cloud is sparse), the estimate
-// and ConfidenceTracker (the verdict), EstimateRefinement (the scan fit, and
+// and ConfidenceTracker (the verdict, with LookAlikes: the map's look-alike
+// places the scan fits as well), EstimateRefinement (the scan fit, and
 // map -> odom), and Recovery (the resampling, with its strategies). The
 // design decisions behind them, with their evidence: docs/design.md.
 //
