@@ -128,13 +128,11 @@ Candidate refine(const LikelihoodField& field, const std::vector<Eigen::Vector2d
   return bestOffset(field, samples, rough.motion, step, 1);
 }
 
-}  // namespace
-
-std::vector<MapSymmetry> findMapSymmetries(const LikelihoodField& field) {
-  const OccupancyGrid& grid = field.grid();
+// Grid-frame centres of the map's obstacle cells.
+std::vector<Eigen::Vector2d> obstacleCentres(const OccupancyGrid& grid) {
   const int w = grid.width(), h = grid.height();
   const double res = grid.resolution();
-  std::vector<Eigen::Vector2d> obstacles;  // grid-frame centres of obstacle cells
+  std::vector<Eigen::Vector2d> obstacles;
   const std::vector<int8_t>& cells = grid.data();
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
@@ -144,12 +142,14 @@ std::vector<MapSymmetry> findMapSymmetries(const LikelihoodField& field) {
       }
     }
   }
-  if (obstacles.empty()) return {};
+  return obstacles;
+}
 
-  int f = std::max(1, static_cast<int>(std::ceil(kCoarseCell / res - 1e-9)));
-  while ((w + f - 1) / f > kMaxCoarseSide || (h + f - 1) / f > kMaxCoarseSide) ++f;
-  const int cw = (w + f - 1) / f, ch = (h + f - 1) / f;
-  const double cell = f * res;
+// The peaks of the coarse grid's autocorrelation (shifts) and
+// self-convolution (half turns) holding kMinSymmetryOverlap of its obstacle
+// cells, strongest first, at most kMaxSymmetries; `cell` m a side.
+std::vector<Candidate> coarsePeaks(const std::vector<Eigen::Vector2d>& obstacles, int cw, int ch,
+                                   double cell) {
   const int p = fftSize(2 * std::max(cw, ch));
   std::vector<Complex> spectrum(static_cast<std::size_t>(p) * p);
   for (const Eigen::Vector2d& u : obstacles) {
@@ -195,6 +195,22 @@ std::vector<MapSymmetry> findMapSymmetries(const LikelihoodField& field) {
   if (candidates.size() > LookAlikes::kMaxSymmetries) {
     candidates.resize(LookAlikes::kMaxSymmetries);
   }
+  return candidates;
+}
+
+}  // namespace
+
+std::vector<MapSymmetry> findMapSymmetries(const LikelihoodField& field) {
+  const OccupancyGrid& grid = field.grid();
+  const int w = grid.width(), h = grid.height();
+  const double res = grid.resolution();
+  const std::vector<Eigen::Vector2d> obstacles = obstacleCentres(grid);
+  if (obstacles.empty()) return {};
+
+  int f = std::max(1, static_cast<int>(std::ceil(kCoarseCell / res - 1e-9)));
+  while ((w + f - 1) / f > kMaxCoarseSide || (h + f - 1) / f > kMaxCoarseSide) ++f;
+  const std::vector<Candidate> candidates =
+      coarsePeaks(obstacles, (w + f - 1) / f, (h + f - 1) / f, f * res);
 
   std::vector<Eigen::Vector2d> samples;
   const std::size_t stride = std::max<std::size_t>(1, obstacles.size() / kRefineSamples);
