@@ -8,6 +8,8 @@
 #include <unsupported/Eigen/FFT>
 #include <utility>
 
+#include "pf_localization/core/sensor_update.h"
+
 namespace pf {
 namespace {
 
@@ -249,21 +251,18 @@ void LookAlikes::restart() { streaks_.assign(symmetries_.size(), 0); }
 
 namespace {
 
-// The scans' log-likelihood at each of `poses`: one batch through the
-// model's particle scoring. No search around them: the symmetries are
-// refined to a cell, and half a cell (2.5 cm) moves 60 beams' tempered
-// log-likelihood by about 0.4 at sigma_hit 0.2 m, far below the margins.
+// The scans' log-likelihood at each of `poses`, as the filter weighs a
+// particle there (groupLogLikelihoods). No search around them: the
+// symmetries are refined to a cell, and half a cell (2.5 cm) moves 60 beams'
+// tempered log-likelihood by about 0.4 at sigma_hit 0.2 m, far below the margins.
 std::vector<double> fitsAt(const SensorModel& model, const std::vector<PreparedScan>& scans,
                            const std::vector<Pose2>& poses) {
   ParticleSet placed;
   placed.resize(poses.size());
   for (std::size_t i = 0; i < poses.size(); ++i) placed.setPose(i, poses[i]);
-  std::vector<double> sum(poses.size(), 0.0), one;
-  for (const PreparedScan& scan : scans) {
-    model.logLikelihoods(scan, placed, &one);
-    for (std::size_t j = 0; j < sum.size(); ++j) sum[j] += one[j];
-  }
-  return sum;
+  std::vector<double> fits, scratch;
+  groupLogLikelihoods(model, scans, placed, &fits, &scratch);
+  return fits;
 }
 
 }  // namespace

@@ -4,12 +4,29 @@
 
 #include "pf_localization/core/particle_blocks.h"
 #include "pf_localization/core/prefault.h"
+#include "pf_localization/core/scan_group.h"
 
 namespace pf {
 
 Weighing SensorUpdate::weigh(const PreparedScan& scan, double min_ess_fraction,
                              double likelihood_exponent, ParticleSet* particles, int threads) {
   return weigh(*model_, scan, min_ess_fraction, likelihood_exponent, particles, threads);
+}
+
+std::size_t groupLogLikelihoods(const SensorModel& model, const std::vector<PreparedScan>& scans,
+                                const ParticleSet& particles, std::vector<double>* log_likelihood,
+                                std::vector<double>* scratch, int threads) {
+  if (scans.size() == 1) return model.logLikelihoods(scans.front(), particles, log_likelihood);
+  log_likelihood->assign(particles.size(), 0.0);
+  std::size_t beams_counted = 0;
+  for (const PreparedScan& scan : scans) {
+    if (scan.size() == 0) continue;
+    beams_counted += model.logLikelihoods(scan, particles, scratch);
+    forEachSlice(log_likelihood->size(), threads, [&](std::size_t begin, std::size_t end) {
+      for (std::size_t i = begin; i < end; ++i) (*log_likelihood)[i] += scan.weight * (*scratch)[i];
+    });
+  }
+  return beams_counted;
 }
 
 Weighing SensorUpdate::weigh(const std::vector<PreparedScan>& scans, double min_ess_fraction,
@@ -28,22 +45,10 @@ Weighing SensorUpdate::weigh(const SensorModel& model, const PreparedScan& scan,
 Weighing SensorUpdate::weigh(const SensorModel& model, const std::vector<PreparedScan>& scans,
                              double min_ess_fraction, double likelihood_exponent,
                              ParticleSet* particles, int threads) {
-  if (scans.size() == 1) {
-    return weigh(model, scans.front(), min_ess_fraction, likelihood_exponent, particles, threads);
-  }
-  log_likelihood_.assign(particles->size(), 0.0);
-  std::size_t beams = 0, beams_counted = 0;
-  for (const PreparedScan& scan : scans) {
-    beams += scan.size();
-    if (scan.size() == 0) continue;
-    beams_counted += model.logLikelihoods(scan, *particles, &sensor_log_likelihood_);
-    forEachSlice(log_likelihood_.size(), threads, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t i = begin; i < end; ++i) {
-        log_likelihood_[i] += scan.weight * sensor_log_likelihood_[i];
-      }
-    });
-  }
-  return finish(beams, beams_counted, min_ess_fraction, likelihood_exponent, particles, threads);
+  const std::size_t beams_counted = groupLogLikelihoods(model, scans, *particles, &log_likelihood_,
+                                                        &sensor_log_likelihood_, threads);
+  return finish(beamCount(scans), beams_counted, min_ess_fraction, likelihood_exponent, particles,
+                threads);
 }
 
 Weighing SensorUpdate::finish(std::size_t beams, std::size_t beams_counted, double min_ess_fraction,

@@ -24,6 +24,15 @@ struct Weighing {
   double mean_beam_likelihood = 0.0;
 };
 
+/// The log-likelihood of a group of scans for every particle of
+/// `particles`, into `log_likelihood`: one scan's as the model gives it,
+/// several scans' summed, each times its LaserScan::weight (empty ones
+/// skipped), with `scratch` for one scan's. On up to `threads` threads.
+/// Returns how many beams the model counted (beam skipping may leave some out).
+std::size_t groupLogLikelihoods(const SensorModel& model, const std::vector<PreparedScan>& scans,
+                                const ParticleSet& particles, std::vector<double>* log_likelihood,
+                                std::vector<double>* scratch, int threads = 1);
+
 class SensorUpdate {
  public:
   void setModel(std::unique_ptr<SensorModel> model) { model_ = std::move(model); }
