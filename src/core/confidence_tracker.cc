@@ -29,17 +29,17 @@ void ConfidenceTracker::holdAfterJump(const std::optional<Pose2>& predicted, con
 
 void ConfidenceTracker::holdWhileAmbiguous(std::size_t places, std::size_t look_alikes) {
   if (confidence_.state != LocalizationState::kLocalized) return;
-  if (places <= 1 && look_alikes > 0) {
-    confidence_.state = LocalizationState::kUncertain;
+  if (places > 1) {
+    confidence_.reason =
+        std::to_string(places - 1) + " other place" + (places > 2 ? "s" : "") + " with at least " +
+        std::to_string(static_cast<int>(100 * kMinHypothesisShare)) + " % of the weight";
+  } else if (look_alikes > 0) {
     confidence_.reason = "the scan fits " + std::to_string(look_alikes) + " look-alike place" +
                          (look_alikes > 1 ? "s" : "") + " of the map as well";
+  } else {
     return;
   }
-  if (places <= 1) return;
   confidence_.state = LocalizationState::kUncertain;
-  confidence_.reason =
-      std::to_string(places - 1) + " other place" + (places > 2 ? "s" : "") + " with at least " +
-      std::to_string(static_cast<int>(100 * kMinHypothesisShare)) + " % of the weight";
 }
 
 void ConfidenceTracker::addFit(const Eigen::Matrix3d& fit_covariance) {

@@ -119,13 +119,11 @@ Candidate bestOffset(const LikelihoodField& field, const std::vector<Eigen::Vect
 }
 
 // `candidate` moved by whole cells within +-reach, to the best overlap: a
-// search on every step-th cell with a quarter of the samples, then every
-// cell around its best with them all.
+// search on every step-th cell with `some` of the samples (a quarter), then
+// every cell around its best with them all.
 Candidate refine(const LikelihoodField& field, const std::vector<Eigen::Vector2d>& samples,
-                 const Pose2& candidate, int reach) {
+                 const std::vector<Eigen::Vector2d>& some, const Pose2& candidate, int reach) {
   const int step = std::max(1, reach / 4);
-  std::vector<Eigen::Vector2d> some;
-  for (std::size_t i = 0; i < samples.size(); i += 4) some.push_back(samples[i]);
   const Candidate rough = bestOffset(field, some, candidate, reach - reach % step, step);
   return bestOffset(field, samples, rough.motion, step, 1);
 }
@@ -217,9 +215,11 @@ std::vector<MapSymmetry> findMapSymmetries(const LikelihoodField& field) {
   std::vector<Eigen::Vector2d> samples;
   const std::size_t stride = std::max<std::size_t>(1, obstacles.size() / kRefineSamples);
   for (std::size_t i = 0; i < obstacles.size(); i += stride) samples.push_back(obstacles[i]);
+  std::vector<Eigen::Vector2d> some;
+  for (std::size_t i = 0; i < samples.size(); i += 4) some.push_back(samples[i]);
   std::vector<Candidate> refined;
   for (const Candidate& c : candidates) {
-    const Candidate r = refine(field, samples, c.motion, f);
+    const Candidate r = refine(field, samples, some, c.motion, f);
     const bool is_shift = r.motion.yaw == 0.0;
     if (r.score < LookAlikes::kMinSymmetryOverlap) continue;
     if (is_shift && std::hypot(r.motion.x, r.motion.y) < LookAlikes::kMinShift) continue;
