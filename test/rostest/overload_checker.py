@@ -27,7 +27,9 @@ or the XML result's <system-out>) whether the test passes or not.
 Params (all optional; unset: only reported):
   max_tf_gap [s], tf_gap_p99 [s] (99 % of the gaps at most this),
   max_latency_p95_ms, latency_p95_over_update_ms (latency p95
-  must stay below update_time p95 + this), max_update_time_p95_ms,
+  must stay below update_time p95 + this), max_update_time_p50_ms,
+  max_update_time_p95_ms, max_particle_cap (particle_cap must be reported
+  and at most this),
   min_dropped_scans, max_scan_age_p95_ms, max_rss_growth_mb, rss_after [s],
   rmse_below [m], start_after [s, default 5], min_samples (default 50),
   idle_timeout [s wall, default 8], wall_timeout [s wall, default 150],
@@ -239,7 +241,9 @@ class OverloadChecker:
                 if b is not None and not ok(value(key), float(b)):
                     failures.append('%s = %s breaks %s = %s' % (key, s.get(key), name, b))
             check('max_latency_p95_ms', 'latency_p95_ms', lambda v, b: v <= b)
+            check('max_update_time_p50_ms', 'update_time_p50_ms', lambda v, b: v <= b)
             check('max_update_time_p95_ms', 'update_time_p95_ms', lambda v, b: v <= b)
+            check('max_particle_cap', 'particle_cap', lambda v, b: v <= b)
             check('max_scan_age_p95_ms', 'scan_age_p95_ms', lambda v, b: v <= b)
             check('min_dropped_scans', 'dropped_scans', lambda v, b: v >= b)
             over = opt('latency_p95_over_update_ms')
