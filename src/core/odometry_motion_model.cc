@@ -15,6 +15,10 @@ namespace {
 // Below this translation (m) the direction of travel is noise, not motion.
 constexpr double kMinTranslationForHeading = 0.01;
 
+// Particles moved per pass of applyDifferential: its four intermediate
+// arrays (32 KiB) stay within a core's L1/L2 cache.
+constexpr std::size_t kMotionChunk = 1024;
+
 // A rotation of nearly pi before a straight move is a robot reversing, not
 // turning around: its noise must be that of the small angle it really turned.
 double rotationMagnitude(double rot) {
@@ -49,17 +53,17 @@ struct DifferentialDraws {
   double fault_fraction, fault_margin;
 };
 
-// The random part of a differential step for particles [begin, end), one
+// The random part of a differential step for `count` particles, one
 // particle after the other from `stream`: each heading turned by its first
 // rotation (the heading of travel), its translation, its second rotation,
 // and whether it took a fault. Everything the loop reads is a local or a
 // value here, the stream too (copied in and back): a store through the
 // char pointer `faulty` might otherwise change it, and the stream's state
 // and every other operand were reloaded for each particle.
-void drawDifferential(const DifferentialDraws d, Random* stream, std::size_t begin, std::size_t end,
-                      double* yaw, double* trans, double* turn2, uint8_t* faulty) {
+void drawDifferential(const DifferentialDraws d, Random* stream, std::size_t count, double* yaw,
+                      double* trans, double* turn2, uint8_t* faulty) {
   Random random = *stream;
-  for (std::size_t i = begin; i < end; ++i) {
+  for (std::size_t i = 0; i < count; ++i) {
     const double r1 = d.step.rot1 - random.gaussian(d.sigma_rot1);
     trans[i] = sampleTranslation(d.step.trans, d.sigma_trans, d.fault_fraction, d.fault_margin,
                                  &random, &faulty[i]);
@@ -165,34 +169,26 @@ void OdometryMotionModel::applyDifferential(const Pose2& from, const Pose2& to,
       fault_fraction,
       params_.fault_margin};
 
-  // Two passes per block: the random draws, one particle after the other
-  // (the random stream is the same as drawing and moving each particle in
-  // turn), then the headings' sines and cosines for the whole block at once
-  // (sinCos vectorises; one C library call per particle was most of this
-  // step).
+  // Two passes per chunk of a block: the random draws, one particle after
+  // the other (the random stream is the same as drawing and moving each
+  // particle in turn), then the headings' sines and cosines for the chunk at
+  // once (sinCos vectorises; one C library call per particle was most of this
+  // step). A chunk's intermediate values stay in the core's cache: at a
+  // million particles, whole-block arrays made two threads wait on memory.
   ParticleSet& p = *particles;
-  const std::size_t n = p.size();
-  struct TransScratch {
-    std::vector<double> trans, turn2, s, c;
-  };  // kept: no allocation per update
-  TransScratch& trans_scratch = threadScratch<TransScratch>();
-  std::vector<double>& trans = trans_scratch.trans;
-  std::vector<double>& turn2 = trans_scratch.turn2;
-  std::vector<double>& s = trans_scratch.s;
-  std::vector<double>& c = trans_scratch.c;
-  trans.resize(n);
-  turn2.resize(n);
-  s.resize(n);
-  c.resize(n);
-  forEachBlock(n, threads, [&](std::size_t b, std::size_t begin, std::size_t end) {
-    // p.yaw becomes the heading of travel until the last pass.
-    drawDifferential(draws, streams->stream(b), begin, end, p.yaw.data(), trans.data(),
-                     turn2.data(), faulty);
-    sinCos(p.yaw.data() + begin, end - begin, s.data() + begin, c.data() + begin);
-    for (std::size_t i = begin; i < end; ++i) {
-      p.x[i] += trans[i] * c[i];
-      p.y[i] += trans[i] * s[i];
-      p.yaw[i] = normalizeAngle(p.yaw[i] + turn2[i]);
+  forEachBlock(p.size(), threads, [&](std::size_t b, std::size_t begin, std::size_t end) {
+    Random* stream = streams->stream(b);
+    for (std::size_t from = begin; from < end; from += kMotionChunk) {
+      const std::size_t to = std::min(end, from + kMotionChunk);
+      alignas(64) double trans[kMotionChunk], turn2[kMotionChunk], s[kMotionChunk], c[kMotionChunk];
+      // p.yaw becomes the heading of travel until the last pass.
+      drawDifferential(draws, stream, to - from, p.yaw.data() + from, trans, turn2, faulty + from);
+      sinCos(p.yaw.data() + from, to - from, s, c);
+      for (std::size_t i = from; i < to; ++i) {
+        p.x[i] += trans[i - from] * c[i - from];
+        p.y[i] += trans[i - from] * s[i - from];
+        p.yaw[i] = normalizeAngle(p.yaw[i] + turn2[i - from]);
+      }
     }
   });
 }
