@@ -24,13 +24,30 @@
 namespace pf {
 namespace {
 
-TEST(ParticleBlocks, BlocksCoverTheCloudInFixedSizes) {
+TEST(ParticleBlocks, BlocksCoverTheCloudInEqualShares) {
   EXPECT_EQ(0u, blockCount(0));
   EXPECT_EQ(1u, blockCount(1));
   EXPECT_EQ(1u, blockCount(kParticleBlock));
+  EXPECT_EQ(0u, blockBegin(0, kParticleBlock));
+  EXPECT_EQ(kParticleBlock, blockEnd(0, kParticleBlock));
   EXPECT_EQ(2u, blockCount(kParticleBlock + 1));
-  EXPECT_EQ(kParticleBlock, blockBegin(1));
-  EXPECT_EQ(kParticleBlock + 1, blockEnd(1, kParticleBlock + 1));
+  // 100 000 particles: two blocks of 50 000, not 65 536 and 34 464.
+  EXPECT_EQ(50000u, blockEnd(0, 100000));
+  EXPECT_EQ(50000u, blockBegin(1, 100000));
+  EXPECT_EQ(100000u, blockEnd(1, 100000));
+  // A million: 16 blocks, each within a particle of the others, none over
+  // the limit, each starting where the one before ended.
+  const std::size_t n = 1000000;
+  ASSERT_EQ(16u, blockCount(n));
+  for (std::size_t b = 0; b < blockCount(n); ++b) {
+    const std::size_t size = blockEnd(b, n) - blockBegin(b, n);
+    EXPECT_TRUE(size == n / 16 || size == n / 16 + 1) << b;
+    EXPECT_LE(size, kParticleBlock);
+    if (b > 0) {
+      EXPECT_EQ(blockEnd(b - 1, n), blockBegin(b, n));
+    }
+  }
+  EXPECT_EQ(n, blockEnd(15, n));
   // The default budget is one block: its clouds are processed as before.
   EXPECT_EQ(1u, blockCount(static_cast<std::size_t>(KldParams().max_particles)));
 }
@@ -54,7 +71,7 @@ TEST(ParticleBlocks, AReductionAddsTheBlocksInOrderForAnyThreadCount) {
   double expected = 0.0;
   for (std::size_t b = 0; b < blockCount(n); ++b) {
     double part = 0.0;
-    for (std::size_t i = blockBegin(b); i < blockEnd(b, n); ++i) part += v[i];
+    for (std::size_t i = blockBegin(b, n); i < blockEnd(b, n); ++i) part += v[i];
     expected = b == 0 ? part : expected + part;
   }
   for (int threads : {1, 2, 3, 8}) EXPECT_EQ(expected, sum(threads)) << threads << " threads";

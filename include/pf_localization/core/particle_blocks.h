@@ -4,7 +4,8 @@
 // Work that depends on order (a random stream, a floating-point sum) is done
 // block by block: each block has its own stream and its own partial sums,
 // and the partial sums are added in block order. The blocks' boundaries
-// depend only on the particle count, so the threads that run them (any
+// depend only on the particle count (as many blocks of equal size as it
+// takes to hold at most 2^16 particles each), so the threads that run them (any
 // number, in any order) give the same bits. A cloud of one block, which
 // every cloud of the filter's default budget is (max_particles 50 000), is
 // processed exactly as the sequential code always did: one stream, one sum.
@@ -23,8 +24,8 @@
 
 namespace pf {
 
-/// Particles per block: 2^16, above the default max_particles (50 000), so
-/// that a cloud of the default budget is a single block.
+/// The most particles in a block: 2^16, above the default max_particles
+/// (50 000), so that a cloud of the default budget is a single block.
 inline constexpr std::size_t kParticleBlock = std::size_t{1} << 16;
 
 /// Below this many particles per thread, splitting particle-by-particle work
@@ -37,11 +38,11 @@ inline constexpr std::size_t kMinParticlesPerThread = 16384;
 /// The number of blocks of `n` particles (0 for none).
 inline std::size_t blockCount(std::size_t n) { return (n + kParticleBlock - 1) / kParticleBlock; }
 
-/// The particles [begin, end) of block `b` of `n`.
-inline std::size_t blockBegin(std::size_t b) { return b * kParticleBlock; }
-inline std::size_t blockEnd(std::size_t b, std::size_t n) {
-  return std::min(n, (b + 1) * kParticleBlock);
-}
+/// The particles [blockBegin(b, n), blockEnd(b, n)) of block `b` of `n`:
+/// the blocks are as equal as whole particles allow, so that the threads
+/// get even shares (fixed 2^16-particle blocks split 100 000 as 2:1).
+inline std::size_t blockBegin(std::size_t b, std::size_t n) { return n * b / blockCount(n); }
+inline std::size_t blockEnd(std::size_t b, std::size_t n) { return blockBegin(b + 1, n); }
 
 /// How many threads to use for `n` particles of particle-by-particle work,
 /// given `threads` (at least 1).
@@ -55,7 +56,7 @@ inline int threadsFor(std::size_t n, int threads) {
 /// `threads` threads (worker_pool.h), in no particular order.
 template <typename F>
 void forEachBlock(std::size_t n, int threads, F&& f) {
-  auto block = [&](std::size_t b) { f(b, blockBegin(b), blockEnd(b, n)); };
+  auto block = [&](std::size_t b) { f(b, blockBegin(b, n), blockEnd(b, n)); };
   WorkerPool::instance().run(threads, blockCount(n), block);
 }
 
