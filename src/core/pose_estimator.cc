@@ -148,16 +148,27 @@ Cluster summarizeIndexed(const ParticleSet& particles, std::size_t count, Index 
   struct Sums {
     double w = 0.0, sx = 0.0, sy = 0.0, ss = 0.0, sc = 0.0;
   };
-  const Sums sums = reduceBlocks(
+  // The headings' sines and cosines a chunk at a time (sinCos vectorises; a
+  // C library call per particle was a tenth of a million-particle update).
+  const Sums sums = reduceBlockRanges(
       count, threads, Sums(),
-      [&](std::size_t k, Sums& a) {
-        const std::size_t i = index(k);
-        const double w = particles.weight[i];
-        a.w += w;
-        a.sx += w * particles.x[i];
-        a.sy += w * particles.y[i];
-        a.ss += w * std::sin(particles.yaw[i]);
-        a.sc += w * std::cos(particles.yaw[i]);
+      [&](std::size_t begin, std::size_t end, Sums& a) {
+        constexpr std::size_t kChunk = 1024;
+        alignas(64) double yaw[kChunk], sin_yaw[kChunk], cos_yaw[kChunk];
+        for (std::size_t from = begin; from < end; from += kChunk) {
+          const std::size_t m = std::min(kChunk, end - from);
+          for (std::size_t j = 0; j < m; ++j) yaw[j] = particles.yaw[index(from + j)];
+          sinCos(yaw, m, sin_yaw, cos_yaw);
+          for (std::size_t j = 0; j < m; ++j) {
+            const std::size_t i = index(from + j);
+            const double w = particles.weight[i];
+            a.w += w;
+            a.sx += w * particles.x[i];
+            a.sy += w * particles.y[i];
+            a.ss += w * sin_yaw[j];
+            a.sc += w * cos_yaw[j];
+          }
+        }
       },
       [](Sums& into, const Sums& from) {
         into.w += from.w;
