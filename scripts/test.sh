@@ -77,15 +77,16 @@ check "the .deb: fields, files under /usr, Depends cover its libraries and nodes
 check "bag_demo.launch from the .deb unpacked with dpkg -x: pf_node publishes pf_pose" pf_check_deb_demo "$deb"
 
 # --- Global localization among the simulated warehouse's twin aisles ---------
-# Issue 30: with a million particles (pf_bag_runner, seed 1: deterministic),
+# Issue 30: with a million particles (pf_bag_runner, seed 2: deterministic),
 # never "localized" at the wrong place, and the true place among the published
-# hypotheses in at least 95 % of the updates. Without GlobalSearch (the smoothed
-# likelihood, then the settling): 57 updates confidently wrong, the truth
-# listed in 59 %. About 10 s.
+# hypotheses (within 1 m of one's mean or inside its 95 % ellipse) in every
+# update. Without GlobalSearch (the smoothed likelihood, then the settling),
+# seed 1: 57 updates confidently wrong, the truth listed in 59 %; with 32
+# hypotheses listed instead of 64, seed 2 misses it in 2 updates. About 10 s.
 warehouse_global() {
   local out="$ws/warehouse_global" lib="$ws/devel/lib/pf_localization"
   rm -rf "$out" && mkdir -p "$out"
-  "$lib/pf_bag_runner" --bag bags/warehouse_global.bag --map maps/warehouse.yaml --seed 1 \
+  "$lib/pf_bag_runner" --bag bags/warehouse_global.bag --map maps/warehouse.yaml --seed 2 \
     --particles 1000000 --out "$out/traj.tum" --log "$out/updates.csv" \
     --hypotheses "$out/hypotheses.csv" --quiet >"$out/runner.log" 2>&1 || { tail -n 5 "$out/runner.log"; return 1; }
   /usr/bin/python3 "$lib/pf_evaluate" --traj "$out/traj.tum" --bag bags/warehouse_global.bag \
@@ -95,9 +96,10 @@ warehouse_global() {
 import json, sys
 d = json.load(open(sys.argv[1]))
 wrong, share = d['confidently_wrong_updates'], d['hypotheses']['contain_truth_share']
-print('warehouse_global.bag, 1 000 000 particles: %d updates confidently wrong, '
+print('warehouse_global.bag, 1 000 000 particles, seed 2: %d updates confidently wrong, '
       'the truth among the hypotheses in %.1f %% of %d' % (wrong, 100 * share, d['hypotheses']['updates']))
-sys.exit(0 if wrong == 0 and share >= 0.95 else 1)
+# Every update: with 32 listed (before 64), seed 2 left the truth off in 2.
+sys.exit(0 if wrong == 0 and share == 1.0 else 1)
 PY
 }
 check "warehouse global localization, 1M particles: never localized wrong, the truth listed" warehouse_global

@@ -53,7 +53,7 @@ constexpr char kUsage[] =
     "         [--particles-out P.csv]    every particle of every update in the first 30 s\n"
     "         [--covariance COV.csv]     t,xx,xy,yy,yawyaw,xyaw,yyaw: pf_pose's covariance\n"
     "                                    at each pose of the trajectory (same stamps)\n"
-    "         [--hypotheses HYP.csv]     t,rank,x,y,yaw,weight,std_x,std_y: pf_hypotheses,\n"
+    "         [--hypotheses HYP.csv]     t,rank,x,y,yaw,weight,std_x,std_y,cov_xy: pf_hypotheses,\n"
     "                                    one line per hypothesis per filter update\n"
     "         [--quiet]                  no progress bar\n";
 
@@ -274,7 +274,8 @@ void openOutputs(const Options& opt, Outputs* o) {
   if (!opt.hypotheses.empty()) {
     o->hypotheses.open(opt.hypotheses);
     if (!o->hypotheses) fail(opt.hypotheses + ": cannot write");
-    o->hypotheses << "t,rank,x,y,yaw,weight,std_x,std_y\n" << std::fixed << std::setprecision(6);
+    o->hypotheses << "t,rank,x,y,yaw,weight,std_x,std_y,cov_xy\n"
+                  << std::fixed << std::setprecision(6);
   }
 }
 
@@ -506,7 +507,8 @@ void Replay::writeHypotheses(double t) {
     const pf::Hypothesis& a = h.listed[k];
     outputs_.hypotheses << t << "," << k + 1 << "," << a.pose.x << "," << a.pose.y << ","
                         << a.pose.yaw << "," << a.weight << "," << std::sqrt(a.covariance(0, 0))
-                        << "," << std::sqrt(a.covariance(1, 1)) << "\n";
+                        << "," << std::sqrt(a.covariance(1, 1)) << "," << a.covariance(0, 1)
+                        << "\n";
   }
 }
 

@@ -111,8 +111,8 @@ TEST(Hypotheses, TenIdenticalAislesAreTenAndTheListIsCapped) {
   EXPECT_EQ(10u, capped.count);
   ASSERT_EQ(4u, capped.listed.size());
   EXPECT_DOUBLE_EQ(3.0, capped.listed.back().pose.x);
-  const Hypotheses many = hypothesesOf(estimateWithWeights(std::vector<double>(40, 0.025)), 0.2);
-  EXPECT_EQ(40u, many.count);
+  const Hypotheses many = hypothesesOf(estimateWithWeights(std::vector<double>(100, 0.01)), 0.2);
+  EXPECT_EQ(100u, many.count);
   EXPECT_EQ(kMaxListedHypotheses, many.listed.size());
 }
 

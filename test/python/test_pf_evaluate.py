@@ -282,7 +282,7 @@ class HypothesesTest(unittest.TestCase):
     @staticmethod
     def rows(updates):
         """(t, [(x, y, weight), ...]) per update -> the runner's rows t,rank,x,y,yaw,weight,sx,sy."""
-        return traj([(t, rank + 1, x, y, 0.0, w, 0.1, 0.1)
+        return traj([(t, rank + 1, x, y, 0.0, w, 0.1, 0.1, 0.0)
                      for t, listed in updates for rank, (x, y, w) in enumerate(listed)])
 
     def test_the_truth_among_several_counts_and_a_miss_is_timed(self):
@@ -305,6 +305,30 @@ class HypothesesTest(unittest.TestCase):
         self.assertAlmostEqual(pfe.hypotheses_metrics(hyp, self.ref, near=0.3)['contain_truth_share'],
                                2 / 5)
 
+    def test_a_spread_place_holds_the_truth_inside_its_ellipse(self):
+        # An aisle-long cluster: std 3 m along x, 0.2 m across. The truth 2.25 m along it is
+        # inside its 95 % ellipse (NEES 0.56), though 2.25 m from its mean; 1.2 m across it is
+        # not (NEES 36); a tilted ellipse follows its correlation.
+        def rows(sx, sy, cxy, x, y):
+            return np.array([[2.25, 1, x, y, 0.0, 1.0, sx, sy, cxy]])
+        along = pfe.hypotheses_metrics(rows(3.0, 0.2, 0.0, 4.5, 0.0), self.ref)
+        self.assertAlmostEqual(along['contain_truth_share'], 1.0)
+        self.assertAlmostEqual(along['near_truth_share'], 0.0)
+        across = pfe.hypotheses_metrics(rows(3.0, 0.2, 0.0, 2.25, 1.2), self.ref)
+        self.assertAlmostEqual(across['contain_truth_share'], 0.0)
+        self.assertEqual(across['misses_s'], [2.25])
+        # The same cluster turned 45 degrees, its long axis along (1, 1): the truth 1.4 m from its
+        # mean along that axis is inside, 1.4 m across it is not.
+        c = np.hypot(3.0, 0.2) ** 2 / 2
+        sxy = (9.0 - 0.04) / 2
+        tilted = lambda x, y: pfe.hypotheses_metrics(rows(np.sqrt(c), np.sqrt(c), sxy, x, y),
+                                                     self.ref)['contain_truth_share']
+        self.assertAlmostEqual(tilted(2.25 - 1.0, -1.0), 1.0)
+        self.assertAlmostEqual(tilted(2.25 - 1.0, 1.0), 0.0)
+        # A degenerate covariance holds nothing beyond the radius.
+        self.assertAlmostEqual(pfe.hypotheses_metrics(rows(0.0, 0.0, 0.0, 4.5, 0.0),
+                                                      self.ref)['contain_truth_share'], 0.0)
+
     def test_read_hypotheses_sorts_by_time_and_rank_and_wants_its_columns(self):
         with tempfile.TemporaryDirectory() as d:
             path = os.path.join(d, 'hyp.csv')
@@ -325,7 +349,7 @@ class HypothesesTest(unittest.TestCase):
                 with open(os.path.join(d, name), 'w') as f:
                     f.writelines('%.6f %.6f %.6f 0 0 0 0 1\n' % tuple(r[:3]) for r in a)
             with open(os.path.join(d, 'hyp.csv'), 'w') as f:
-                f.write('t,rank,x,y,yaw,weight,std_x,std_y\n')
+                f.write('t,rank,x,y,yaw,weight,std_x,std_y,cov_xy\n')
                 f.writelines(','.join('%.6g' % v for v in r) + '\n' for r in self.rows(
                     [(1.0, [(1.0, 0.0, 0.5), (5.75, 0.0, 0.5)]), (2.0, [(9.0, 0.0, 1.0)])]))
             argv = ['--traj', os.path.join(d, 'traj.tum'), '--ref', os.path.join(d, 'ref.tum'),
@@ -336,8 +360,9 @@ class HypothesesTest(unittest.TestCase):
                 h = json.load(f)['hypotheses']
             self.assertAlmostEqual(h['contain_truth_share'], 0.5)
             self.assertAlmostEqual(h['contain_truth_share_with_several'], 1.0)
-            self.assertIn('the true place within 1.0 m of one in 50.0 % of 2 updates; in 100.0 % of '
-                          'the 1 with several (up to 2, mean 1.50)', pfe.describe(m, summary))
+            self.assertIn('the true place within 1.0 m of one or inside its 95 % ellipse in 50.0 % of 2 '
+                          'updates (within 1.0 m: 50.0 %); in 100.0 % of the 1 with several (up to 2, '
+                          'mean 1.50)', pfe.describe(m, summary))
 
 
 class AlignedAteTest(unittest.TestCase):

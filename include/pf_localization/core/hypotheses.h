@@ -37,12 +37,13 @@ namespace pf {
 // localization leaves for a few updates 1-2 % each.
 constexpr double kMinHypothesisShare = 0.05;
 
-// At most this many hypotheses are listed, the heaviest. Ten identical
-// aisles are the warehouse the feature is for; a cloud with more than 32
-// places of weight tells a navigation stack no more than "not localized",
-// and 32 keep the message small (about 12 kB). The count says how many
+// At most this many hypotheses are listed, the heaviest. A global
+// localization among ten identical aisles, each with its rack bays and its
+// half-turn twin, holds up to about 60 places in its first second; listing
+// them all keeps the true one on the list (docs/design.md, "Look-alike
+// places"), and 64 keep the message about 23 kB. The count says how many
 // there were.
-constexpr std::size_t kMaxListedHypotheses = 32;
+constexpr std::size_t kMaxListedHypotheses = 64;
 
 struct Hypothesis {
   Pose2 pose;           // the cluster's weighted mean
