@@ -72,19 +72,19 @@ void LookAlikeMove::contribute(const RecoveryContext& context, const RecoveryPar
   if (context.fast < params.trigger_ratio * context.slow) plan->moves = context.better_look_alikes;
 }
 
-std::size_t LookAlikeMove::move(const std::vector<Pose2>& moves, std::size_t n,
+std::size_t LookAlikeMove::copy(const std::vector<Pose2>& moves, std::size_t n, std::size_t room,
                                 ParticleSet* particles) {
-  if (moves.empty()) return 0;
-  std::size_t moved = 0;
-  const auto period =
-      static_cast<std::size_t>(std::ceil(static_cast<double>(moves.size()) / kLookAlikeShare));
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t k = i % period;
-    if (k >= moves.size()) continue;
-    particles->setPose(i, compose(moves[k], particles->pose(i)));
-    ++moved;
+  if (moves.empty() || n == 0 || room <= n) return 0;
+  const std::size_t each = std::min(n, (room - n) / moves.size());
+  particles->resize(n + each * moves.size());
+  std::size_t to = n;
+  for (const Pose2& motion : moves) {
+    for (std::size_t j = 0; j < each; ++j) {
+      const std::size_t from = j * n / each;
+      particles->setPose(to++, compose(motion, particles->pose(from)));
+    }
   }
-  return moved;
+  return to - n;
 }
 
 void Recovery::restart() {
@@ -147,18 +147,20 @@ ResampleOutcome Recovery::resample(const RecoveryPlan& plan, double ess,
   systematicResample(*particles, kept, random, &spare_, threads);
   std::swap(*particles, spare_);
   if (plan.spread) ExpansionResetting::spread(params.recovery, kept, random, particles);
-  out.moved = LookAlikeMove::move(plan.moves, kept, particles);
-  particles->resize(kept + injected);
-  for (std::size_t i = kept; i < kept + injected; ++i) {
+  const std::size_t copied = LookAlikeMove::copy(plan.moves, kept, max - injected, particles);
+  out.moved = copied;
+  const std::size_t survivors = kept + copied;
+  particles->resize(survivors + injected);
+  for (std::size_t i = survivors; i < survivors + injected; ++i) {
     particles->setPose(i, randomFreePose(grid, random));
   }
   particles->setUniformWeights();
-  if (injected > 0 && kept > 0) {
+  if (injected > 0 && survivors > 0) {
     const double prior = params.recovery.kidnap_prior;
-    const double w_kept = (1.0 - prior) / static_cast<double>(kept);
+    const double w_kept = (1.0 - prior) / static_cast<double>(survivors);
     const double w_injected = prior / static_cast<double>(injected);
-    std::fill(particles->weight.begin(), particles->weight.begin() + kept, w_kept);
-    std::fill(particles->weight.begin() + kept, particles->weight.end(), w_injected);
+    std::fill(particles->weight.begin(), particles->weight.begin() + survivors, w_kept);
+    std::fill(particles->weight.begin() + survivors, particles->weight.end(), w_injected);
   }
   out.resampled = true;
   out.injected = injected;

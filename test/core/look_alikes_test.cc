@@ -171,7 +171,7 @@ TEST_F(LookAlikesInTwinRooms, ATwinThatFitsClearlyBetterCountsAfterItsStreak) {
   EXPECT_TRUE(look_alikes_.judge(model_, scan, wrong).better.empty());
 }
 
-TEST(LookAlikeMove, CarriesItsShareOfTheSurvivorsOnlyWhileTheScansFitPoorly) {
+TEST(LookAlikeMove, CopiesTheSurvivorsToEachLookAlikeOnlyWhileTheScansFitPoorly) {
   RecoveryContext context;
   context.slow = 1.0;
   context.fast = 0.5;
@@ -186,15 +186,32 @@ TEST(LookAlikeMove, CarriesItsShareOfTheSurvivorsOnlyWhileTheScansFitPoorly) {
   strategy.contribute(context, params, &plan);
   EXPECT_TRUE(plan.moves.empty());
 
-  ParticleSet particles;
-  particles.resize(100);
-  for (std::size_t i = 0; i < 100; ++i) particles.setPose(i, {1.0, 0.01 * i, 0.2});
-  EXPECT_EQ(50u, LookAlikeMove::move({kEastShift}, 100, &particles));
-  EXPECT_DOUBLE_EQ(5.0, particles.x[0]);
-  EXPECT_DOUBLE_EQ(1.0, particles.x[1]);
+  const auto cloud = [](std::size_t n) {
+    ParticleSet particles;
+    particles.resize(n);
+    for (std::size_t i = 0; i < n; ++i) particles.setPose(i, {1.0, 0.01 * i, 0.2});
+    return particles;
+  };
+  // Room for all: the tracked place keeps its 100, the look-alike gets 100 more.
+  ParticleSet particles = cloud(100);
+  EXPECT_EQ(100u, LookAlikeMove::copy({kEastShift}, 100, 1000, &particles));
+  ASSERT_EQ(200u, particles.size());
+  EXPECT_DOUBLE_EQ(1.0, particles.x[0]);
   EXPECT_DOUBLE_EQ(0.01, particles.y[1]);
-  // Three look-alikes share the half: three of every six particles.
-  EXPECT_EQ(48u, LookAlikeMove::move({kEastShift, kEastShift, kEastShift}, 96, &particles));
+  EXPECT_DOUBLE_EQ(5.0, particles.x[101]);
+  EXPECT_DOUBLE_EQ(0.01, particles.y[101]);
+  EXPECT_DOUBLE_EQ(0.2, particles.yaw[101]);
+  // Room for 160: three look-alikes take 20 each, every fifth survivor.
+  particles = cloud(100);
+  EXPECT_EQ(60u, LookAlikeMove::copy({kEastShift, kEastShift, kEastShift}, 100, 160, &particles));
+  ASSERT_EQ(160u, particles.size());
+  EXPECT_DOUBLE_EQ(5.0, particles.x[159]);
+  EXPECT_DOUBLE_EQ(0.95, particles.y[159]);
+  // No room beyond the survivors, or no look-alike: nothing is added.
+  particles = cloud(100);
+  EXPECT_EQ(0u, LookAlikeMove::copy({kEastShift}, 100, 100, &particles));
+  EXPECT_EQ(0u, LookAlikeMove::copy({}, 100, 1000, &particles));
+  EXPECT_EQ(100u, particles.size());
 }
 
 TEST(LookAlikes, AFilterCarriedIntoTheTwinRoomDoubtsAndThenFindsItselfThere) {

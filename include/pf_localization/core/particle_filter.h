@@ -75,7 +75,7 @@ struct UpdateReport {
   double search_sigma = 0.0;  // the hit std dev of GlobalSearch's smoothed model (0: the model's)
   bool expanded = false;      // the survivors were spread by expansion resetting
   // Look-alike places (look_alikes.h) the scan fits as well as the estimate,
-  // and those it fits clearly better, where recovery moved `moved` particles.
+  // and those it fits clearly better, where recovery added `moved` particles.
   std::size_t look_alikes = 0;
   std::size_t look_alikes_better = 0;
   std::size_t moved = 0;

@@ -15,10 +15,10 @@
 //   fatal error in Monte Carlo localization" (IROS 2004): a single scan
 //   fitting below expansion_ratio times the long-term average spreads the
 //   survivors of the resampling.
-// - LookAlikeMove: where the scan fits a look-alike of the estimate clearly
-//   better (look_alikes.h), kLookAlikeShare of the survivors are carried
-//   there by the map's motion, keeping the cloud's shape: the twin a robot
-//   was kidnapped into, or the one a global search missed, is tried at once.
+// - LookAlikeMove: where the scan fits look-alikes of the estimate clearly
+//   better (look_alikes.h), each gets a copy of the survivors carried there
+//   by the map's motion, keeping the cloud's shape: the twin a robot was
+//   kidnapped into, or the one a global search missed, is tried at once.
 // Injected particles weigh kidnap_prior together (a mixture proposal: Thrun,
 // Fox, Burgard & Dellaert, AIJ 128, 2001). See docs/design.md, "Recovery
 // waits while localized".
@@ -97,16 +97,19 @@ class ExpansionResetting final : public RecoveryStrategy {
 
 class LookAlikeMove final : public RecoveryStrategy {
  public:
-  /// The share of the survivors moved, split evenly among the look-alikes:
-  /// enough to be weighed by the next scan, while the rest keep the place
-  /// the filter tracked should the look-alike's lead be noise.
-  static constexpr double kLookAlikeShare = 0.5;
   void contribute(const RecoveryContext& context, const RecoveryParams& params,
                   RecoveryPlan* plan) override;
-  /// Moves every particle whose index i has i mod P < moves.size() by
-  /// moves[i mod P], of the first `n`, with P = ceil(moves / kLookAlikeShare).
-  /// Returns how many moved.
-  static std::size_t move(const std::vector<Pose2>& moves, std::size_t n, ParticleSet* particles);
+  /// Appends to the first `n` particles, for each motion, a copy of them
+  /// moved by it; when the cloud would outgrow `room` particles, each copy
+  /// takes an equal share of the room left, spread over the survivors.
+  /// Returns how many were added. The tracked place keeps all of its
+  /// particles, should the look-alikes' lead be noise, and each look-alike
+  /// is as densely sampled as it: with a share each (half the survivors
+  /// split among them), a look-alike's weight was that of its luckiest few
+  /// particles, and a twin as likely as the others could lose them all on
+  /// the next scan (docs/design.md, "Look-alike places").
+  static std::size_t copy(const std::vector<Pose2>& moves, std::size_t n, std::size_t room,
+                          ParticleSet* particles);
 };
 
 /// What Recovery::resample did.
@@ -114,7 +117,7 @@ struct ResampleOutcome {
   bool resampled = false;
   std::size_t injected = 0;  // random particles added
   bool expanded = false;     // the survivors were spread
-  std::size_t moved = 0;     // survivors carried to look-alikes
+  std::size_t moved = 0;     // particles added at look-alikes (LookAlikeMove::copy)
 };
 
 class Recovery {
