@@ -76,22 +76,31 @@ deb=$(tail -n 1 "$ws/make_deb.log" 2>/dev/null)
 check "the .deb: fields, files under /usr, Depends cover its libraries and nodes" pf_check_deb "$deb" package.xml
 check "bag_demo.launch from the .deb unpacked with dpkg -x: pf_node publishes pf_pose" pf_check_deb_demo "$deb"
 
-# --- Global localization among the simulated warehouse's twin aisles ---------
-# Issue 30: with a million particles (pf_bag_runner, seed 2: deterministic),
-# never "localized" at the wrong place, and the true place among the published
-# hypotheses (within 1 m of one's mean or inside its 95 % ellipse) in every
-# update. Without GlobalSearch (the smoothed likelihood, then the settling),
-# seed 1: 57 updates confidently wrong, the truth listed in 59 %; with 32
-# hypotheses listed instead of 64, seed 2 misses it in 2 updates. About 10 s.
+# --- The simulated warehouse's twin aisles (issue 30) -----------------------
+# warehouse_run DIR BAG RUNNER_ARGS...: pf_bag_runner on BAG and
+# maps/warehouse.yaml into DIR (deterministic for a seed), then pf_evaluate
+# into DIR/eval.
+warehouse_run() {
+  local dir=$1 bag=$2 lib="$ws/devel/lib/pf_localization"
+  shift 2
+  rm -rf "$dir" && mkdir -p "$dir"
+  "$lib/pf_bag_runner" --bag "$bag" --map maps/warehouse.yaml "$@" --out "$dir/traj.tum" \
+    --log "$dir/updates.csv" --hypotheses "$dir/hypotheses.csv" --quiet >"$dir/runner.log" 2>&1 ||
+    { tail -n 5 "$dir/runner.log"; return 1; }
+  /usr/bin/python3 "$lib/pf_evaluate" --traj "$dir/traj.tum" --bag "$bag" --map maps/warehouse.yaml \
+    --log "$dir/updates.csv" --hypotheses "$dir/hypotheses.csv" --out "$dir/eval" --no-plots \
+    >"$dir/eval.log" 2>&1 || { tail -n 5 "$dir/eval.log"; return 1; }
+}
+
+# Global localization with a million particles (seed 2): never "localized" at
+# the wrong place, and the true place among the published hypotheses (within
+# 1 m of one's mean or inside its 95 % ellipse) in every update. Without
+# GlobalSearch (the smoothed likelihood, then the settling), seed 1: 57
+# updates confidently wrong, the truth listed in 59 %; with 32 hypotheses
+# listed instead of 64, seed 2 misses it in 2 updates. About 10 s.
 warehouse_global() {
-  local out="$ws/warehouse_global" lib="$ws/devel/lib/pf_localization"
-  rm -rf "$out" && mkdir -p "$out"
-  "$lib/pf_bag_runner" --bag bags/warehouse_global.bag --map maps/warehouse.yaml --seed 2 \
-    --particles 1000000 --out "$out/traj.tum" --log "$out/updates.csv" \
-    --hypotheses "$out/hypotheses.csv" --quiet >"$out/runner.log" 2>&1 || { tail -n 5 "$out/runner.log"; return 1; }
-  /usr/bin/python3 "$lib/pf_evaluate" --traj "$out/traj.tum" --bag bags/warehouse_global.bag \
-    --map maps/warehouse.yaml --log "$out/updates.csv" --hypotheses "$out/hypotheses.csv" \
-    --out "$out/eval" --no-plots >"$out/eval.log" 2>&1 || { tail -n 5 "$out/eval.log"; return 1; }
+  local out="$ws/warehouse_global"
+  warehouse_run "$out" bags/warehouse_global.bag --seed 2 --particles 1000000 || return 1
   /usr/bin/python3 - "$out/eval/summary.json" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))
@@ -104,26 +113,21 @@ PY
 }
 check "warehouse global localization, 1M particles: never localized wrong, the truth listed" warehouse_global
 
-# Kidnapped into the twin aisle (issue 30): the default budget, seeds 1-10
-# (pf_bag_runner: deterministic), never "localized" wrong, and back within
-# 0.3 m for good by 84.5 s, 10 s after the scans first fit the twin clearly
-# better (74.5 s, docs/design.md, "Look-alike places"). With each look-alike
-# given a share of the survivors instead of a copy of them, seed 8 lost the
-# twin on the next scan and was back only at 87.5 s. About 15 s.
+# Kidnapped into the twin aisle: the default budget, seeds 1-10, never
+# "localized" wrong, and back within 0.3 m for good by 84.5 s, 10 s after the
+# scans first fit the twin clearly better (74.5 s, docs/design.md, "Look-alike
+# places"). With each look-alike given a share of the survivors instead of a
+# copy of them, seed 8 lost the twin on the next scan and was back only at
+# 87.5 s. About 20 s.
 warehouse_kidnap() {
-  local out="$ws/warehouse_kidnap" lib="$ws/devel/lib/pf_localization" seed
-  rm -rf "$out" && mkdir -p "$out"
+  local out="$ws/warehouse_kidnap" seed
   for seed in 1 2 3 4 5 6 7 8 9 10; do
-    "$lib/pf_bag_runner" --bag bags/warehouse_kidnap.bag --map maps/warehouse.yaml --seed $seed \
-      --initial-pose 5.0 6.0 1.5707963 --out "$out/traj$seed.tum" --log "$out/updates$seed.csv" \
-      --quiet >"$out/runner$seed.log" 2>&1 || { tail -n 5 "$out/runner$seed.log"; return 1; }
-    /usr/bin/python3 "$lib/pf_evaluate" --traj "$out/traj$seed.tum" --bag bags/warehouse_kidnap.bag \
-      --map maps/warehouse.yaml --log "$out/updates$seed.csv" --out "$out/eval$seed" --no-plots \
-      >"$out/eval$seed.log" 2>&1 || { tail -n 5 "$out/eval$seed.log"; return 1; }
+    warehouse_run "$out/seed$seed" bags/warehouse_kidnap.bag --seed $seed \
+      --initial-pose 5.0 6.0 1.5707963 || return 1
   done
   /usr/bin/python3 - "$out" <<'PY'
 import json, sys
-runs = [json.load(open('%s/eval%d/summary.json' % (sys.argv[1], s))) for s in range(1, 11)]
+runs = [json.load(open('%s/seed%d/eval/summary.json' % (sys.argv[1], s))) for s in range(1, 11)]
 back = [d['convergence_time_s'] for d in runs]
 wrong = sum(d['confidently_wrong_updates'] for d in runs)
 print('warehouse_kidnap.bag, seeds 1-10: back within 0.3 m for good at %s s (bound 84.5 s); '
