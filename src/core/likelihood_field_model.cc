@@ -346,7 +346,10 @@ void LikelihoodFieldModel::score(const float* bx, const float* by, std::size_t b
   log_likelihood->resize(particles.size());
   // The headings' sines and cosines for the whole cloud at once (sinCos
   // vectorises), not one C library call per particle. Kept per thread: no
-  // allocation per update.
+  // allocation per update. Only ever grown: the look-alike judge scores a
+  // few poses on this thread between two scorings of the cloud, and a
+  // vector shrunk to them was zero-filled back to the cloud's size (16 MB
+  // for a million particles) on one thread before every scoring.
   const std::size_t n = particles.size();
   struct HeadingScratch {
     std::vector<double> heading, sin_yaw, cos_yaw;
@@ -355,9 +358,11 @@ void LikelihoodFieldModel::score(const float* bx, const float* by, std::size_t b
   std::vector<double>& heading = heading_scratch.heading;
   std::vector<double>& sin_yaw = heading_scratch.sin_yaw;
   std::vector<double>& cos_yaw = heading_scratch.cos_yaw;
-  sin_yaw.resize(n);
-  cos_yaw.resize(n);
-  if (frame.origin.yaw != 0.0) heading.resize(n);
+  if (sin_yaw.size() < n) {
+    sin_yaw.resize(n);
+    cos_yaw.resize(n);
+  }
+  if (frame.origin.yaw != 0.0 && heading.size() < n) heading.resize(n);
   double* s = sin_yaw.data();
   double* c = cos_yaw.data();
   // One contiguous slice per thread; every particle's score is computed
