@@ -147,7 +147,7 @@ check "warehouse kidnap into the twin aisle, 10 seeds: found within 10 s of the 
 # fall inside: docs/design.md, "An honest covariance"), 85-99 % of the
 # reference inside the published 95 % ellipse. The figures the defaults reach
 # are printed. Without the recordings this fails: CI always has them. About
-# 10 s.
+# 3 s.
 real_recordings() {
   local out="$ws/real_recordings"
   rm -rf "$out" && mkdir -p "$out"
