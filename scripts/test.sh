@@ -142,7 +142,9 @@ check "warehouse kidnap into the twin aisle, 10 seeds: found within 10 s of the 
 # the defaults (seed 1: each run is the same every time), held to issue 28's
 # targets: Intel <= 0.035 m, fr079 <= 0.065 m, AC109 <= 0.065 m after the
 # best rigid fit (its AprilTags are turned 3 deg from the map) and no worse
-# than 0.13 m raw; never "localized" more than 1 m off; where the reference's
+# than 0.13 m raw; never more than 0.5 m off (issue 28 asks it of fr079 after
+# its first 10 s; every pose of all three meets it); never "localized" more
+# than 1 m off; where the reference's
 # noise is known well enough to judge it (not AC109, where 100 % of the tags
 # fall inside: docs/design.md, "An honest covariance"), 85-99 % of the
 # reference inside the published 95 % ellipse. The figures the defaults reach
@@ -159,6 +161,7 @@ import json, os, sys
 # published covariance is judged), metres.
 bounds = {'intel_lab': (0.035, None, True), 'fr079': (0.065, None, True),
           'neato_ac109_1': (0.13, 0.065, False)}
+MAX_ERROR = 0.5  # m, of any pose
 ok = True
 for name, (raw, aligned, judge_cov) in sorted(bounds.items()):
     path = os.path.join(sys.argv[1], name + '_default', 'eval', 'summary.json')
@@ -169,11 +172,13 @@ for name, (raw, aligned, judge_cov) in sorted(bounds.items()):
     d = json.load(open(path))
     inside = d['covariance']['inside_95_percent']
     good = (d['ate_rmse_m'] <= raw and (aligned is None or d['ate_aligned_rmse_m'] <= aligned)
-            and d['confidently_wrong_updates'] == 0 and (not judge_cov or 85.0 <= inside <= 99.0))
-    print('%s: ATE %.3f m (bound %.3f), after the rigid fit %.3f m%s, %d updates confidently '
-          'wrong, %.1f %% inside the 95 %% ellipse%s: %s'
+            and d['max_m'] <= MAX_ERROR and d['confidently_wrong_updates'] == 0
+            and (not judge_cov or 85.0 <= inside <= 99.0))
+    print('%s: ATE %.3f m (bound %.3f), after the rigid fit %.3f m%s, max %.2f m (bound %.1f), '
+          '%d updates confidently wrong, %.1f %% inside the 95 %% ellipse%s: %s'
           % (name, d['ate_rmse_m'], raw, d['ate_aligned_rmse_m'],
-             ' (bound %.3f)' % aligned if aligned else '', d['confidently_wrong_updates'], inside,
+             ' (bound %.3f)' % aligned if aligned else '', d['max_m'], MAX_ERROR,
+             d['confidently_wrong_updates'], inside,
              ' (85-99)' if judge_cov else ' (not judged)', 'ok' if good else 'FAILED'))
     ok = ok and good
 sys.exit(0 if ok else 1)

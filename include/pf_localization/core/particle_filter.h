@@ -49,6 +49,7 @@
 #include "pf_localization/core/sensor_model.h"
 #include "pf_localization/core/sensor_update.h"
 #include "pf_localization/core/skip_reason.h"
+#include "pf_localization/core/transient_beams.h"
 #include "pf_localization/core/update_gate.h"
 
 namespace pf {
@@ -64,7 +65,8 @@ struct UpdateReport {
   SkipReason skip_reason = SkipReason::kNone;  // why not, when !updated
   std::string skip_detail;                     // the specifics, for the log (may be empty)
   int beams_used = 0;
-  int beams_dropped = 0;
+  int beams_dropped = 0;  // without a reading (the masked ones not counted)
+  int beams_masked = 0;  // seeing something that moved in while the robot stood (transient_beams.h)
   int beams_skipped = 0;  // of beams_used, left out by beam skipping
   std::size_t particles = 0;
   double ess = 0.0;  // before resampling
@@ -158,6 +160,9 @@ class ParticleFilter {
   std::optional<Pose2> mapToOdom() const;
 
  private:
+  // The scans with the beams that see something that moved in while the
+  // robot stood masked (transient_beams.h), judged from the last estimate.
+  ScanGroup maskTransients(const Pose2& odom, const ScanGroup& measured);
   void weigh(const std::vector<PreparedScan>& scans, UpdateReport* report);
   // The estimate of the weighted cloud and the verdict on it; `predicted`:
   // the last estimate moved by the odometry since (none on a first update).
@@ -175,7 +180,9 @@ class ParticleFilter {
   MotionUpdate motion_;  // the motion model and the odometry fault share
   ParticleSet particles_;
   PoseEstimate estimate_;
-  UpdateGate gate_;  // holds the odometry of the last update
+  TransientBeams transients_;            // what the beams saw while the robot stood still
+  std::vector<LaserScan> masked_scans_;  // the scans with the transient beams masked
+  UpdateGate gate_;                      // holds the odometry of the last update
   ConfidenceTracker confidence_;
   LookAlikes look_alikes_;                // the map's symmetries, and what each scan says of them
   std::vector<Pose2> look_alike_places_;  // the last scan's, fitting as well as the estimate
