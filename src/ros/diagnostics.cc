@@ -69,6 +69,8 @@ diagnostic_msgs::DiagnosticStatus toDiagnosticStatus(const pf::ParticleFilter& f
   add(&status, "look_alike_places", static_cast<double>(report.look_alikes));
   add(&status, "moved_to_look_alikes", static_cast<double>(report.moved));
   add(&status, "beams_used", report.beams_used);
+  // Left out: they see something that stepped up to the standing robot.
+  add(&status, "beams_masked", report.beams_masked);
   const pf::ParticleFilterParams& p = filter.params();
   add(&status, "config_generation", config_generation);
   add(&status, "max_particles", p.kld.max_particles);

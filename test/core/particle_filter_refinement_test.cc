@@ -21,14 +21,7 @@ namespace {
 using small_world::castScan;
 using small_world::kTruth;
 
-ParticleFilterParams params() {
-  ParticleFilterParams p;
-  p.kld.min_particles = 300;
-  p.kld.max_particles = 2000;
-  p.seed = 3;
-  p.refine_estimate = true;
-  return p;
-}
+ParticleFilterParams params() { return small_world::refinedParams(); }
 
 // The odometry frame is not the map frame: map -> odom is kOdomInMap.
 const Pose2 kOdomInMap{0.7, -0.4, 0.3};

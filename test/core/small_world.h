@@ -3,6 +3,7 @@
 // robot is at.
 #pragma once
 
+#include "pf_localization/core/particle_filter_params.h"
 #include "support/rooms.h"
 #include "support/scan_simulator.h"
 
@@ -18,6 +19,17 @@ inline LaserScan castScan(const OccupancyGrid& grid, const Pose2& robot) {
 }
 
 const Pose2 kTruth{1.6, 1.4, 0.2};
+
+// A filter for this room, fitting its estimate to the scan: a cloud small
+// enough for a quick test, seeded.
+inline ParticleFilterParams refinedParams() {
+  ParticleFilterParams p;
+  p.kld.min_particles = 300;
+  p.kld.max_particles = 2000;
+  p.seed = 3;
+  p.refine_estimate = true;
+  return p;
+}
 
 }  // namespace small_world
 }  // namespace pf
