@@ -57,7 +57,9 @@ void systematicResampleSliced(const ParticleSet& in, std::size_t n, Random* rand
   };  // kept: no allocation per update
   std::vector<double>& cumulative = threadScratch<Cumulative>().sums;
   const std::size_t m = in.size();
-  cumulative.resize(m);
+  // Only grows: the first m are written below, and a resize up after a
+  // smaller cloud would zero-fill them first (8 MB at a million).
+  if (cumulative.size() < m) cumulative.resize(m);
   double running = 0.0;
   for (std::size_t j = 0; j < m; ++j) cumulative[j] = running += in.weight[j];
   const double step = cumulative[m - 1] / static_cast<double>(n);
