@@ -204,15 +204,17 @@ bool pinsAlong(const Eigen::Matrix3d& fit, double yaw, double margin) {
 }  // namespace
 
 ScanGroup ParticleFilter::maskTransients(const Pose2& odom, const ScanGroup& measured) {
-  TransientBeams::OnMap on_map;
-  if (sensor_.hasModel() && gate_.hasUpdated() && odom.isFinite()) {
-    const Pose2 robot = compose(refinement_.mapToOdom(estimate_.pose, *gate_.odomAtUpdate()), odom);
-    const LikelihoodField& field = sensor_.model().field();
-    on_map = [&field, robot](double x, double y) {
-      const Pose2 end = compose(robot, {x, y, 0.0});
-      return field.distanceAt(end.x, end.y) < kOnMapDistance;
-    };
+  if (!sensor_.hasModel() || !gate_.hasUpdated() || !odom.isFinite()) {
+    return transients_.mask(odom, measured, {}, &masked_scans_);
   }
+  // The robot where the last estimate would be now had the odometry been right.
+  const Pose2 robot = compose(refinement_.mapToOdom(estimate_.pose, *gate_.odomAtUpdate()), odom);
+  const LikelihoodField& field = sensor_.model().field();
+  // Two references: std::function holds them without allocating.
+  const auto on_map = [&field, &robot](double x, double y) {
+    const Pose2 end = compose(robot, {x, y, 0.0});
+    return field.distanceAt(end.x, end.y) < kOnMapDistance;
+  };
   return transients_.mask(odom, measured, on_map, &masked_scans_);
 }
 
