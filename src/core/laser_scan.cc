@@ -36,11 +36,9 @@ std::vector<Beam> selectBeams(const LaserScan& scan, int max_beams, double range
   valid.reserve(scan.ranges.size());
   for (std::size_t i = 0; i < scan.ranges.size(); ++i) {
     const float r = scan.ranges[i];
-    // NaN fails every comparison, so it is dropped along with inf and zero.
-    // A reading of range_min is a driver's "too close to measure" (REP 117's
-    // -inf, clamped): a lidar with something stuck over it reads it on every
-    // beam, and those end points inside the robot would only pull the fit.
-    if (r > 0.0f && r > lo && r < hi) {
+    // A lidar with something stuck over it reads range_min on every beam,
+    // and those end points inside the robot would only pull the fit.
+    if (isReading(r, lo, hi)) {
       valid.push_back({r, static_cast<float>(scan.angle_min + i * scan.angle_increment), i});
     }
   }

@@ -9,10 +9,10 @@ namespace {
 
 constexpr float kNoReading = std::numeric_limits<float>::infinity();
 
-// A beam's range, or inf when it has none (selectBeams' validity).
+// A beam's range, or inf when it has none (as selectBeams judges it).
 float rangeOf(const LaserScan& scan, std::size_t i) {
   const float r = scan.ranges[i];
-  return r > 0.0f && r > scan.range_min && r < scan.range_max ? r : kNoReading;
+  return isReading(r, scan.range_min, scan.range_max) ? r : kNoReading;
 }
 
 }  // namespace
@@ -64,9 +64,9 @@ int TransientBeams::maskScan(const LaserScan& scan, const Pose2& at, const OnMap
       1, static_cast<std::size_t>(std::ceil(kBearingTolerance / std::fabs(scan.angle_increment))));
   int count = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    // Shorter than what the background saw along this beam and its two
-    // neighbours, so that a depth edge a beam slid across is not taken for
-    // something that moved in.
+    // Shorter than what the background saw within `reach` beams of it, so
+    // that a depth edge a beam slid across is not taken for something that
+    // moved in.
     const float r = rangeOf(scan, i);
     bool shorter = std::isfinite(r);
     for (std::size_t j = i > reach ? i - reach : 0; shorter && j <= i + reach && j < n; ++j) {

@@ -34,6 +34,11 @@ struct LaserScan {
 /// sensor pose, robot offset or sweep, or a weight outside (0, 1]. Empty when the scan is usable.
 std::optional<std::string> validateScan(const LaserScan& scan);
 
+/// Whether range `r` is a reading within (lo, hi): NaN, inf, zero and
+/// negatives are not. A reading of `lo` itself is a driver's "too close to
+/// measure" (REP 117's -inf, clamped), not a range.
+inline bool isReading(float r, double lo, double hi) { return r > 0.0f && r > lo && r < hi; }
+
 /// One usable beam: its measured range, its bearing in the sensor frame and
 /// its index in the scan (which says when it was taken).
 struct Beam {
