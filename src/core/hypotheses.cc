@@ -27,18 +27,23 @@ Hypotheses hypothesesOf(const PoseEstimate& estimate, double rival_weight_ratio,
   return out;
 }
 
-void addLookAlikes(const std::vector<Pose2>& places, Hypotheses* hypotheses) {
+void addLookAlikes(std::vector<LookAlikePlace> places, Hypotheses* hypotheses) {
   if (hypotheses->listed.empty()) return;
+  std::stable_sort(places.begin(), places.end(),
+                   [](const LookAlikePlace& a, const LookAlikePlace& b) { return a.fit > b.fit; });
   const Eigen::Matrix3d covariance = hypotheses->listed.front().covariance;
-  for (const Pose2& place : places) {
-    const bool held =
-        std::any_of(hypotheses->listed.begin(), hypotheses->listed.end(), [&](const Hypothesis& h) {
-          return std::hypot(h.pose.x - place.x, h.pose.y - place.y) < LookAlikes::kMinShift;
-        });
+  std::vector<Pose2> taken;  // the cloud's hypotheses, then the places counted
+  for (const Hypothesis& h : hypotheses->listed) taken.push_back(h.pose);
+  for (const LookAlikePlace& place : places) {
+    const Pose2& p = place.pose;
+    const bool held = std::any_of(taken.begin(), taken.end(), [&](const Pose2& q) {
+      return std::hypot(q.x - p.x, q.y - p.y) < LookAlikes::kMinShift;
+    });
     if (held) continue;
+    taken.push_back(p);
     ++hypotheses->count;
     if (hypotheses->listed.size() < kMaxListedHypotheses) {
-      hypotheses->listed.push_back({place, 0.0, covariance, 0});
+      hypotheses->listed.push_back({p, 0.0, covariance, 0});
     }
   }
 }

@@ -267,19 +267,23 @@ std::vector<double> fitsAt(const SensorModel& model, const std::vector<PreparedS
 
 }  // namespace
 
+void LookAlikes::lookAlikesOf(const OccupancyGrid& grid, const Pose2& pose,
+                              std::vector<Pose2>* poses, std::vector<std::size_t>* index) const {
+  for (std::size_t i = 0; i < symmetries_.size(); ++i) {
+    const Pose2 twin = compose(symmetries_[i].motion, pose);
+    if (!grid.isFreeAt(twin.x, twin.y)) continue;
+    poses->push_back(twin);
+    if (index) index->push_back(i);
+  }
+}
+
 LookAlikeView LookAlikes::judge(const SensorModel& model, const std::vector<PreparedScan>& scans,
                                 const Pose2& estimate) {
   LookAlikeView view;
   if (symmetries_.empty()) return view;
-  const OccupancyGrid& grid = model.field().grid();
   std::vector<Pose2> poses{estimate};  // the estimate, then its look-alikes in free space
   std::vector<std::size_t> index;      // each look-alike's symmetry
-  for (std::size_t i = 0; i < symmetries_.size(); ++i) {
-    const Pose2 twin = compose(symmetries_[i].motion, estimate);
-    if (!grid.isFreeAt(twin.x, twin.y)) continue;
-    poses.push_back(twin);
-    index.push_back(i);
-  }
+  lookAlikesOf(model.field().grid(), estimate, &poses, &index);
   const std::vector<double> fits = fitsAt(model, scans, poses);
   view.fit = fits[0];
   view.best_fit = -std::numeric_limits<double>::infinity();
@@ -291,7 +295,7 @@ LookAlikeView LookAlikes::judge(const SensorModel& model, const std::vector<Prep
     const std::size_t i = index[j - 1];
     if (fits[j] >= view.fit - kAsGoodMargin) {
       ++view.as_good;
-      view.places.push_back(poses[j]);
+      view.places.push_back({poses[j], fits[j]});
     }
     if (fits[j] >= better) {
       streaks[i] = streaks_[i] + 1;
@@ -300,6 +304,20 @@ LookAlikeView LookAlikes::judge(const SensorModel& model, const std::vector<Prep
   }
   streaks_ = std::move(streaks);
   return view;
+}
+
+std::vector<LookAlikePlace> LookAlikes::placesAround(const SensorModel& model,
+                                                     const std::vector<PreparedScan>& scans,
+                                                     const std::vector<Pose2>& held,
+                                                     double min_fit) const {
+  std::vector<Pose2> poses;
+  for (const Pose2& place : held) lookAlikesOf(model.field().grid(), place, &poses, nullptr);
+  std::vector<LookAlikePlace> out;
+  if (poses.empty()) return out;
+  const std::vector<double> fits = fitsAt(model, scans, poses);
+  for (std::size_t j = 0; j < poses.size(); ++j)
+    if (fits[j] >= min_fit) out.push_back({poses[j], fits[j]});
+  return out;
 }
 
 }  // namespace pf

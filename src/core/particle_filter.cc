@@ -277,10 +277,24 @@ void ParticleFilter::estimateAndJudge(const std::vector<PreparedScan>& scans,
   const LookAlikeView view = look_alikes_.judge(model, scans, estimate_.pose);
   confidence_.holdWhileAmbiguous(places, view.as_good);
   search_.observe(places);
-  look_alike_places_ = view.places;
+  listLookAlikes(scans, view, places);
   report->look_alikes = view.as_good;
   report->look_alikes_better = view.better.size();
   recovery_.observeLookAlikes(view.better);
+}
+
+void ParticleFilter::listLookAlikes(const std::vector<PreparedScan>& scans,
+                                    const LookAlikeView& view, std::size_t places) {
+  look_alike_places_ = view.places;
+  if (places < 2) return;
+  // A cloud spread over several places may hold none at the true place but
+  // one a rack bay along it: the look-alikes of each are places too.
+  const Hypotheses held = hypothesesOf(estimate_, params_.confidence.rival_weight_ratio);
+  std::vector<Pose2> others;
+  for (std::size_t i = 1; i < held.listed.size(); ++i) others.push_back(held.listed[i].pose);
+  const std::vector<LookAlikePlace> around = look_alikes_.placesAround(
+      sensor_.model(), scans, others, view.fit - LookAlikes::kAsGoodMargin);
+  look_alike_places_.insert(look_alike_places_.end(), around.begin(), around.end());
 }
 
 void ParticleFilter::weigh(const std::vector<PreparedScan>& scans, UpdateReport* report) {

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -118,8 +119,8 @@ TEST_F(LookAlikesInTwinRooms, AScanThatCannotTellTheRoomsApartFitsTheTwinAsWell)
   ASSERT_EQ(view.as_good, view.places.size());
   const Pose2 twin = compose(kEastShift, west);
   bool listed = false;
-  for (const Pose2& p : view.places)
-    listed = listed || std::hypot(p.x - twin.x, p.y - twin.y) < 0.06;
+  for (const LookAlikePlace& p : view.places)
+    listed = listed || std::hypot(p.pose.x - twin.x, p.pose.y - twin.y) < 0.06;
   EXPECT_TRUE(listed);
 }
 
@@ -128,7 +129,7 @@ TEST(AddLookAlikes, ListsThePlacesTheCloudDoesNotHoldWithNoWeight) {
   h.count = 1;
   h.listed.push_back({{2.0, 1.5, 0.3}, 1.0, Eigen::Vector3d(0.01, 0.02, 0.001).asDiagonal(), 800});
   // One look-alike the cloud holds already (within kMinShift), one it does not.
-  addLookAlikes({{2.5, 1.5, 0.3}, {6.0, 1.5, 0.3}}, &h);
+  addLookAlikes({{{2.5, 1.5, 0.3}, 1.0}, {{6.0, 1.5, 0.3}, 1.0}}, &h);
   EXPECT_EQ(2u, h.count);
   ASSERT_EQ(2u, h.listed.size());
   EXPECT_DOUBLE_EQ(6.0, h.listed[1].pose.x);
@@ -137,8 +138,42 @@ TEST(AddLookAlikes, ListsThePlacesTheCloudDoesNotHoldWithNoWeight) {
   EXPECT_TRUE(h.listed[1].covariance.isApprox(h.listed[0].covariance));
   // Without a hypothesis of the cloud there is nothing to be like.
   Hypotheses none;
-  addLookAlikes({{6.0, 1.5, 0.3}}, &none);
+  addLookAlikes({{{6.0, 1.5, 0.3}, 1.0}}, &none);
   EXPECT_EQ(0u, none.count);
+}
+
+TEST(AddLookAlikes, ListsTheBestFittingFirstAndEachPlaceOnce) {
+  Hypotheses h;
+  h.count = 1;
+  h.listed.push_back({{2.0, 1.5, 0.3}, 1.0, Eigen::Vector3d(0.01, 0.02, 0.001).asDiagonal(), 800});
+  // Two look-alikes of one place reached from two held places (0.3 m
+  // apart, the same place), and a worse fitting one elsewhere.
+  addLookAlikes({{{6.0, 1.5, 0.3}, -5.0}, {{10.3, 1.5, 0.3}, 1.0}, {{10.0, 1.5, 0.3}, 2.0}}, &h);
+  EXPECT_EQ(3u, h.count);
+  ASSERT_EQ(3u, h.listed.size());
+  EXPECT_DOUBLE_EQ(10.0, h.listed[1].pose.x);
+  EXPECT_DOUBLE_EQ(6.0, h.listed[2].pose.x);
+}
+
+TEST_F(LookAlikesInTwinRooms, APlaceTheCloudHoldsNamesItsTwinWhereTheScanFits) {
+  // The scan is taken in the west room; the cloud holds, besides its
+  // estimate, a place in the east room. Its look-alike is the true pose.
+  const Pose2 west{2.0, 1.5, 0.3};
+  const std::vector<PreparedScan> scans = scanFrom(west);
+  const double fit = look_alikes_.judge(model_, scans, west).fit;
+  const Pose2 east = compose(kEastShift, west);
+  const std::vector<LookAlikePlace> around =
+      look_alikes_.placesAround(model_, scans, {east}, fit - LookAlikes::kAsGoodMargin);
+  const auto truth = std::find_if(around.begin(), around.end(), [&](const LookAlikePlace& p) {
+    return std::hypot(p.pose.x - west.x, p.pose.y - west.y) < 0.06;
+  });
+  ASSERT_NE(around.end(), truth);
+  EXPECT_NEAR(fit, truth->fit, LookAlikes::kAsGoodMargin);
+  // Where the scan fits worse than asked for, nothing is named.
+  for (const LookAlikePlace& p : look_alikes_.placesAround(model_, scans, {east}, truth->fit + 1.0))
+    EXPECT_GT(std::hypot(p.pose.x - west.x, p.pose.y - west.y), 0.06);
+  // A cloud holding no other place has no look-alikes to name.
+  EXPECT_TRUE(look_alikes_.placesAround(model_, scans, {}, -1e9).empty());
 }
 
 TEST_F(LookAlikesInTwinRooms, TheCabinetTellsThemApart) {

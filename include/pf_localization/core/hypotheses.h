@@ -24,6 +24,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "pf_localization/core/look_alikes.h"
 #include "pf_localization/core/pose2.h"
 #include "pf_localization/core/pose_estimator.h"
 
@@ -71,9 +72,10 @@ Hypotheses hypothesesOf(const PoseEstimate& estimate, double rival_weight_ratio,
 
 /// Lists after the cloud's hypotheses the look-alike `places` the scan fits
 /// as well as the estimate (look_alikes.h) that the cloud does not hold (no
-/// hypothesis within LookAlikes::kMinShift): weight 0, no particles, the
-/// heaviest hypothesis's covariance (a shift or half turn leaves an x-y
-/// covariance as it is). Counted, and listed up to kMaxListedHypotheses.
-void addLookAlikes(const std::vector<Pose2>& places, Hypotheses* hypotheses);
+/// hypothesis within LookAlikes::kMinShift), best fit first: weight 0, no
+/// particles, the heaviest hypothesis's covariance (a shift or half turn
+/// leaves an x-y covariance as it is). A place within kMinShift of a better
+/// fitting one is that place. Counted, and listed up to kMaxListedHypotheses.
+void addLookAlikes(std::vector<LookAlikePlace> places, Hypotheses* hypotheses);
 
 }  // namespace pf

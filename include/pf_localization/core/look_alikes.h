@@ -34,11 +34,17 @@ struct MapSymmetry {
 /// strongest first, at most kMaxSymmetries.
 std::vector<MapSymmetry> findMapSymmetries(const LikelihoodField& field);
 
+/// A look-alike place and the scans' log-likelihood there.
+struct LookAlikePlace {
+  Pose2 pose;
+  double fit = 0.0;
+};
+
 /// What one scan says about the estimate's look-alikes.
 struct LookAlikeView {
-  double fit = 0.0;           // the scans' log-likelihood at the estimate
-  std::size_t as_good = 0;    // look-alikes fitting within kAsGoodMargin of it, or better
-  std::vector<Pose2> places;  // those look-alikes' poses
+  double fit = 0.0;                    // the scans' log-likelihood at the estimate
+  std::size_t as_good = 0;             // look-alikes fitting within kAsGoodMargin of it, or better
+  std::vector<LookAlikePlace> places;  // those look-alikes
   // Motions whose look-alike fits kBetterMargin more than the estimate and
   // within kAsGoodMargin of the best look-alike.
   std::vector<Pose2> better;
@@ -77,8 +83,19 @@ class LookAlikes {
   /// free space) and compares the model's log-likelihoods.
   LookAlikeView judge(const SensorModel& model, const std::vector<PreparedScan>& scans,
                       const Pose2& estimate);
+  /// The look-alikes (in free space) of each of `held`, the other places a
+  /// spread cloud holds, where `scans` fit at least `min_fit`. Such a cloud
+  /// may hold no particle near the true place but one a rack bay along it.
+  std::vector<LookAlikePlace> placesAround(const SensorModel& model,
+                                           const std::vector<PreparedScan>& scans,
+                                           const std::vector<Pose2>& held, double min_fit) const;
 
  private:
+  // Appends to `poses` each look-alike of `pose` in free space, and its
+  // symmetry's index to `index` when given.
+  void lookAlikesOf(const OccupancyGrid& grid, const Pose2& pose, std::vector<Pose2>* poses,
+                    std::vector<std::size_t>* index) const;
+
   std::vector<MapSymmetry> symmetries_;
   std::vector<int> streaks_;  // per symmetry: consecutive updates it fitted clearly better
 };

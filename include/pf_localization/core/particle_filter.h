@@ -168,6 +168,11 @@ class ParticleFilter {
   // the last estimate moved by the odometry since (none on a first update).
   void estimateAndJudge(const std::vector<PreparedScan>& scans,
                         const std::optional<Pose2>& predicted, UpdateReport* report);
+  // The places pf_hypotheses lists after the cloud's: the look-alikes of
+  // the estimate (`view`) and, when the cloud holds several `places`, of
+  // each listed one, that the scans fit as well as the estimate.
+  void listLookAlikes(const std::vector<PreparedScan>& scans, const LookAlikeView& view,
+                      std::size_t places);
   void resample(UpdateReport* report);
   void restartAfterInitialization();
   void reserveStorage(std::size_t max_particles);
@@ -184,8 +189,10 @@ class ParticleFilter {
   std::vector<LaserScan> masked_scans_;  // the scans with the transient beams masked
   UpdateGate gate_;                      // holds the odometry of the last update
   ConfidenceTracker confidence_;
-  LookAlikes look_alikes_;                // the map's symmetries, and what each scan says of them
-  std::vector<Pose2> look_alike_places_;  // the last scan's, fitting as well as the estimate
+  LookAlikes look_alikes_;  // the map's symmetries, and what each scan says of them
+  // The last scan's look-alikes of the places the cloud holds, fitting as
+  // well as the estimate.
+  std::vector<LookAlikePlace> look_alike_places_;
   EstimateRefinement refinement_;
   Recovery recovery_;
 };
