@@ -114,32 +114,43 @@ PY
 check "warehouse global localization, 1M particles: never localized wrong, the truth listed" warehouse_global
 
 # The same at the default budget (50 000), seeds 1-10: never "localized" at
-# the wrong place, and the true place among the hypotheses in at least
-# 99.9 % of the updates (one miss in 2 500). Such a cloud may hold the true
-# aisle only a rack bay or two from the truth: with the look-alikes of the
-# estimate alone listed, not those of every place the cloud holds, seeds 2,
-# 4 and 8 left the truth off in 10 updates between 0.9 and 1.7 s (99.6 %).
-# About 30 s.
+# the wrong place; the true place among the hypotheses in at least 99.9 %
+# of the updates (one miss in 2 500); and "localized" (so, at the right
+# place) within 10 s of the first scan that tells the aisles apart (34.1 s,
+# README), by 44.1 s. Such a cloud may hold the true aisle only a rack bay
+# or two from the truth: with the look-alikes of the estimate alone listed,
+# not those of every place the cloud holds, seeds 2, 4 and 8 left the truth
+# off in 10 updates between 0.9 and 1.7 s (99.6 %). While the fit had to be
+# below the usual one too before a better look-alike got a copy of the
+# cloud, seeds 4 and 8 were localized only at 45.9 and 44.3 s. About 30 s.
 warehouse_global_default() {
   local out="$ws/warehouse_global_default" seed
   for seed in 1 2 3 4 5 6 7 8 9 10; do
     warehouse_run "$out/seed$seed" bags/warehouse_global.bag --seed $seed || return 1
   done
   /usr/bin/python3 - "$out" <<'PY'
-import json, sys
+import csv, json, sys
 runs = [json.load(open('%s/seed%d/eval/summary.json' % (sys.argv[1], s))) for s in range(1, 11)]
+def localized_at(seed, start):
+    for row in csv.DictReader(open('%s/seed%d/updates.csv' % (sys.argv[1], seed))):
+        if row['state'] == 'localized':
+            return float(row['t']) - start
+    return float('inf')
+BY = 44.1  # s: 10 s after the first scan that tells the aisles apart
+localized = [localized_at(s + 1, d['reference_start_s']) for s, d in enumerate(runs)]
 wrong = sum(d['confidently_wrong_updates'] for d in runs)
 updates = sum(d['hypotheses']['updates'] for d in runs)
 listed = sum(d['hypotheses']['contain_truth_share'] * d['hypotheses']['updates'] for d in runs)
 misses = ['seed %d at %s s' % (s + 1, ', '.join('%.2f' % t for t in d['hypotheses']['misses_s']))
           for s, d in enumerate(runs) if d['hypotheses']['misses_s']]
 print('warehouse_global.bag, 50 000 particles, seeds 1-10: %d updates confidently wrong, the truth '
-      'among the hypotheses in %.2f %% of %d (missed: %s)'
-      % (wrong, 100 * listed / updates, updates, '; '.join(misses) or 'none'))
-sys.exit(0 if wrong == 0 and listed >= 0.999 * updates else 1)
+      'among the hypotheses in %.2f %% of %d (missed: %s), localized at %s s (bound %.1f s)'
+      % (wrong, 100 * listed / updates, updates, '; '.join(misses) or 'none',
+         ', '.join('%.1f' % t for t in localized), BY))
+sys.exit(0 if wrong == 0 and listed >= 0.999 * updates and max(localized) <= BY else 1)
 PY
 }
-check "warehouse global localization, default budget, 10 seeds: never localized wrong, the truth listed" warehouse_global_default
+check "warehouse global localization, default budget, 10 seeds: never localized wrong, the truth listed, localized by 44.1 s" warehouse_global_default
 
 # Kidnapped into the twin aisle: the default budget, seeds 1-10, never
 # "localized" wrong, and back within 0.3 m for good by 84.5 s, 10 s after the

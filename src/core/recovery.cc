@@ -64,12 +64,14 @@ void ExpansionResetting::spread(const RecoveryParams& params, std::size_t n, Ran
   }
 }
 
-void LookAlikeMove::contribute(const RecoveryContext& context, const RecoveryParams& params,
+void LookAlikeMove::contribute(const RecoveryContext& context, const RecoveryParams& /*params*/,
                                RecoveryPlan* plan) {
-  // Only while the scans fit worse than usual, as AugmentedMclInjection
-  // asks: a look-alike that wins one scan while the tracked place fits as
-  // it always did has won by an object that is not on the map.
-  if (context.fast < params.trigger_ratio * context.slow) plan->moves = context.better_look_alikes;
+  // Whenever a look-alike has fitted clearly better for kBetterUpdates in a
+  // row (look_alikes.h): that streak is what tells a place from an object
+  // that is not on the map. Asking as well for a fit below the usual one
+  // held the move back for seconds where the fit sinks slowly, as the view
+  // that tells two aisles apart comes in (docs/design.md).
+  plan->moves = context.better_look_alikes;
 }
 
 std::size_t LookAlikeMove::copy(const std::vector<Pose2>& moves, std::size_t n, std::size_t room,

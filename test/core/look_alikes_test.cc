@@ -206,17 +206,17 @@ TEST_F(LookAlikesInTwinRooms, ATwinThatFitsClearlyBetterCountsAfterItsStreak) {
   EXPECT_TRUE(look_alikes_.judge(model_, scan, wrong).better.empty());
 }
 
-TEST(LookAlikeMove, CopiesTheSurvivorsToEachLookAlikeOnlyWhileTheScansFitPoorly) {
+TEST(LookAlikeMove, CopiesTheSurvivorsToEachBetterLookAlikeHoweverTheScansFit) {
   RecoveryContext context;
   context.slow = 1.0;
-  context.fast = 0.5;
+  context.fast = 0.9;  // above trigger_ratio (0.7) of the usual fit
   context.better_look_alikes = {kEastShift};
   RecoveryParams params;
   RecoveryPlan plan;
   LookAlikeMove strategy;
   strategy.contribute(context, params, &plan);
   ASSERT_EQ(1u, plan.moves.size());
-  context.fast = 0.9;  // above trigger_ratio (0.7) of the usual fit
+  context.better_look_alikes.clear();
   plan = RecoveryPlan();
   strategy.contribute(context, params, &plan);
   EXPECT_TRUE(plan.moves.empty());
