@@ -92,6 +92,16 @@ warehouse_run() {
     >"$dir/eval.log" 2>&1 || { tail -n 5 "$dir/eval.log"; return 1; }
 }
 
+# warehouse_seeds DIR BAG RUNNER_ARGS...: warehouse_run for seeds 1-10, into
+# DIR/seed1 ... DIR/seed10.
+warehouse_seeds() {
+  local dir=$1 bag=$2 seed
+  shift 2
+  for seed in 1 2 3 4 5 6 7 8 9 10; do
+    warehouse_run "$dir/seed$seed" "$bag" --seed $seed "$@" || return 1
+  done
+}
+
 # Global localization with a million particles (seed 2): never "localized" at
 # the wrong place, and the true place among the published hypotheses (within
 # 1 m of one's mean or inside its 95 % ellipse) in every update. Without
@@ -124,10 +134,8 @@ check "warehouse global localization, 1M particles: never localized wrong, the t
 # below the usual one too before a better look-alike got a copy of the
 # cloud, seeds 4 and 8 were localized only at 45.9 and 44.3 s. About 30 s.
 warehouse_global_default() {
-  local out="$ws/warehouse_global_default" seed
-  for seed in 1 2 3 4 5 6 7 8 9 10; do
-    warehouse_run "$out/seed$seed" bags/warehouse_global.bag --seed $seed || return 1
-  done
+  local out="$ws/warehouse_global_default"
+  warehouse_seeds "$out" bags/warehouse_global.bag || return 1
   /usr/bin/python3 - "$out" <<'PY'
 import csv, json, sys
 runs = [json.load(open('%s/seed%d/eval/summary.json' % (sys.argv[1], s))) for s in range(1, 11)]
@@ -159,11 +167,8 @@ check "warehouse global localization, default budget, 10 seeds: never localized 
 # copy of them, seed 8 lost the twin on the next scan and was back only at
 # 87.5 s. About 20 s.
 warehouse_kidnap() {
-  local out="$ws/warehouse_kidnap" seed
-  for seed in 1 2 3 4 5 6 7 8 9 10; do
-    warehouse_run "$out/seed$seed" bags/warehouse_kidnap.bag --seed $seed \
-      --initial-pose 5.0 6.0 1.5707963 || return 1
-  done
+  local out="$ws/warehouse_kidnap"
+  warehouse_seeds "$out" bags/warehouse_kidnap.bag --initial-pose 5.0 6.0 1.5707963 || return 1
   /usr/bin/python3 - "$out" <<'PY'
 import json, sys
 runs = [json.load(open('%s/seed%d/eval/summary.json' % (sys.argv[1], s))) for s in range(1, 11)]
