@@ -1,5 +1,7 @@
 #include "pf_localization/core/confidence_tracker.h"
 
+#include <Eigen/LU>
+#include <cmath>
 #include <string>
 
 #include "pf_localization/core/hypotheses.h"
@@ -7,27 +9,56 @@
 
 namespace pf {
 
-void ConfidenceTracker::restart(const Eigen::Matrix3d& covariance) {
+namespace {
+
+// chi-square with 3 degrees of freedom at 99.9 %: a jump this far (squared,
+// in the standard deviations of the last published spread and the cloud's
+// together) left both.
+constexpr double kJumpGate = 16.27;
+
+}  // namespace
+
+void ConfidenceTracker::restart(const Eigen::Matrix3d& covariance, bool place_given) {
   confidence_ = Confidence();
   confidence_.state = LocalizationState::kUncertain;
   fit_state_ = confidence_.state;
   confidence_.reason = "no scan since the initialisation";
   confidence_.covariance = covariance;
   settle_left_ = 0;
+  place_known_ = place_given;
+  covers_places_ = false;
 }
 
 void ConfidenceTracker::assess(const ParticleSet& particles, const PoseEstimate& estimate,
                                double hit_fraction, const ConfidenceParams& params, int threads) {
+  previous_covariance_ = confidence_.covariance;
   confidence_ = assessConfidence(particles, estimate, hit_fraction, params, threads);
   fit_state_ = confidence_.state;
+  covers_places_ = false;
 }
 
 void ConfidenceTracker::holdAfterJump(const std::optional<Pose2>& predicted, const Pose2& estimate,
                                       const ConfidenceParams& params) {
-  if (predicted) pf::holdAfterJump(*predicted, estimate, params, &settle_left_, &confidence_);
+  if (!predicted) return;
+  pf::holdAfterJump(*predicted, estimate, params, &settle_left_, &confidence_);
+  // A jump as far as a look-alike can be (LookAlikes::kMinShift, or a turn
+  // towards a half-turn twin) and beyond both the last published spread and
+  // the cloud's: the scans alone chose where the cloud went. Within them (a
+  // cloud long along a corridor, say) the track had not ruled it out.
+  const Eigen::Vector3d d(estimate.x - predicted->x, estimate.y - predicted->y,
+                          angleDiff(estimate.yaw, predicted->yaw));
+  const bool far = d.head<2>().norm() >= LookAlikes::kMinShift || std::fabs(d(2)) > 0.5 * M_PI;
+  const Eigen::Matrix3d information =
+      (previous_covariance_ + confidence_.covariance + 1e-9 * Eigen::Matrix3d::Identity())
+          .inverse();
+  const bool beyond = !information.allFinite() || d.dot(information * d) > kJumpGate;
+  if (far && beyond) place_known_ = false;
 }
 
 void ConfidenceTracker::holdWhileAmbiguous(std::size_t places, std::size_t look_alikes) {
+  if (fit_state_ != LocalizationState::kLost && places <= 1 && look_alikes == 0) {
+    place_known_ = true;
+  }
   if (confidence_.state != LocalizationState::kLocalized) return;
   if (places > 1) {
     confidence_.reason =
@@ -42,8 +73,15 @@ void ConfidenceTracker::holdWhileAmbiguous(std::size_t places, std::size_t look_
   confidence_.state = LocalizationState::kUncertain;
 }
 
+void ConfidenceTracker::coverLookAlikes(const Pose2& estimate, double fit,
+                                        const std::vector<LookAlikePlace>& places) {
+  if (place_known_ || places.empty()) return;
+  confidence_.covariance = lookAlikeCovariance(estimate, confidence_.covariance, fit, places);
+  covers_places_ = true;
+}
+
 void ConfidenceTracker::addFit(const Eigen::Matrix3d& fit_covariance) {
-  confidence_.covariance = confidence_.rivals > 0
+  confidence_.covariance = confidence_.rivals > 0 || covers_places_
                                ? coveringCovariance(fit_covariance, confidence_.covariance)
                                : fusedCovariance(fit_covariance, confidence_.covariance);
 }

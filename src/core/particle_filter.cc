@@ -134,7 +134,7 @@ void ParticleFilter::initializeGaussian(const Pose2& mean, const Eigen::Matrix3d
   particles_.setUniformWeights();
   estimate_ = estimatePose(particles_, params_.clusters, threads_);
   search_.stop();
-  restartAfterInitialization();
+  restartAfterInitialization(true);
 }
 
 void ParticleFilter::initializeUniform() {
@@ -151,15 +151,15 @@ void ParticleFilter::initializeUniform() {
   estimate_ = estimatePose(particles_, params_.clusters, threads_);
   const double cell = grid.resolution();
   search_.start(static_cast<double>(grid.freeCells().size()) * cell * cell);
-  restartAfterInitialization();
+  restartAfterInitialization(false);
 }
 
-void ParticleFilter::restartAfterInitialization() {
+void ParticleFilter::restartAfterInitialization(bool place_given) {
   // The new particles describe the robot now: the odometry travelled since the
   // last update must not move them again, so the next update skips motion.
   gate_.restart();
   refinement_.reset();
-  confidence_.restart(estimate_.covariance);
+  confidence_.restart(estimate_.covariance, place_given);
   recovery_.restart();
   look_alikes_.restart();
   look_alike_places_.clear();
@@ -278,6 +278,7 @@ void ParticleFilter::estimateAndJudge(const std::vector<PreparedScan>& scans,
   confidence_.holdWhileAmbiguous(places, view.as_good);
   search_.observe(places);
   listLookAlikes(scans, view, places);
+  confidence_.coverLookAlikes(estimate_.pose, view.fit, look_alike_places_);
   report->look_alikes = view.as_good;
   report->look_alikes_better = view.better.size();
   recovery_.observeLookAlikes(view.better);

@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -105,6 +106,53 @@ TEST_F(ConfidenceTrackerTest, AFitNarrowsThePublishedCovarianceWhereItConstrains
   EXPECT_NEAR(cloud(0, 0), c(0, 0), 0.05 * cloud(0, 0));
   EXPECT_LT(c(1, 1), 1e-6);
   EXPECT_LT(c(2, 2), 1e-7);
+}
+
+// Twin places 10 m apart along x that the scan fits as well as the estimate.
+class ConfidenceTrackerLookAlikesTest : public ConfidenceTrackerTest {
+ protected:
+  // An update at the estimate `at_`, tracked from `predicted`, whose scan
+  // fits `as_good` twins as well (one listed, 10 m ahead).
+  void update(const Pose2& predicted, std::size_t as_good) {
+    assessLocalized();
+    tracker_.holdAfterJump(predicted, at_, params_);
+    tracker_.holdWhileAmbiguous(1, as_good);
+    std::vector<LookAlikePlace> places;
+    if (as_good > 0) places.push_back({compose({10.0, 0.0, 0.0}, at_), kFit});
+    tracker_.coverLookAlikes(at_, kFit, places);
+  }
+  double stdX() const { return std::sqrt(tracker_.confidence().covariance(0, 0)); }
+
+  static constexpr double kFit = -40.0;
+};
+
+TEST_F(ConfidenceTrackerLookAlikesTest, AfterAGlobalInitialisationTheCovarianceCoversTheTwins) {
+  tracker_.restart(Eigen::Matrix3d::Identity() * 100.0, false);
+  update(at_, 1);
+  // Half the weight 10 m away: sqrt(0.5 * 10^2) = 7.07 m about the
+  // estimate, where the cloud alone says cm.
+  EXPECT_NEAR(std::sqrt(50.0), stdX(), 0.01);
+  // A fit narrows the estimate's place, not the choice between the twins.
+  tracker_.addFit(Eigen::Vector3d(1e-6, 1e-6, 1e-7).asDiagonal());
+  EXPECT_GT(stdX(), 7.0);
+  // A scan that fits no twin as well tells the place apart, for good.
+  update(at_, 0);
+  EXPECT_LT(stdX(), 0.05);
+  update(at_, 1);
+  EXPECT_LT(stdX(), 0.05);
+}
+
+TEST_F(ConfidenceTrackerLookAlikesTest, AGivenPoseTellsThePlaceApartUntilAFarJump) {
+  tracker_.restart(Eigen::Matrix3d::Identity() * 0.01, true);
+  update(at_, 1);
+  EXPECT_LT(stdX(), 0.05);
+  // A jump of 0.6 m is one (holdAfterJump) but cannot reach a twin.
+  update(compose(at_, {0.6, 0.0, 0.0}), 1);
+  EXPECT_LT(stdX(), 0.05);
+  // 3 m beyond where the odometry put the last estimate, far outside
+  // its spread: the scans alone chose this place.
+  update(compose(at_, {3.0, 0.0, 0.0}), 1);
+  EXPECT_NEAR(std::sqrt(50.0), stdX(), 0.01);
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <vector>
 
 #include "pf_localization/core/confidence.h"
@@ -121,6 +122,37 @@ TEST(Hypotheses, NoClustersOrNoWeightAreNone) {
   const Hypotheses weightless = hypothesesOf(estimateWithWeights({0.0, 0.0}), 0.2);
   EXPECT_EQ(0u, weightless.count);
   EXPECT_TRUE(weightless.listed.empty());
+}
+
+// The estimate at the origin, 2 cm wide, and twin places the scan fits.
+TEST(LookAlikeCovariance, CoversEquallyLikelyPlacesAndWeighsEachByItsFit) {
+  const Pose2 at{0.0, 0.0, 0.0};
+  const Eigen::Matrix3d own = Eigen::Vector3d(4e-4, 4e-4, 1e-4).asDiagonal();
+  const double fit = -50.0;
+  // No look-alike: the covariance stands.
+  EXPECT_EQ(own, lookAlikeCovariance(at, own, fit, {}));
+  // A twin 10 m along x that fits as well: half the weight there, so the
+  // x variance about the estimate is 0.5 * 10^2 more; y and yaw as before.
+  Eigen::Matrix3d c = lookAlikeCovariance(at, own, fit, {{{10.0, 0.0, 0.0}, fit}});
+  EXPECT_NEAR(own(0, 0) + 50.0, c(0, 0), 1e-9);
+  EXPECT_NEAR(own(1, 1), c(1, 1), 1e-12);
+  EXPECT_NEAR(own(2, 2), c(2, 2), 1e-12);
+  // One that fits 3 nats worse holds e^-3 / (1 + e^-3) of the weight.
+  const double w = std::exp(-3.0) / (1.0 + std::exp(-3.0));
+  c = lookAlikeCovariance(at, own, fit, {{{10.0, 0.0, 0.0}, fit - 3.0}});
+  EXPECT_NEAR(own(0, 0) + w * 100.0, c(0, 0), 1e-9);
+  // A half-turn twin at the same spot: yaw off by pi with half the weight.
+  c = lookAlikeCovariance(at, own, fit, {{{0.0, 5.0, M_PI}, fit}});
+  EXPECT_NEAR(own(2, 2) + 0.5 * M_PI * M_PI, c(2, 2), 1e-9);
+  EXPECT_NEAR(own(1, 1) + 0.5 * 25.0, c(1, 1), 1e-9);
+  // A place within LookAlikes::kMinShift of the estimate, or of a better
+  // fitting place, is that place: counted once.
+  c = lookAlikeCovariance(
+      at, own, fit, {{{0.5, 0.0, 0.0}, fit}, {{10.0, 0.0, 0.0}, fit}, {{10.4, 0.0, 0.0}, fit}});
+  EXPECT_NEAR(own(0, 0) + 50.0, c(0, 0), 1e-9);
+  // A far better twin takes (nearly) all the weight, without overflow.
+  c = lookAlikeCovariance(at, own, fit, {{{10.0, 0.0, 0.0}, fit + 2000.0}});
+  EXPECT_NEAR(own(0, 0) + 100.0, c(0, 0), 1e-9);
 }
 
 }  // namespace

@@ -53,7 +53,8 @@ struct Confidence {
   double std_yaw = 0.0;       // rad
   int rivals = 0;             // clusters at least rival_weight_ratio as heavy as the first
   // The covariance to publish: the heaviest cluster's, or the whole cloud's
-  // when rivals exist, so that an ambiguous estimate never looks precise.
+  // when rivals exist, so that an ambiguous estimate never looks precise
+  // (ConfidenceTracker also widens it over look-alike places).
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
 };
 

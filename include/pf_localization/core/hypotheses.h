@@ -78,4 +78,14 @@ Hypotheses hypothesesOf(const PoseEstimate& estimate, double rival_weight_ratio,
 /// fitting one is that place. Counted, and listed up to kMaxListedHypotheses.
 void addLookAlikes(std::vector<LookAlikePlace> places, Hypotheses* hypotheses);
 
+/// The covariance, about `estimate`, of where the robot is when the scans
+/// (log-likelihood `fit` at the estimate) cannot tell the estimate's place
+/// from the look-alike `places`: a mixture of the estimate's place and each
+/// look-alike, each with `covariance`, weighted by its likelihood relative
+/// to the estimate's (the posterior of equally likely places, as with
+/// LookAlikes::kAsGoodMargin). A place within LookAlikes::kMinShift of the
+/// estimate or of a better fitting place is that place. No places: `covariance`.
+Eigen::Matrix3d lookAlikeCovariance(const Pose2& estimate, const Eigen::Matrix3d& covariance,
+                                    double fit, std::vector<LookAlikePlace> places);
+
 }  // namespace pf

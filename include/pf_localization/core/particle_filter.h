@@ -174,7 +174,7 @@ class ParticleFilter {
   void listLookAlikes(const std::vector<PreparedScan>& scans, const LookAlikeView& view,
                       std::size_t places);
   void resample(UpdateReport* report);
-  void restartAfterInitialization();
+  void restartAfterInitialization(bool place_given);
   void reserveStorage(std::size_t max_particles);
 
   ParticleFilterParams params_;
