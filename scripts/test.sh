@@ -14,7 +14,7 @@ repo=$(cd "$(dirname "$0")/.." && pwd)
 source "$repo/scripts/workspace.bash"
 ws=$(pf_default_ws "$repo")
 export PATH=/usr/bin:$PATH
-cd "$repo"
+cd "$repo" || exit 1
 
 bash scripts/install_deps.sh || { echo "install failed"; echo "0 passed, 1 failed"; exit 1; }
 rm -rf "$ws/build/test_results"
@@ -266,7 +266,11 @@ check "the core and the simulator include no ROS header" core_is_ros_free
 if [ "${PF_SKIP_SANITIZE:-0}" != 1 ]; then
   check "unit tests under ASan + UBSan (scripts/sanitize.sh)" bash scripts/sanitize.sh
 fi
-no_long_functions() { /usr/bin/python3 scripts/long_functions.py --max 80 $(git ls-files 'src/*.cc'); }
+no_long_functions() {
+  local sources
+  mapfile -t sources < <(git ls-files 'src/*.cc')
+  /usr/bin/python3 scripts/long_functions.py --max 80 "${sources[@]}"
+}
 check "no function in src/ longer than 80 lines" no_long_functions
 check "clang-format clean" clang_format_clean
 # The rviz workflow in a real rviz under Xvfb (about 45 s).
