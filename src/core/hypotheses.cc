@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "pf_localization/core/look_alikes.h"
@@ -28,23 +29,38 @@ Hypotheses hypothesesOf(const PoseEstimate& estimate, double rival_weight_ratio,
   return out;
 }
 
-void addLookAlikes(std::vector<LookAlikePlace> places, Hypotheses* hypotheses) {
-  if (hypotheses->listed.empty()) return;
+namespace {
+
+// `places`, best fit first, less those within LookAlikes::kMinShift of one
+// of `taken` or of a better fitting place: each place once.
+std::vector<LookAlikePlace> distinctPlaces(std::vector<LookAlikePlace> places,
+                                           std::vector<Pose2> taken) {
   std::stable_sort(places.begin(), places.end(),
                    [](const LookAlikePlace& a, const LookAlikePlace& b) { return a.fit > b.fit; });
-  const Eigen::Matrix3d covariance = hypotheses->listed.front().covariance;
-  std::vector<Pose2> taken;  // the cloud's hypotheses, then the places counted
-  for (const Hypothesis& h : hypotheses->listed) taken.push_back(h.pose);
+  std::vector<LookAlikePlace> out;
   for (const LookAlikePlace& place : places) {
     const Pose2& p = place.pose;
-    const bool held = std::any_of(taken.begin(), taken.end(), [&](const Pose2& q) {
+    const bool seen = std::any_of(taken.begin(), taken.end(), [&](const Pose2& q) {
       return std::hypot(q.x - p.x, q.y - p.y) < LookAlikes::kMinShift;
     });
-    if (held) continue;
+    if (seen) continue;
     taken.push_back(p);
+    out.push_back(place);
+  }
+  return out;
+}
+
+}  // namespace
+
+void addLookAlikes(std::vector<LookAlikePlace> places, Hypotheses* hypotheses) {
+  if (hypotheses->listed.empty()) return;
+  const Eigen::Matrix3d covariance = hypotheses->listed.front().covariance;
+  std::vector<Pose2> held;
+  for (const Hypothesis& h : hypotheses->listed) held.push_back(h.pose);
+  for (const LookAlikePlace& place : distinctPlaces(std::move(places), std::move(held))) {
     ++hypotheses->count;
     if (hypotheses->listed.size() < kMaxListedHypotheses) {
-      hypotheses->listed.push_back({p, 0.0, covariance, 0});
+      hypotheses->listed.push_back({place.pose, 0.0, covariance, 0});
     }
   }
 }
@@ -52,20 +68,13 @@ void addLookAlikes(std::vector<LookAlikePlace> places, Hypotheses* hypotheses) {
 Eigen::Matrix3d lookAlikeCovariance(const Pose2& estimate, const Eigen::Matrix3d& covariance,
                                     double fit, std::vector<LookAlikePlace> places) {
   if (!std::isfinite(fit)) return covariance;
-  std::stable_sort(places.begin(), places.end(),
-                   [](const LookAlikePlace& a, const LookAlikePlace& b) { return a.fit > b.fit; });
   // Log-likelihoods relative to the estimate's, then to the largest, so
   // that a far better look-alike does not overflow the exponential.
   std::vector<Eigen::Vector3d> offsets{Eigen::Vector3d::Zero()};
   std::vector<double> log_ratio{0.0};
-  std::vector<Pose2> taken{estimate};
-  for (const LookAlikePlace& place : places) {
+  for (const LookAlikePlace& place : distinctPlaces(std::move(places), {estimate})) {
+    if (!std::isfinite(place.fit)) continue;
     const Pose2& p = place.pose;
-    const bool same = std::any_of(taken.begin(), taken.end(), [&](const Pose2& q) {
-      return std::hypot(q.x - p.x, q.y - p.y) < LookAlikes::kMinShift;
-    });
-    if (same || !std::isfinite(place.fit)) continue;
-    taken.push_back(p);
     offsets.emplace_back(p.x - estimate.x, p.y - estimate.y, angleDiff(p.yaw, estimate.yaw));
     log_ratio.push_back(place.fit - fit);
   }
