@@ -1,6 +1,5 @@
 #include "pf_localization/core/confidence_tracker.h"
 
-#include <Eigen/LU>
 #include <cmath>
 #include <string>
 
@@ -45,14 +44,11 @@ void ConfidenceTracker::holdAfterJump(const std::optional<Pose2>& predicted, con
   // towards a half-turn twin) and beyond both the last published spread and
   // the cloud's: the scans alone chose where the cloud went. Within them (a
   // cloud long along a corridor, say) the track had not ruled it out.
-  const Eigen::Vector3d d(estimate.x - predicted->x, estimate.y - predicted->y,
-                          angleDiff(estimate.yaw, predicted->yaw));
+  const Eigen::Vector3d d = poseDifference(estimate, *predicted);
   const bool far = d.head<2>().norm() >= LookAlikes::kMinShift || std::fabs(d(2)) > 0.5 * M_PI;
-  const Eigen::Matrix3d information =
-      (previous_covariance_ + confidence_.covariance + 1e-9 * Eigen::Matrix3d::Identity())
-          .inverse();
-  const bool beyond = !information.allFinite() || d.dot(information * d) > kJumpGate;
-  if (far && beyond) place_known_ = false;
+  if (far && squaredMahalanobis(d, previous_covariance_ + confidence_.covariance) > kJumpGate) {
+    place_known_ = false;
+  }
 }
 
 void ConfidenceTracker::holdWhileAmbiguous(std::size_t places, std::size_t look_alikes) {

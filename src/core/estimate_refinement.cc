@@ -1,9 +1,7 @@
 #include "pf_localization/core/estimate_refinement.h"
 
 #include <Eigen/Core>
-#include <Eigen/LU>
 #include <cmath>
-#include <limits>
 
 namespace pf {
 
@@ -14,24 +12,13 @@ namespace {
 // cloud's mean along an open direction and still be believed.
 constexpr double kPredictionGate = 10.83;
 
-Eigen::Vector3d difference(const Pose2& to, const Pose2& from) {
-  return {to.x - from.x, to.y - from.y, angleDiff(to.yaw, from.yaw)};
-}
-
-// The squared Mahalanobis length of `d` in the cloud's spread (`cloud`, its
-// covariance); +inf when the covariance cannot be inverted.
-double inCloudSpread(const Eigen::Vector3d& d, const Eigen::Matrix3d& cloud) {
-  const Eigen::Matrix3d information = (cloud + 1e-9 * Eigen::Matrix3d::Identity()).inverse();
-  return information.allFinite() ? d.dot(information * d) : std::numeric_limits<double>::infinity();
-}
-
 // `from` moved to `to` along the directions of projector `open`, when that
 // move lies within the cloud's spread.
 Pose2 alongOpen(const Eigen::Matrix3d& open, const Pose2& from, const Pose2& to,
                 const Eigen::Matrix3d& cloud) {
   if (open.isZero()) return from;
-  const Eigen::Vector3d d = open * difference(to, from);
-  if (inCloudSpread(d, cloud) > kPredictionGate) return from;
+  const Eigen::Vector3d d = open * poseDifference(to, from);
+  if (squaredMahalanobis(d, cloud) > kPredictionGate) return from;
   return {from.x + d(0), from.y + d(1), normalizeAngle(from.yaw + d(2))};
 }
 
@@ -100,7 +87,7 @@ ScanRefinement EstimateRefinement::atUpdate(const SensorModel& model, const Scan
   // The cloud's mean can sit on a wrong door pattern while the odometry's
   // prediction is where the robot is: fitted from both, the scan decides.
   if (predicted && !lost && !(r.accepted && sameBasin(r.pose, *predicted)) &&
-      inCloudSpread(difference(*predicted, estimate->pose), estimate->covariance) <=
+      squaredMahalanobis(poseDifference(*predicted, estimate->pose), estimate->covariance) <=
           kPredictionStartGate) {
     const ScanRefinement from_prediction =
         refiner.refine(prepared, *predicted, estimate->covariance);

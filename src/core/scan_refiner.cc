@@ -2,8 +2,10 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -342,6 +344,15 @@ Eigen::Matrix3d coveringCovariance(const Eigen::Matrix3d& a, const Eigen::Matrix
   }
   const Eigen::Matrix3d c = l * v * wider.asDiagonal() * v.transpose() * l.transpose();
   return 0.5 * (c + c.transpose());
+}
+
+Eigen::Vector3d poseDifference(const Pose2& to, const Pose2& from) {
+  return {to.x - from.x, to.y - from.y, angleDiff(to.yaw, from.yaw)};
+}
+
+double squaredMahalanobis(const Eigen::Vector3d& d, const Eigen::Matrix3d& covariance) {
+  const Eigen::Matrix3d information = (covariance + 1e-9 * Eigen::Matrix3d::Identity()).inverse();
+  return information.allFinite() ? d.dot(information * d) : std::numeric_limits<double>::infinity();
 }
 
 }  // namespace pf

@@ -179,4 +179,11 @@ Eigen::Matrix3d fusedCovariance(const Eigen::Matrix3d& fit, const Eigen::Matrix3
 /// a refined pose without claiming more certainty than the cloud has.
 Eigen::Matrix3d coveringCovariance(const Eigen::Matrix3d& a, const Eigen::Matrix3d& b);
 
+/// `to` - `from` as (x, y, yaw), the yaw difference wrapped.
+Eigen::Vector3d poseDifference(const Pose2& to, const Pose2& from);
+
+/// The squared Mahalanobis length of `d` in a spread of `covariance`; +inf
+/// when the covariance (with a 1e-9 ridge) cannot be inverted.
+double squaredMahalanobis(const Eigen::Vector3d& d, const Eigen::Matrix3d& covariance);
+
 }  // namespace pf
