@@ -19,6 +19,10 @@ constexpr double kMinTranslationForHeading = 0.01;
 // arrays (32 KiB) stay within a core's L1/L2 cache.
 constexpr std::size_t kMotionChunk = 1024;
 
+// v^2 for a step of v up to one update's `one`; beyond it, the sum of the
+// squares of the v / one updates of length `one` the step stands for.
+double spanSquare(double v, double one) { return v * std::min(v, one); }
+
 // A rotation of nearly pi before a straight move is a robot reversing, not
 // turning around: its noise must be that of the small angle it really turned.
 double rotationMagnitude(double rot) {
@@ -120,8 +124,13 @@ void validate(const OdometryMotionParams& p) {
                    "OdometryMotionParams::fault_margin", ">= 0", p.fault_margin);
 }
 
-OdometryMotionModel::OdometryMotionModel(const OdometryMotionParams& params)
-    : params_((validate(params), params)) {}
+OdometryMotionModel::OdometryMotionModel(const OdometryMotionParams& params,
+                                         const OneUpdateStep& update_step)
+    : params_((validate(params), params)), update_step_(update_step) {
+  requireParameter(update_step.distance > 0.0, "OneUpdateStep::distance", "> 0",
+                   update_step.distance);
+  requireParameter(update_step.angle > 0.0, "OneUpdateStep::angle", "> 0", update_step.angle);
+}
 
 OdometryStep OdometryMotionModel::decompose(const Pose2& from, const Pose2& to) {
   const double dx = to.x - from.x;
@@ -158,14 +167,14 @@ void OdometryMotionModel::applyDifferential(const Pose2& from, const Pose2& to,
                                             BlockStreams* streams, uint8_t* faulty,
                                             int threads) const {
   const OdometryStep step = decompose(from, to);
-  const double rot1 = rotationMagnitude(step.rot1);
-  const double rot2 = rotationMagnitude(step.rot2);
-  const double trans2 = step.trans * step.trans;
+  const double rot1_2 = spanSquare(rotationMagnitude(step.rot1), update_step_.angle);
+  const double rot2_2 = spanSquare(rotationMagnitude(step.rot2), update_step_.angle);
+  const double trans2 = spanSquare(step.trans, update_step_.distance);
   const DifferentialDraws draws{
       step,
-      std::sqrt(params_.alpha1 * rot1 * rot1 + params_.alpha2 * trans2),
-      std::sqrt(params_.alpha3 * trans2 + params_.alpha4 * (rot1 * rot1 + rot2 * rot2)),
-      std::sqrt(params_.alpha1 * rot2 * rot2 + params_.alpha2 * trans2),
+      std::sqrt(params_.alpha1 * rot1_2 + params_.alpha2 * trans2),
+      std::sqrt(params_.alpha3 * trans2 + params_.alpha4 * (rot1_2 + rot2_2)),
+      std::sqrt(params_.alpha1 * rot2_2 + params_.alpha2 * trans2),
       fault_fraction,
       params_.fault_margin};
 
@@ -203,7 +212,8 @@ void OdometryMotionModel::applyOmni(const Pose2& from, const Pose2& to, double f
   // Direction of travel relative to the heading: omni robots may move sideways.
   const double bearing =
       trans < kMinTranslationForHeading ? 0.0 : angleDiff(std::atan2(dy, dx), from.yaw);
-  const double trans2 = trans * trans, rot2 = rot * rot;
+  const double trans2 = spanSquare(trans, update_step_.distance);
+  const double rot2 = spanSquare(std::fabs(rot), update_step_.angle);
   const double sigma_trans = std::sqrt(params_.alpha3 * trans2 + params_.alpha1 * rot2);
   const double sigma_rot = std::sqrt(params_.alpha4 * rot2 + params_.alpha2 * trans2);
   const double sigma_strafe = std::sqrt(params_.alpha1 * rot2 + params_.alpha5 * trans2);

@@ -35,7 +35,7 @@ ParticleFilter::ParticleFilter(const ParticleFilterParams& params)
     : params_((validate(params), params)),
       threads_(resolvedThreads(params.threads)),
       random_(params.seed),
-      motion_(params.motion) {
+      motion_(params.motion, oneUpdateStep(params)) {
   // Room for the largest cloud from the start: the particle count swings
   // between min and max particles, and reallocating would make the process's
   // memory swing with it (and allocate on the update path). See
@@ -75,7 +75,7 @@ bool sameSensor(const ParticleFilterParams& a, const ParticleFilterParams& b) {
 void ParticleFilter::setParams(const ParticleFilterParams& params) {
   validate(params);
   // Everything that can throw comes before the first change.
-  const OdometryMotionModel motion(params.motion);
+  const OdometryMotionModel motion(params.motion, oneUpdateStep(params));
   std::unique_ptr<SensorModel> model;
   if (sensor_.hasModel() && !sameSensor(params, params_)) {
     // The model holds its parameters and its table of beam likelihoods; the

@@ -13,7 +13,18 @@ GateDecision skipped(SkipReason reason, std::string detail = "") {
   return d;
 }
 
+// An update's step overshoots the threshold by at most what the robot moves
+// between two scans, and the scans come every threshold or more often.
+constexpr double kUpdateStepsPerThreshold = 2.0;
+
 }  // namespace
+
+OneUpdateStep oneUpdateStep(const ParticleFilterParams& params) {
+  OneUpdateStep step;
+  if (params.update_min_d > 0.0) step.distance = kUpdateStepsPerThreshold * params.update_min_d;
+  if (params.update_min_a > 0.0) step.angle = kUpdateStepsPerThreshold * params.update_min_a;
+  return step;
+}
 
 GateDecision UpdateGate::decide(const Pose2& odom, const ScanGroup& scans, const SensorModel* model,
                                 bool initialized, const Pose2& estimate, bool odometry_suspect,

@@ -295,6 +295,70 @@ TEST(ApplyNoisy, OmniSpreadMatchesTheModel) {
   EXPECT_NEAR(0.1, yaw.stddev, 0.005);
 }
 
+// --- a step longer than one update's -----------------------------------------
+
+TEST(ApplyLongStep, ItsNoiseAddsUpLikeThatOfTheUpdatesItSpans) {
+  // amcl's alphas, a 2 m step (a scan 2.5 s after the last at 0.8 m/s) and
+  // one update's step 0.4 m: five updates' noise, variance alpha * 2 * 0.4.
+  OdometryMotionParams params;
+  params.fault_fraction = 0.0;
+  const OdometryMotionModel model(params, {0.4, M_PI / 3});
+  ParticleSet p = manyAt({0, 0, 0}, kSamples);
+  Random random(15);
+  model.apply({0, 0, 0}, {2, 0, 0}, &p, &random);
+  const Stats trans = stats(kSamples, [&](std::size_t i) { return std::hypot(p.x[i], p.y[i]); });
+  const Stats rot1 = stats(kSamples, [&](std::size_t i) { return std::atan2(p.y[i], p.x[i]); });
+  EXPECT_NEAR(std::sqrt(0.2 * 2.0 * 0.4), trans.stddev, 0.01);  // 0.4 m, not 0.89
+  EXPECT_NEAR(std::sqrt(0.2 * 2.0 * 0.4), rot1.stddev, 0.01);   // 0.4 rad, not 0.89
+  // So the particles go nearly as far as the odometry: the direction's
+  // noise costs cos of it, exp(-0.16 / 2) = 0.92 on average, where a
+  // quadratic 0.89 rad left them at exp(-0.8 / 2) = 0.67 of the way.
+  const Stats x = stats(kSamples, [&](std::size_t i) { return p.x[i]; });
+  EXPECT_NEAR(2.0 * std::exp(-0.08), x.mean, 0.01);
+
+  // Turning 1.5 rad in place: 1.5 / (pi / 3) updates' turning.
+  ParticleSet q = manyAt({0, 0, 0}, kSamples);
+  model.apply({0, 0, 0}, {0, 0, 1.5}, &q, &random);
+  const Stats yaw = stats(kSamples, [&](std::size_t i) { return angleDiff(q.yaw[i], 1.5); });
+  const Stats slide = stats(kSamples, [&](std::size_t i) { return q.x[i]; });
+  EXPECT_NEAR(0.0, yaw.mean, 0.01);
+  EXPECT_NEAR(std::sqrt(0.2 * 1.5 * M_PI / 3), yaw.stddev, 0.01);    // 0.56 rad, not 0.67
+  EXPECT_NEAR(std::sqrt(0.2 * 1.5 * M_PI / 3), slide.stddev, 0.01);  // alpha4: the same here
+}
+
+TEST(ApplyLongStep, StepsUpToOneUpdatesAreTheTextbooksDrawForDraw) {
+  OdometryMotionParams params;
+  params.fault_fraction = 0.03;
+  const OdometryMotionModel textbook(params), spanned(params, {0.4, M_PI / 3});
+  for (const Pose2& to :
+       {Pose2{0.4, 0.0, 0.2}, Pose2{-0.3, 0.1, -1.0}, Pose2{0.0, 0.0, M_PI / 3}}) {
+    ParticleSet a = manyAt({1, 2, 3}, 1000), b = a;
+    Random ra(16), rb(16);
+    textbook.apply({0, 0, 0}, to, &a, &ra);
+    spanned.apply({0, 0, 0}, to, &b, &rb);
+    EXPECT_EQ(a.x, b.x);
+    EXPECT_EQ(a.y, b.y);
+    EXPECT_EQ(a.yaw, b.yaw);
+  }
+}
+
+TEST(ApplyLongStep, OmniToo) {
+  OdometryMotionParams params = noisy();
+  params.kind = OdometryMotionParams::Kind::kOmni;
+  const OdometryMotionModel model(params, {0.5, M_PI / 3});
+  ParticleSet p = manyAt({0, 0, 0}, kSamples);
+  Random random(17);
+  model.apply({0, 0, 0}, {2, 0, 0}, &p, &random);
+  // Forward sqrt(alpha3 * 2 * 0.5) = 0.2, strafe sqrt(alpha5 * 1) = 0.3.
+  EXPECT_NEAR(0.2, stats(kSamples, [&](std::size_t i) { return p.x[i]; }).stddev, 0.01);
+  EXPECT_NEAR(0.3, stats(kSamples, [&](std::size_t i) { return p.y[i]; }).stddev, 0.015);
+}
+
+TEST(ApplyLongStep, RefusesAStepThatIsNotPositive) {
+  EXPECT_THROW(OdometryMotionModel(OdometryMotionParams{}, {0.0, 1.0}), std::invalid_argument);
+  EXPECT_THROW(OdometryMotionModel(OdometryMotionParams{}, {1.0, -1.0}), std::invalid_argument);
+}
+
 // The fault mixture: with noise-free alphas, a particle either moves exactly
 // by the odometry, or (the faulty share) exactly the reverse, or stalls
 // within +-fault_margin, in equal halves of the faulty share.

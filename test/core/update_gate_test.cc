@@ -32,6 +32,16 @@ class UpdateGateTest : public ::testing::Test {
   UpdateGate gate_;
 };
 
+TEST(OneUpdateStep, IsTwiceTheThresholdsAndUnboundedWithout) {
+  ParticleFilterParams params;  // 0.2 m, pi / 6
+  EXPECT_DOUBLE_EQ(0.4, oneUpdateStep(params).distance);
+  EXPECT_DOUBLE_EQ(M_PI / 3, oneUpdateStep(params).angle);
+  params.update_min_d = 0.0;  // every scan updates
+  params.update_min_a = 0.0;
+  EXPECT_EQ(std::numeric_limits<double>::infinity(), oneUpdateStep(params).distance);
+  EXPECT_EQ(std::numeric_limits<double>::infinity(), oneUpdateStep(params).angle);
+}
+
 TEST_F(UpdateGateTest, InputChecksComeFirstAndSayWhich) {
   const LaserScan scan = castScan(grid_, kTruth);
   EXPECT_EQ(SkipReason::kNoMap,

@@ -14,7 +14,8 @@ namespace pf {
 class MotionUpdate {
  public:
   /// Throws std::invalid_argument as OdometryMotionModel does.
-  explicit MotionUpdate(const OdometryMotionParams& params) : model_(params) {}
+  MotionUpdate(const OdometryMotionParams& params, const OneUpdateStep& update_step)
+      : model_(params, update_step) {}
 
   /// Replaces the model (new parameters); the fault share is kept within
   /// the new bounds.

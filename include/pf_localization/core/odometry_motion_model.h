@@ -12,6 +12,15 @@
 // rotation noise uses the smaller of |rot1| and |pi - rot1|; and for tiny
 // translations the direction of travel is meaningless, so rot1 is taken as 0.
 //
+// One filter update's step: the alphas describe the noise of the step one
+// update makes, as in amcl, whose updates come every update_min_d of travel.
+// A longer step (scans far apart) stands for several updates, and its
+// variance adds up as theirs would, linearly in its length, instead of with
+// its square: each v^2 above becomes v * min(v, one update's v). Left
+// quadratic, a long step's direction of travel is so noisy that the
+// particles fall short of the odometry on average, and along a corridor the
+// cloud falls behind the robot (docs/design.md, "A long step's noise").
+//
 // Omnidirectional: the step is a translation in the robot frame (forward and
 // strafe) plus a rotation, with amcl's omni convention for the alphas:
 //   trans:  sqrt(alpha3 * trans^2 + alpha1 * rot^2)
@@ -43,6 +52,7 @@
 #pragma once
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "pf_localization/core/parameter_table.h"
@@ -80,6 +90,14 @@ struct OdometryMotionParams {
   double fault_margin = 0.1;
 };
 
+/// The longest step one filter update makes (see above): steps up to it have
+/// the alphas' noise; longer ones, that of the updates they span. Infinite:
+/// every step is one update's (the textbook model).
+struct OneUpdateStep {
+  double distance = std::numeric_limits<double>::infinity();  // m
+  double angle = std::numeric_limits<double>::infinity();     // rad
+};
+
 /// The parameters of OdometryMotionParams (parameter_table.h).
 const ParameterTable<OdometryMotionParams>& odometryMotionParameters();
 
@@ -95,10 +113,12 @@ struct OdometryStep {
 
 class OdometryMotionModel {
  public:
-  /// Throws std::invalid_argument (see validate()).
-  explicit OdometryMotionModel(const OdometryMotionParams& params);
+  /// Throws std::invalid_argument (see validate(), and a non-positive step).
+  explicit OdometryMotionModel(const OdometryMotionParams& params,
+                               const OneUpdateStep& update_step = {});
 
   const OdometryMotionParams& params() const { return params_; }
+  const OneUpdateStep& updateStep() const { return update_step_; }
 
   /// Decomposes the odometry motion from `from` to `to` (both in the odom frame).
   static OdometryStep decompose(const Pose2& from, const Pose2& to);
@@ -121,6 +141,7 @@ class OdometryMotionModel {
                  BlockStreams* random, uint8_t* faulty, int threads) const;
 
   OdometryMotionParams params_;
+  OneUpdateStep update_step_;
 };
 
 }  // namespace pf

@@ -28,6 +28,14 @@
 
 namespace pf {
 
+/// The longest step one update makes while the scans come often enough for
+/// the gate (odometry_motion_model.h): twice update_min_d and update_min_a.
+/// A scan arrives before the robot has gone the threshold again, so an
+/// update's step is at most twice it unless the robot moved more than the
+/// threshold between two scans. Infinite for a threshold of 0 (every scan
+/// updates: nothing says how long an update's step is).
+OneUpdateStep oneUpdateStep(const ParticleFilterParams& params);
+
 /// What UpdateGate::decide found.
 struct GateDecision {
   SkipReason skip = SkipReason::kNone;  // kNone: the update runs
