@@ -118,7 +118,6 @@ class OdometryMotionModel {
                                const OneUpdateStep& update_step = {});
 
   const OdometryMotionParams& params() const { return params_; }
-  const OneUpdateStep& updateStep() const { return update_step_; }
 
   /// Decomposes the odometry motion from `from` to `to` (both in the odom frame).
   static OdometryStep decompose(const Pose2& from, const Pose2& to);
