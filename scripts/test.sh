@@ -144,10 +144,13 @@ check "warehouse global localization, 1M particles: never localized wrong, the t
 # below the usual one too before a better look-alike got a copy of the
 # cloud, seeds 4 and 8 were localized only at 45.9 and 44.3 s. And the
 # published covariance covers the look-alikes until a scan tells the place
-# apart (ConfidenceTracker::coverLookAlikes): each seed has at least 70 % of
-# the reference poses inside its 95 % ellipse and a NEES mean of at most 10;
-# while it was one aisle's, 33-77 % and up to 8e5 (7 seeds over 3e4), the
-# cloud alone in a wrong twin aisle saying 1 cm. About 30 s.
+# apart (ConfidenceTracker::coverLookAlikes), and the map's error once it is
+# told apart (ScanRefiner::mapErrorCovariance): each seed has 85-99 % of the
+# reference poses inside its 95 % ellipse (90.4-93.4 % today) and a NEES
+# mean of at most 5 (2.2-2.8). While it was one aisle's, 33-77 % and up to
+# 8e5 (7 seeds over 3e4), the cloud alone in a wrong twin aisle saying 1 cm;
+# without the map's error, 72-77 %, the simulator's walls half a cell nearer
+# than the map's and the fit saying 1 cm. About 30 s.
 warehouse_global_default() {
   local out="$ws/warehouse_global_default"
   warehouse_seeds "$out" bags/warehouse_global.bag || return 1
@@ -170,11 +173,11 @@ inside = [d['covariance']['inside_95_percent'] for d in runs]
 nees = [d['covariance']['nees_mean'] for d in runs]
 print('warehouse_global.bag, 50 000 particles, seeds 1-10: %d updates confidently wrong, the truth '
       'among the hypotheses in %.2f %% of %d (missed: %s), localized at %s s (bound %.1f s); '
-      'inside the published 95 %% ellipse %.1f-%.1f %% (bound 70), NEES mean %.2f-%.2f (bound 10)'
+      'inside the published 95 %% ellipse %.1f-%.1f %% (bounds 85-99), NEES mean %.2f-%.2f (bound 5)'
       % (wrong, 100 * listed / updates, updates, '; '.join(misses) or 'none',
          ', '.join('%.1f' % t for t in localized), BY, min(inside), max(inside), min(nees), max(nees)))
 sys.exit(0 if wrong == 0 and listed >= 0.999 * updates and max(localized) <= BY
-         and min(inside) >= 70 and max(nees) <= 10 else 1)
+         and min(inside) >= 85 and max(inside) <= 99 and max(nees) <= 5 else 1)
 PY
 }
 check "warehouse global localization, default budget, 10 seeds: never localized wrong, the truth listed, localized by 44.1 s, an honest covariance" warehouse_global_default

@@ -36,6 +36,9 @@ class BicubicDistanceField {
   /// with a zero gradient.
   FieldSample sample(double wx, double wy) const;
 
+  /// m: the map's cell size.
+  double resolution() const { return 1.0 / inv_resolution_; }
+
  private:
   const LikelihoodField& field_;
   // The grid's geometry, taken once: sample() runs for every beam of every

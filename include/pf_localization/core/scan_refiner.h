@@ -33,6 +33,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Eigenvalues>
 #include <optional>
 #include <string>
 
@@ -106,8 +107,9 @@ struct ScanRefinement {
   std::string rejection_detail;                    // the figures behind it, for the log
   Pose2 pose;                                      // the refined pose when accepted, else the start
   // The fit's covariance (x, y, yaw): the residual variance times the
-  // inverse Hessian, widened for the beams' correlation (scan_refiner.cc,
-  // kIndependentBeams); zero in the directions the scan does not constrain.
+  // inverse Hessian, widened for the beams' correlation, plus the error of
+  // the map's walls, one offset per wall (scan_refiner.cc, kIndependentBeams,
+  // mapErrorCovariance); zero in the directions the scan does not constrain.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   int iterations = 0;
   int matched_beams = 0;      // ending within outlier_distance, at the final pose
@@ -150,6 +152,13 @@ class ScanRefiner {
                const Eigen::Matrix3d& prior_information, Pose2* fitted,
                Evaluation* fitted_evaluation) const;
 
+  // The pose's covariance from the map's error: every wall the beams end on
+  // (a run of beams along one line of the map) is drawn with an offset of
+  // its own, uniform over a cell, shared by all its beams. `eig`: the scan's
+  // Hessian at `pose`, the fitted one.
+  Eigen::Matrix3d mapErrorCovariance(
+      const PreparedScan& scan, const Pose2& pose,
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& eig) const;
   BicubicDistanceField field_;
   ScanRefinerParams params_;
 };
