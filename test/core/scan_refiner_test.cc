@@ -144,9 +144,9 @@ TEST(ScanRefiner, AFitThatMovesTooFarIsRejected) {
   EXPECT_NEAR(0.05, std::fabs(r.rotation), 1e-3);
 }
 
-TEST(ScanRefiner, AlongAFeaturelessCorridorTheStartIsKept) {
-  // Two walls 0.8 m apart, open at both ends: the scan says nothing about x.
-  const OccupancyGrid grid = test::gridFromRows(
+// Two walls 0.8 m apart, open at both ends.
+OccupancyGrid corridorGrid() {
+  return test::gridFromRows(
       {
           "##############################",  //
           "..............................",  //
@@ -159,6 +159,11 @@ TEST(ScanRefiner, AlongAFeaturelessCorridorTheStartIsKept) {
           "##############################",  //
       },
       kCell);
+}
+
+TEST(ScanRefiner, AlongAFeaturelessCorridorTheStartIsKept) {
+  // The scan says nothing about x.
+  const OccupancyGrid grid = corridorGrid();
   const LikelihoodField field(grid, 2.0);
   const Pose2 truth{1.5, 0.42, 0.0};
   // Only cells well inside the map, so that no stencil sees past its ends.
@@ -174,8 +179,8 @@ TEST(ScanRefiner, AlongAFeaturelessCorridorTheStartIsKept) {
   EXPECT_GT(r.covariance(1, 1), 0.0);
 }
 
-// Two walls 0.8 m apart, open at both ends; the scan sees `per_cell` end
-// points on every cell of their middle.
+// corridorGrid() seen from `truth`, with `per_cell` end points on every cell
+// of its walls' middle.
 PreparedScan corridorScan(const OccupancyGrid& grid, const Pose2& truth, int per_cell) {
   const PreparedScan cells = scanOfObstacles(grid, truth, 6);
   PreparedScan scan;
@@ -192,19 +197,7 @@ PreparedScan corridorScan(const OccupancyGrid& grid, const Pose2& truth, int per
 }
 
 TEST(ScanRefiner, MoreBeamsOfTheSameWallsDoNotNarrowTheCovarianceBelowTheMapsError) {
-  const OccupancyGrid grid = test::gridFromRows(
-      {
-          "##############################",  //
-          "..............................",  //
-          "..............................",  //
-          "..............................",  //
-          "..............................",  //
-          "..............................",  //
-          "..............................",  //
-          "..............................",  //
-          "##############################",  //
-      },
-      kCell);
+  const OccupancyGrid grid = corridorGrid();
   const LikelihoodField field(grid, 2.0);
   const ScanRefiner refiner(field, ScanRefinerParams());
   const Pose2 truth{1.5, 0.42, 0.0};
