@@ -217,6 +217,38 @@ TEST(ScanRefiner, MoreBeamsOfTheSameWallsDoNotNarrowTheCovarianceBelowTheMapsErr
   }
 }
 
+TEST(ScanRefiner, AtACornerEachWallHasItsOwnOffset) {
+  // A wall along the bottom pins y, one along the left pins x: each axis
+  // rests on one wall's offset, std dev cell / sqrt(12) = 0.029 m, where
+  // taking the two walls' beams as one wall, or every beam as its own,
+  // would say otherwise.
+  const OccupancyGrid grid = test::gridFromRows(
+      {
+          "#...............",  //
+          "#...............",  //
+          "#...............",  //
+          "#...............",  //
+          "#...............",  //
+          "#...............",  //
+          "#...............",  //
+          "#...............",  //
+          "################",  //
+      },
+      kCell);
+  const LikelihoodField field(grid, 2.0);
+  const Pose2 truth{0.62, 0.47, 0.0};
+  const ScanRefinement r =
+      ScanRefiner(field, ScanRefinerParams()).refine(scanOfObstacles(grid, truth), truth);
+  ASSERT_TRUE(r.accepted) << r.rejection_detail;
+  const double wall_std = kCell / std::sqrt(12.0);
+  EXPECT_GT(std::sqrt(r.covariance(0, 0)), 0.9 * wall_std);
+  EXPECT_LT(std::sqrt(r.covariance(0, 0)), 1.2 * wall_std);
+  EXPECT_GT(std::sqrt(r.covariance(1, 1)), 0.9 * wall_std);
+  EXPECT_LT(std::sqrt(r.covariance(1, 1)), 1.2 * wall_std);
+  // Two offsets drawn apart: x and y do not err together.
+  EXPECT_LT(std::fabs(r.covariance(0, 1)), 0.2 * wall_std * wall_std);
+}
+
 TEST(ScanRefiner, InvalidParametersAreNamed) {
   const auto what = [](void (*change)(ScanRefinerParams&)) {
     ScanRefinerParams p;
