@@ -176,6 +176,23 @@ Eigen::Matrix3d priorInformation(const std::optional<Eigen::Matrix3d>& prior_cov
   return prior_information;
 }
 
+// The inverse of the scan's Hessian (eigen-decomposed in `eig`) on the
+// directions it constrains (an eigenvalue at least `degeneracy_ratio` of the
+// largest), zero on the others; `rank`: how many it constrains.
+Eigen::Matrix3d constrainedInverse(const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& eig,
+                                   double degeneracy_ratio, int* rank) {
+  const Eigen::Vector3d lambda = eig.eigenvalues();
+  Eigen::Matrix3d inverse = Eigen::Matrix3d::Zero();
+  *rank = 0;
+  for (int i = 0; i < 3; ++i) {
+    if (lambda(i) < degeneracy_ratio * lambda(2)) continue;
+    const Eigen::Vector3d v = eig.eigenvectors().col(i);
+    inverse += v * v.transpose() / lambda(i);
+    ++*rank;
+  }
+  return inverse;
+}
+
 // The fit's covariance: the residual variance per unit weight (with the
 // fitted degrees of freedom taken off, floored by the map's own precision)
 // times the pseudo-inverse of the scan's Hessian (eigen-decomposed in
@@ -184,15 +201,8 @@ Eigen::Matrix3d priorInformation(const std::optional<Eigen::Matrix3d>& prior_cov
 Eigen::Matrix3d fitCovariance(const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& eig,
                               double sum_weight, double sum_weighted_sq,
                               const ScanRefinerParams& params) {
-  const Eigen::Vector3d lambda = eig.eigenvalues();
   int rank = 0;
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (int i = 0; i < 3; ++i) {
-    if (lambda(i) < params.degeneracy_ratio * lambda(2)) continue;
-    const Eigen::Vector3d v = eig.eigenvectors().col(i);
-    cov += v * v.transpose() / lambda(i);
-    ++rank;
-  }
+  Eigen::Matrix3d cov = constrainedInverse(eig, params.degeneracy_ratio, &rank);
   const double dof = std::max(1.0, sum_weight - rank);
   const double variance =
       std::max(params.min_beam_std * params.min_beam_std, sum_weighted_sq / dof);
@@ -211,20 +221,15 @@ Eigen::Matrix3d ScanRefiner::mapErrorCovariance(
   // The fitted pose moves by H^+ J^T W dr for residual changes dr (the
   // Gauss-Newton step, on the constrained directions only); a wall's offset
   // changes the residuals of all its beams at once.
-  const Eigen::Vector3d lambda = eig.eigenvalues();
-  Eigen::Matrix3d h_inverse = Eigen::Matrix3d::Zero();
-  for (int i = 0; i < 3; ++i) {
-    if (lambda(i) < params_.degeneracy_ratio * lambda(2)) continue;
-    const Eigen::Vector3d v = eig.eigenvectors().col(i);
-    h_inverse += v * v.transpose() / lambda(i);
-  }
+  int rank = 0;
+  const Eigen::Matrix3d h_inverse = constrainedInverse(eig, params_.degeneracy_ratio, &rank);
   const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
   const double k2 = params_.cauchy_scale * params_.cauchy_scale;
   const double resolution = field_.resolution();
   const double cos_wall_turn = std::cos(kWallTurn);
   Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
-  Eigen::Vector3d wall =
-      Eigen::Vector3d::Zero();  // the pose's move per metre of this wall's offset
+  // The pose's move per metre of the current wall's offset.
+  Eigen::Vector3d wall = Eigen::Vector3d::Zero();
   bool on_wall = false;
   double normal_x = 0.0, normal_y = 0.0, last_x = 0.0, last_y = 0.0;
   const auto closeWall = [&] {
