@@ -118,36 +118,63 @@ struct ScanRefiner::Evaluation {
 ScanRefiner::ScanRefiner(const LikelihoodField& field, const ScanRefinerParams& params)
     : field_(field), params_((validate(params), params)) {}
 
+// One matched beam, as ScanRefiner::forEachBeam gives it.
+struct ScanRefiner::MatchedBeam {
+  FieldSample f;  // the field at the end point
+  double px, py;  // the end point in the robot frame
+  double mx, my;  // the end point on the map
+  double c, s;    // the pose's cos and sin of yaw
+  double r;       // residual: distance to the wall's line (wall_offset off)
+  double q;       // 1 + r^2 / cauchy_scale^2
+  double w;       // the Cauchy weight, rho'(r^2 / 2) = 1 / q
+};
+
+template <typename Matched, typename Outlier>
+void ScanRefiner::forEachBeam(const PreparedScan& scan, const Pose2& pose, Matched&& matched,
+                              Outlier&& outlier) const {
+  MatchedBeam beam;
+  beam.c = std::cos(pose.yaw);
+  beam.s = std::sin(pose.yaw);
+  const double k2 = params_.cauchy_scale * params_.cauchy_scale;
+  for (std::size_t b = 0; b < scan.size(); ++b) {
+    beam.px = scan.x[b];
+    beam.py = scan.y[b];
+    beam.mx = pose.x + beam.c * beam.px - beam.s * beam.py;
+    beam.my = pose.y + beam.s * beam.px + beam.c * beam.py;
+    beam.f = field_.sample(beam.mx, beam.my);
+    if (!(beam.f.distance < params_.outlier_distance)) {
+      outlier();
+      continue;
+    }
+    beam.r = beam.f.distance - params_.wall_offset;
+    beam.q = 1.0 + beam.r * beam.r / k2;
+    beam.w = 1.0 / beam.q;
+    matched(static_cast<const MatchedBeam&>(beam));
+  }
+}
+
 ScanRefiner::Evaluation ScanRefiner::evaluate(const PreparedScan& scan, const Pose2& pose,
                                               bool with_derivatives) const {
   Evaluation e;
-  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
   const double k2 = params_.cauchy_scale * params_.cauchy_scale;
   const double truncated = params_.outlier_distance - params_.wall_offset;
   const double outlier_cost = 0.5 * k2 * std::log1p(truncated * truncated / k2);
-  for (std::size_t b = 0; b < scan.size(); ++b) {
-    const double px = scan.x[b], py = scan.y[b];
-    const double mx = pose.x + c * px - s * py, my = pose.y + s * px + c * py;
-    const FieldSample f = field_.sample(mx, my);
-    if (!(f.distance < params_.outlier_distance)) {
+  forEachBeam(
+      scan, pose,
+      [&](const MatchedBeam& beam) {
+        e.cost += 0.5 * k2 * std::log(beam.q);
+        ++e.matched;
+        e.sum_weight += beam.w;
+        e.sum_weighted_sq += beam.w * beam.r * beam.r;
+        e.sum_sq += beam.r * beam.r;
+        if (!with_derivatives) return;
+        const Eigen::Vector3d j = beamJacobian(beam.f, beam.px, beam.py, beam.c, beam.s);
+        e.hessian.noalias() += beam.w * j * j.transpose();
+        e.gradient.noalias() += beam.w * beam.r * j;
+      },
       // Constant beyond the truncation, so the cost stays continuous as
       // beams come and go.
-      e.cost += outlier_cost;
-      continue;
-    }
-    const double r = f.distance - params_.wall_offset;
-    const double q = 1.0 + r * r / k2;
-    e.cost += 0.5 * k2 * std::log(q);
-    ++e.matched;
-    const double w = 1.0 / q;  // Cauchy: rho'(r^2 / 2)
-    e.sum_weight += w;
-    e.sum_weighted_sq += w * r * r;
-    e.sum_sq += r * r;
-    if (!with_derivatives) continue;
-    const Eigen::Vector3d j = beamJacobian(f, px, py, c, s);
-    e.hessian.noalias() += w * j * j.transpose();
-    e.gradient.noalias() += w * r * j;
-  }
+      [&] { e.cost += outlier_cost; });
   return e;
 }
 
@@ -178,18 +205,19 @@ Eigen::Matrix3d priorInformation(const std::optional<Eigen::Matrix3d>& prior_cov
 
 // The inverse of the scan's Hessian (eigen-decomposed in `eig`) on the
 // directions it constrains (an eigenvalue at least `degeneracy_ratio` of the
-// largest), zero on the others; `rank`: how many it constrains.
+// largest), zero on the others; `rank` (unless null): how many it constrains.
 Eigen::Matrix3d constrainedInverse(const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& eig,
-                                   double degeneracy_ratio, int* rank) {
+                                   double degeneracy_ratio, int* rank = nullptr) {
   const Eigen::Vector3d lambda = eig.eigenvalues();
   Eigen::Matrix3d inverse = Eigen::Matrix3d::Zero();
-  *rank = 0;
+  int constrained = 0;
   for (int i = 0; i < 3; ++i) {
     if (lambda(i) < degeneracy_ratio * lambda(2)) continue;
     const Eigen::Vector3d v = eig.eigenvectors().col(i);
     inverse += v * v.transpose() / lambda(i);
-    ++*rank;
+    ++constrained;
   }
+  if (rank) *rank = constrained;
   return inverse;
 }
 
@@ -221,10 +249,7 @@ Eigen::Matrix3d ScanRefiner::mapErrorCovariance(
   // The fitted pose moves by H^+ J^T W dr for residual changes dr (the
   // Gauss-Newton step, on the constrained directions only); a wall's offset
   // changes the residuals of all its beams at once.
-  int rank = 0;
-  const Eigen::Matrix3d h_inverse = constrainedInverse(eig, params_.degeneracy_ratio, &rank);
-  const double c = std::cos(pose.yaw), s = std::sin(pose.yaw);
-  const double k2 = params_.cauchy_scale * params_.cauchy_scale;
+  const Eigen::Matrix3d h_inverse = constrainedInverse(eig, params_.degeneracy_ratio);
   const double resolution = field_.resolution();
   const double cos_wall_turn = std::cos(kWallTurn);
   Eigen::Matrix3d sum = Eigen::Matrix3d::Zero();
@@ -236,33 +261,32 @@ Eigen::Matrix3d ScanRefiner::mapErrorCovariance(
     sum.noalias() += wall * wall.transpose();
     wall.setZero();
   };
-  for (std::size_t b = 0; b < scan.size(); ++b) {
-    const double px = scan.x[b], py = scan.y[b];
-    const double mx = pose.x + c * px - s * py, my = pose.y + s * px + c * py;
-    const FieldSample f = field_.sample(mx, my);
-    if (!(f.distance < params_.outlier_distance)) {  // no wall: the one before ends
-      if (on_wall) closeWall();
-      on_wall = false;
-      continue;
-    }
-    const double norm = std::hypot(f.dx, f.dy);
-    const double nx = norm > 0.0 ? f.dx / norm : 0.0, ny = norm > 0.0 ? f.dy / norm : 0.0;
-    if (on_wall && (nx * normal_x + ny * normal_y < cos_wall_turn ||
-                    std::fabs(nx * (mx - last_x) + ny * (my - last_y)) > resolution)) {
-      closeWall();
-    }
-    on_wall = true;
-    normal_x = nx;
-    normal_y = ny;
-    last_x = mx;
-    last_y = my;
-    const double r = f.distance - params_.wall_offset;
-    const double w = 1.0 / (1.0 + r * r / k2);  // the Cauchy weight, as in evaluate()
-    // Moving the wall by o moves the field with it: the residual changes by
-    // o times the field's slope there (below 1 on the wall's line, where the
-    // interpolated distance bottoms out).
-    wall.noalias() += h_inverse * (w * norm * beamJacobian(f, px, py, c, s));
-  }
+  forEachBeam(
+      scan, pose,
+      [&](const MatchedBeam& beam) {
+        const double norm = std::hypot(beam.f.dx, beam.f.dy);
+        const double nx = norm > 0.0 ? beam.f.dx / norm : 0.0;
+        const double ny = norm > 0.0 ? beam.f.dy / norm : 0.0;
+        if (on_wall &&
+            (nx * normal_x + ny * normal_y < cos_wall_turn ||
+             std::fabs(nx * (beam.mx - last_x) + ny * (beam.my - last_y)) > resolution)) {
+          closeWall();
+        }
+        on_wall = true;
+        normal_x = nx;
+        normal_y = ny;
+        last_x = beam.mx;
+        last_y = beam.my;
+        // Moving the wall by o moves the field with it: the residual changes
+        // by o times the field's slope there (below 1 on the wall's line,
+        // where the interpolated distance bottoms out).
+        wall.noalias() +=
+            h_inverse * (beam.w * norm * beamJacobian(beam.f, beam.px, beam.py, beam.c, beam.s));
+      },
+      [&] {  // no wall: the one before ends
+        if (on_wall) closeWall();
+        on_wall = false;
+      });
   if (on_wall) closeWall();
   Eigen::Matrix3d cov = sum * (resolution * resolution / 12.0);
   // Back from the scaled yaw.

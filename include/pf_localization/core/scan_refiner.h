@@ -141,6 +141,13 @@ class ScanRefiner {
 
  private:
   struct Evaluation;
+  struct MatchedBeam;
+  /// Visits the beams of `scan` at `pose` in scan order: matched(beam) for
+  /// each that ends within outlier_distance of a mapped obstacle, with its
+  /// residual and Cauchy weight; outlier() for each other one.
+  template <typename Matched, typename Outlier>
+  void forEachBeam(const PreparedScan& scan, const Pose2& pose, Matched&& matched,
+                   Outlier&& outlier) const;
   Evaluation evaluate(const PreparedScan& scan, const Pose2& pose, bool with_derivatives) const;
   /// The scan's cost over beam_std^2 plus the prior's, at `at`.
   double totalCost(const Evaluation& e, const Pose2& at, const Pose2& start,
