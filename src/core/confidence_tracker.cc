@@ -1,9 +1,11 @@
 #include "pf_localization/core/confidence_tracker.h"
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "pf_localization/core/hypotheses.h"
+#include "pf_localization/core/new_view.h"
 #include "pf_localization/core/scan_refiner.h"
 
 namespace pf {
@@ -82,11 +84,14 @@ void ConfidenceTracker::addFit(const Eigen::Matrix3d& fit_covariance) {
                                : fusedCovariance(fit_covariance, confidence_.covariance);
 }
 
-void ConfidenceTracker::demoteAfterLowFit(int low_fit_updates, int patience) {
-  if (confidence_.state == LocalizationState::kLocalized && low_fit_updates > patience) {
+void ConfidenceTracker::demoteAfterLowFit(double low_fit_views, int patience) {
+  if (confidence_.state == LocalizationState::kLocalized &&
+      low_fit_views > patience + kViewRounding) {
     confidence_.state = LocalizationState::kUncertain;
-    confidence_.reason = "the scans have fitted worse than usual for " +
-                         std::to_string(low_fit_updates) + " updates";
+    char views[32];
+    std::snprintf(views, sizeof(views), "%.3g", low_fit_views);
+    confidence_.reason =
+        std::string("the scans have fitted worse than usual for ") + views + " views";
   }
 }
 

@@ -1,6 +1,7 @@
 #include "pf_localization/core/odometry_fault_tracker.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "pf_localization/core/particle_blocks.h"
 #include "pf_localization/core/prefault.h"
@@ -12,6 +13,9 @@ namespace {
 // returns to the floor. 0 forgot a reversal as soon as it was found (the
 // faulty particles winning 95 % of the weight gave a share of 0.37).
 constexpr double kFaultMemory = 0.5;
+// The largest evidence ratio (its log) a partial view's scan is raised to:
+// far beyond what moves a posterior, well within a double.
+constexpr double kMaxLogRatio = 300.0;
 
 }  // namespace
 
@@ -20,7 +24,10 @@ void OdometryFaultTracker::clampTo(const OdometryMotionParams& params) {
 }
 
 void OdometryFaultTracker::adapt(const std::vector<double>& weights,
-                                 const OdometryMotionParams& params, int threads) {
+                                 const OdometryMotionParams& params, int threads,
+                                 double view_share) {
+  // Without a new view (a robot standing still) the scan says nothing new.
+  if (view_share <= 0.0) return;
   const double share = sumBlocks(weights.size(), threads,
                                  [&](std::size_t i) { return faulty_[i] ? weights[i] : 0.0; });
   // The scan's evidence for a fault: how much more weight per particle the
@@ -33,10 +40,16 @@ void OdometryFaultTracker::adapt(const std::vector<double>& weights,
     fraction_ = std::clamp(share, floor, params.fault_fraction_max);
     return;
   }
-  const double ratio = (share / prior) / std::max(1e-300, (1.0 - share) / (1.0 - prior));
+  double ratio = (share / prior) / std::max(1e-300, (1.0 - share) / (1.0 - prior));
   // Faults come in runs: the belief before this scan is the last one, half
   // way back to the floor, so that without evidence it decays.
-  const double belief = floor + kFaultMemory * (prior - floor);
+  double memory = kFaultMemory;
+  if (view_share > 0.0 && view_share < 1.0) {
+    // In log space: a tiny share would raise the ratio beyond a double.
+    ratio = std::exp(std::clamp(std::log(ratio) / view_share, -kMaxLogRatio, kMaxLogRatio));
+    memory = std::pow(kFaultMemory, view_share);
+  }
+  const double belief = floor + memory * (prior - floor);
   const double posterior = belief * ratio / (belief * ratio + (1.0 - belief));
   fraction_ = std::clamp(posterior, floor, params.fault_fraction_max);
 }

@@ -20,8 +20,14 @@ constexpr double kMinTranslationForHeading = 0.01;
 constexpr std::size_t kMotionChunk = 1024;
 
 // v^2 for a step of v up to one update's `one`; beyond it, the sum of the
-// squares of the v / one updates of length `one` the step stands for.
-double spanSquare(double v, double one) { return v * std::min(v, one); }
+// squares of the v / one updates of length `one` the step stands for. In an
+// update that brings part of a view (`view`: the view's size, 0 for a whole
+// view), a component shorter than the view has v * view, its share of one
+// view's variance, so that the partial updates of a view add up to at least
+// the noise of the one update they replace.
+double spanSquare(double v, double one, double view) {
+  return v * std::min(std::max(v, view), std::max(one, view));
+}
 
 // A rotation of nearly pi before a straight move is a robot reversing, not
 // turning around: its noise must be that of the small angle it really turned.
@@ -149,34 +155,38 @@ void OdometryMotionModel::apply(const Pose2& from, const Pose2& to, ParticleSet*
 
 void OdometryMotionModel::apply(const Pose2& from, const Pose2& to, double fault_fraction,
                                 ParticleSet* particles, Random* random,
-                                std::vector<uint8_t>* faulty, int threads) const {
+                                std::vector<uint8_t>* faulty, int threads,
+                                double view_share) const {
   thread_local std::vector<uint8_t> unused;
   std::vector<uint8_t>* flags = faulty != nullptr ? faulty : &unused;
   flags->resize(particles->size());
   BlockStreams& streams = threadScratch<BlockStreams>();
   streams.reset(particles->size(), random);
   if (params_.kind == OdometryMotionParams::Kind::kOmni) {
-    applyOmni(from, to, fault_fraction, particles, &streams, flags->data(), threads);
+    applyOmni(from, to, fault_fraction, view_share, particles, &streams, flags->data(), threads);
   } else {
-    applyDifferential(from, to, fault_fraction, particles, &streams, flags->data(), threads);
+    applyDifferential(from, to, fault_fraction, view_share, particles, &streams, flags->data(),
+                      threads);
   }
 }
 
 void OdometryMotionModel::applyDifferential(const Pose2& from, const Pose2& to,
-                                            double fault_fraction, ParticleSet* particles,
-                                            BlockStreams* streams, uint8_t* faulty,
-                                            int threads) const {
+                                            double fault_fraction, double view_share,
+                                            ParticleSet* particles, BlockStreams* streams,
+                                            uint8_t* faulty, int threads) const {
   const OdometryStep step = decompose(from, to);
-  const double rot1_2 = spanSquare(rotationMagnitude(step.rot1), update_step_.angle);
-  const double rot2_2 = spanSquare(rotationMagnitude(step.rot2), update_step_.angle);
-  const double trans2 = spanSquare(step.trans, update_step_.distance);
+  const bool partial = view_share < 1.0;
+  const double view_angle = partial ? kViewAngle : 0.0;
+  const double view_distance = partial ? kViewDistance : 0.0;
+  const double rot1_2 = spanSquare(rotationMagnitude(step.rot1), update_step_.angle, view_angle);
+  const double rot2_2 = spanSquare(rotationMagnitude(step.rot2), update_step_.angle, view_angle);
+  const double trans2 = spanSquare(step.trans, update_step_.distance, view_distance);
   const DifferentialDraws draws{
-      step,
-      std::sqrt(params_.alpha1 * rot1_2 + params_.alpha2 * trans2),
+      step, std::sqrt(params_.alpha1 * rot1_2 + params_.alpha2 * trans2),
       std::sqrt(params_.alpha3 * trans2 + params_.alpha4 * (rot1_2 + rot2_2)),
-      std::sqrt(params_.alpha1 * rot2_2 + params_.alpha2 * trans2),
-      fault_fraction,
-      params_.fault_margin};
+      std::sqrt(params_.alpha1 * rot2_2 + params_.alpha2 * trans2), fault_fraction,
+      // A stalled robot's spread, per view: a share of one covers that share.
+      params_.fault_margin * view_share};
 
   // Two passes per chunk of a block: the random draws, one particle after
   // the other (the random stream is the same as drawing and moving each
@@ -203,8 +213,8 @@ void OdometryMotionModel::applyDifferential(const Pose2& from, const Pose2& to,
 }
 
 void OdometryMotionModel::applyOmni(const Pose2& from, const Pose2& to, double fault_fraction,
-                                    ParticleSet* particles, BlockStreams* streams, uint8_t* faulty,
-                                    int threads) const {
+                                    double view_share, ParticleSet* particles,
+                                    BlockStreams* streams, uint8_t* faulty, int threads) const {
   const double dx = to.x - from.x;
   const double dy = to.y - from.y;
   const double trans = std::hypot(dx, dy);
@@ -212,8 +222,10 @@ void OdometryMotionModel::applyOmni(const Pose2& from, const Pose2& to, double f
   // Direction of travel relative to the heading: omni robots may move sideways.
   const double bearing =
       trans < kMinTranslationForHeading ? 0.0 : angleDiff(std::atan2(dy, dx), from.yaw);
-  const double trans2 = spanSquare(trans, update_step_.distance);
-  const double rot2 = spanSquare(std::fabs(rot), update_step_.angle);
+  const bool partial = view_share < 1.0;
+  const double trans2 = spanSquare(trans, update_step_.distance, partial ? kViewDistance : 0.0);
+  const double rot2 = spanSquare(std::fabs(rot), update_step_.angle, partial ? kViewAngle : 0.0);
+  const double fault_margin = params_.fault_margin * view_share;
   const double sigma_trans = std::sqrt(params_.alpha3 * trans2 + params_.alpha1 * rot2);
   const double sigma_rot = std::sqrt(params_.alpha4 * rot2 + params_.alpha2 * trans2);
   const double sigma_strafe = std::sqrt(params_.alpha1 * rot2 + params_.alpha5 * trans2);
@@ -222,8 +234,8 @@ void OdometryMotionModel::applyOmni(const Pose2& from, const Pose2& to, double f
   forEachBlock(p.size(), threads, [&](std::size_t b, std::size_t begin, std::size_t end) {
     Random random = *streams->stream(b);  // in registers, as in applyDifferential
     for (std::size_t i = begin; i < end; ++i) {
-      const double t = sampleTranslation(trans, sigma_trans, fault_fraction, params_.fault_margin,
-                                         &random, &faulty[i]);
+      const double t =
+          sampleTranslation(trans, sigma_trans, fault_fraction, fault_margin, &random, &faulty[i]);
       const double s = random.gaussian(sigma_strafe);
       const double heading = p.yaw[i] + bearing;
       p.x[i] += t * std::cos(heading) - s * std::sin(heading);

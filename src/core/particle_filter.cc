@@ -236,11 +236,11 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& measured
   std::optional<Pose2> predicted;
   if (gate.from) {
     predicted = compose(refinement_.mapToOdom(estimate_.pose, *gate.from), odom);
-    motion_.apply(*gate.from, odom, &particles_, &random_, threads_);
+    motion_.apply(*gate.from, odom, &particles_, &random_, threads_, gate.view);
   }
-  weigh(*gate.scans, &report);
+  weigh(*gate.scans, gate.view, &report);
   if (gate.from && OdometryFaultTracker::observable(gate.step, params_.motion)) {
-    motion_.faults().adapt(particles_.weight, params_.motion, threads_);
+    motion_.faults().adapt(particles_.weight, params_.motion, threads_, gate.view);
   }
   report.fault_fraction = motion_.faults().fraction();
   report.ess = effectiveSampleSize(particles_.weight, threads_);
@@ -253,7 +253,7 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& measured
       !report.refinement.accepted ||
       pinsAlong(report.refinement.covariance, estimate_.pose.yaw, params_.motion.fault_margin));
   resample(&report);
-  confidence_.demoteAfterLowFit(recovery_.lowFitUpdates(), params_.recovery.patience);
+  confidence_.demoteAfterLowFit(recovery_.lowFitViews(), params_.recovery.patience);
   report.updated = true;
   report.particles = particles_.size();
   return report;
@@ -298,7 +298,8 @@ void ParticleFilter::listLookAlikes(const std::vector<PreparedScan>& scans,
   look_alike_places_.insert(look_alike_places_.end(), around.begin(), around.end());
 }
 
-void ParticleFilter::weigh(const std::vector<PreparedScan>& scans, UpdateReport* report) {
+void ParticleFilter::weigh(const std::vector<PreparedScan>& scans, double view,
+                           UpdateReport* report) {
   const double ess_fraction =
       std::max(temperingEssFraction(confidence_.fitState(), confidence_.confidence(), params_),
                search_.minEssFraction());
@@ -306,12 +307,12 @@ void ParticleFilter::weigh(const std::vector<PreparedScan>& scans, UpdateReport*
       search_.model(sensor_.model(), params_.sensor.sigma_hit, params_.sensor.max_distance, scans,
                     particles_, params_.kld, threads_);
   const Weighing w = sensor_.weigh(smoothed ? *smoothed : sensor_.model(), scans, ess_fraction,
-                                   params_.sensor.likelihood_exponent, &particles_, threads_);
+                                   params_.sensor.likelihood_exponent, &particles_, threads_, view);
   report->search_sigma = search_.sigma();
   report->tempering = w.tempering;
   report->beams_skipped = w.beams_skipped;
   report->mean_beam_likelihood = w.mean_beam_likelihood;
-  recovery_.observe(w.mean_beam_likelihood, params_.recovery);
+  recovery_.observe(w.mean_beam_likelihood, params_.recovery, view);
 }
 
 void ParticleFilter::resample(UpdateReport* report) {

@@ -17,15 +17,17 @@ void AugmentedMclInjection::contribute(const RecoveryContext& context, const Rec
   // one injects anything.
   const double usual = params.trigger_ratio * context.slow;
   const double dip = usual > 0.0 ? std::max(0.0, 1.0 - context.fast / usual) : 0.0;
-  low_fit_updates_ = dip > 0.0 ? low_fit_updates_ + 1 : 0;
+  low_fit_views_ = dip > 0.0 ? low_fit_views_ + context.view : 0.0;
   // The fit sags for a few scans wherever the map is poor, and random
   // guesses then only add rivals; a robot really lost is soon "lost", or
   // stays badly fitted for longer.
   const int patience =
       context.state == LocalizationState::kLocalized ? params.patience_localized : params.patience;
-  const bool patient = context.state != LocalizationState::kLost && low_fit_updates_ <= patience;
+  const bool patient =
+      context.state != LocalizationState::kLost && low_fit_views_ <= patience + kViewRounding;
+  // A view's worth of closer updates injects what one update would.
   if (context.has_free_space && !patient) {
-    plan->inject_probability = std::max(plan->inject_probability, dip);
+    plan->inject_probability = std::max(plan->inject_probability, dip * context.view);
   }
 }
 
@@ -51,16 +53,19 @@ void ExpansionResetting::contribute(const RecoveryContext& context, const Recove
   if (params.expansion_ratio > 0.0 && context.slow_before > 0.0 &&
       context.mean_beam_likelihood < params.expansion_ratio * context.slow_before) {
     plan->spread = true;
+    // The spreads of a view's worth of closer updates add up to one's.
+    plan->spread_scale = std::sqrt(context.view);
   }
 }
 
 void ExpansionResetting::spread(const RecoveryParams& params, std::size_t n, Random* random,
-                                ParticleSet* particles) {
+                                ParticleSet* particles, double scale) {
+  const double std_xy = params.expansion_std_xy * scale;
+  const double std_yaw = params.expansion_std_yaw * scale;
   for (std::size_t i = 0; i < n; ++i) {
-    particles->x[i] += random->gaussian(params.expansion_std_xy);
-    particles->y[i] += random->gaussian(params.expansion_std_xy);
-    particles->yaw[i] =
-        normalizeAngle(particles->yaw[i] + random->gaussian(params.expansion_std_yaw));
+    particles->x[i] += random->gaussian(std_xy);
+    particles->y[i] += random->gaussian(std_xy);
+    particles->yaw[i] = normalizeAngle(particles->yaw[i] + random->gaussian(std_yaw));
   }
 }
 
@@ -97,15 +102,16 @@ void Recovery::restart() {
   expansion_.restart();
 }
 
-void Recovery::observe(double mean_beam_likelihood, const RecoveryParams& params) {
+void Recovery::observe(double mean_beam_likelihood, const RecoveryParams& params, double view) {
   context_.mean_beam_likelihood = mean_beam_likelihood;
+  context_.view = view;
   context_.slow_before = context_.slow;
   if (params.alpha_slow > 0.0) {
     if (context_.slow == 0.0) {
       context_.slow = context_.fast = mean_beam_likelihood;
     } else {
-      context_.slow += params.alpha_slow * (mean_beam_likelihood - context_.slow);
-      context_.fast += params.alpha_fast * (mean_beam_likelihood - context_.fast);
+      context_.slow += view * params.alpha_slow * (mean_beam_likelihood - context_.slow);
+      context_.fast += view * params.alpha_fast * (mean_beam_likelihood - context_.fast);
     }
   }
 }
@@ -148,7 +154,9 @@ ResampleOutcome Recovery::resample(const RecoveryPlan& plan, double ess,
       std::min(max - injected, static_cast<std::size_t>(std::ceil((1.0 - p) * target)));
   systematicResample(*particles, kept, random, &spare_, threads);
   std::swap(*particles, spare_);
-  if (plan.spread) ExpansionResetting::spread(params.recovery, kept, random, particles);
+  if (plan.spread) {
+    ExpansionResetting::spread(params.recovery, kept, random, particles, plan.spread_scale);
+  }
   const std::size_t copied = LookAlikeMove::copy(plan.moves, kept, max - injected, particles);
   out.moved = copied;
   const std::size_t survivors = kept + copied;

@@ -44,18 +44,30 @@ Weighing SensorUpdate::weigh(const SensorModel& model, const PreparedScan& scan,
 
 Weighing SensorUpdate::weigh(const SensorModel& model, const std::vector<PreparedScan>& scans,
                              double min_ess_fraction, double likelihood_exponent,
-                             ParticleSet* particles, int threads) {
+                             ParticleSet* particles, int threads, double evidence_share) {
   const std::size_t beams_counted = groupLogLikelihoods(model, scans, *particles, &log_likelihood_,
                                                         &sensor_log_likelihood_, threads);
   return finish(beamCount(scans), beams_counted, min_ess_fraction, likelihood_exponent, particles,
-                threads);
+                threads, evidence_share);
 }
 
 Weighing SensorUpdate::finish(std::size_t beams, std::size_t beams_counted, double min_ess_fraction,
-                              double likelihood_exponent, ParticleSet* particles, int threads) {
+                              double likelihood_exponent, ParticleSet* particles, int threads,
+                              double evidence_share) {
   Weighing w;
-  w.tempering =
-      applyLikelihood(log_likelihood_, min_ess_fraction, &particles->weight, &scratch_, threads);
+  // A partial view's evidence: the likelihood to the power of its share
+  // (the mean below divides the share out again).
+  double share = 1.0;
+  if (evidence_share < 1.0 && evidence_share > 0.0) {
+    share = evidence_share;
+    for (double& l : log_likelihood_) l *= share;
+  }
+  if (evidence_share > 0.0) {
+    w.tempering = share * applyLikelihood(log_likelihood_, min_ess_fraction, &particles->weight,
+                                          &scratch_, threads);
+  } else {
+    w.tempering = 0.0;  // no new view: the weights stay as they are
+  }
   w.beams_skipped = static_cast<int>(beams - beams_counted);
   // The per-beam geometric mean is independent of the beam count, so
   // comparable across scans and robots. Weighted with the posterior, not the
@@ -63,7 +75,7 @@ Weighing SensorUpdate::finish(std::size_t beams, std::size_t beams_counted, doub
   // are worth, and a cloud salted with random particles is not judged by
   // them. Over the beams the model counted: beam skipping may leave some out.
   const double counted =
-      static_cast<double>(std::max<std::size_t>(beams_counted, 1)) * likelihood_exponent;
+      static_cast<double>(std::max<std::size_t>(beams_counted, 1)) * likelihood_exponent * share;
   w.mean_beam_likelihood = meanBeamLikelihood(particles->weight, log_likelihood_, counted, threads);
   return w;
 }

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <utility>
 
+#include "pf_localization/core/new_view.h"
+
 namespace pf {
 namespace {
 
@@ -45,6 +47,7 @@ GateDecision UpdateGate::decide(const Pose2& odom, const ScanGroup& scans, const
   if (!first) {
     const Pose2 delta = between(*odom_at_update_, odom);
     d.step = std::hypot(delta.x, delta.y);
+    if (!force_ && !odometry_suspect) d.view = newViewShare(delta);
     if (!(d.step <= params.odom_jump_limit)) {
       // Wheels do not carry a robot this far between two scans: moving the
       // particles by it would throw them away.
@@ -66,6 +69,7 @@ GateDecision UpdateGate::decide(const Pose2& odom, const ScanGroup& scans, const
       d.scans = fitDropped(*model, scans, estimate, delta, params);
       if (!d.scans) return skipped(SkipReason::kNotMoved);
       d.fit_dropped = true;
+      d.view = 1.0;
     }
   }
   if (!d.scans) d.scans = prepareScans(*model, scans);

@@ -90,11 +90,22 @@ TEST_F(ConfidenceTrackerTest, ASecondPlaceWithAShareOfTheWeightHoldsThePublished
 
 TEST_F(ConfidenceTrackerTest, AFitBelowTheTriggerForLongerThanPatienceDemotes) {
   assessLocalized();
-  tracker_.demoteAfterLowFit(5, 5);
+  tracker_.demoteAfterLowFit(5.0, 5);
   EXPECT_EQ(LocalizationState::kLocalized, tracker_.confidence().state);
-  tracker_.demoteAfterLowFit(6, 5);
+  tracker_.demoteAfterLowFit(6.0, 5);
   EXPECT_EQ(LocalizationState::kUncertain, tracker_.confidence().state);
-  EXPECT_NE(std::string::npos, tracker_.confidence().reason.find("6 updates"));
+  EXPECT_NE(std::string::npos, tracker_.confidence().reason.find("for 6 views"));
+}
+
+// Patience counts views (new_view.h): updates a fifth of a view apart
+// demote only after as much motion as whole-view updates do.
+TEST_F(ConfidenceTrackerTest, PatienceCountsViewsNotUpdates) {
+  assessLocalized();
+  tracker_.demoteAfterLowFit(25 * 0.2, 5);
+  EXPECT_EQ(LocalizationState::kLocalized, tracker_.confidence().state);
+  tracker_.demoteAfterLowFit(26 * 0.2, 5);
+  EXPECT_EQ(LocalizationState::kUncertain, tracker_.confidence().state);
+  EXPECT_NE(std::string::npos, tracker_.confidence().reason.find("for 5.2 views"));
 }
 
 TEST_F(ConfidenceTrackerTest, AFitNarrowsThePublishedCovarianceWhereItConstrains) {

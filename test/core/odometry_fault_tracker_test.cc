@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 #include <vector>
 
@@ -20,16 +21,54 @@ OdometryMotionParams bounds() {
 }
 
 // `n` particles, the first `faulty` flagged, which together win `won` of
-// the weight.
+// the weight, in an update that brings a share `view` of a new view.
 void adapt(OdometryFaultTracker* tracker, std::size_t n, std::size_t faulty, double won,
-           const OdometryMotionParams& p) {
+           const OdometryMotionParams& p, double view = 1.0) {
   tracker->flags()->assign(n, 0);
   std::vector<double> w(n);
   for (std::size_t i = 0; i < n; ++i) {
     (*tracker->flags())[i] = i < faulty ? 1 : 0;
     w[i] = i < faulty ? won / faulty : (1.0 - won) / (n - faulty);
   }
-  tracker->adapt(w, p);
+  tracker->adapt(w, p, 1, view);
+}
+
+// The weight `faulty` of `n` particles win when a scan whose whole
+// evidence gives them `won` is taken to the power `view`.
+double wonAtShare(std::size_t n, std::size_t faulty, double won, double view) {
+  const double each = std::pow(won / faulty, view),
+               other = std::pow((1.0 - won) / (n - faulty), view);
+  return faulty * each / (faulty * each + (n - faulty) * other);
+}
+
+TEST(OdometryFaultTracker, AViewInPartialUpdatesMovesTheShareAsOneWholeUpdate) {
+  const OdometryMotionParams p = bounds();
+  // Evidence: a whole update at 0.3 from the floor, as above.
+  OdometryFaultTracker whole, halves;
+  whole.restart(p);
+  halves.restart(p);
+  adapt(&whole, 20, 1, 0.3, p);
+  adapt(&halves, 20, 1, wonAtShare(20, 1, 0.3, 0.5), p, 0.5);
+  // One half of a view with the evidence of half a scan believes what a
+  // whole update does but for the memory of the prior (0.5^0.5 of it kept).
+  EXPECT_NEAR(whole.fraction(), halves.fraction(), 0.02);
+  EXPECT_GT(halves.fraction(), 0.25);
+  // No evidence (the faulty particles win the share they were given): two
+  // halves of a view decay towards the floor as far as one whole update.
+  OdometryFaultTracker decay_whole, decay_halves;
+  decay_whole.restart(p);
+  decay_halves.restart(p);
+  adapt(&decay_whole, 20, 1, 0.3, p);
+  adapt(&decay_halves, 20, 1, 0.3, p);
+  adapt(&decay_whole, 20, 6, decay_whole.fraction(), p);
+  adapt(&decay_halves, 20, 6, decay_halves.fraction(), p, 0.5);
+  adapt(&decay_halves, 20, 6, decay_halves.fraction(), p, 0.5);
+  EXPECT_NEAR(0.05 + 0.5 * (0.3 - 0.05), decay_whole.fraction(), 1e-12);
+  EXPECT_NEAR(decay_whole.fraction(), decay_halves.fraction(), 1e-12);
+  // Without a new view, nothing changes.
+  const double before = decay_halves.fraction();
+  adapt(&decay_halves, 20, 1, 0.9, p, 0.0);
+  EXPECT_EQ(before, decay_halves.fraction());
 }
 
 TEST(OdometryFaultTracker, FollowsTheScansEvidenceWithinBounds) {

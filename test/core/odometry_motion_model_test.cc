@@ -359,6 +359,53 @@ TEST(ApplyLongStep, RefusesAStepThatIsNotPositive) {
   EXPECT_THROW(OdometryMotionModel(OdometryMotionParams{}, {1.0, -1.0}), std::invalid_argument);
 }
 
+// Updates closer together than a view (new_view.h): five updates of a fifth
+// of a view each spread the particles as one update a view apart does;
+// with the textbook's squares they spread them by a fifth of its variance.
+TEST(ApplyPartialView, FiveFifthsOfAViewAddUpToOneWholeUpdatesNoise) {
+  OdometryMotionParams params;  // amcl's alphas, 0.2
+  params.fault_fraction = 0.0;
+  const OdometryMotionModel model(params, {0.4, M_PI / 3});  // one update's step, at the defaults
+  Random random(31);
+  ParticleSet whole = manyAt({0, 0, 0}, kSamples);
+  model.apply({0, 0, 0}, {kViewDistance, 0, 0}, 0.0, &whole, &random, nullptr);
+  ParticleSet fifths = manyAt({0, 0, 0}, kSamples);
+  ParticleSet textbook = manyAt({0, 0, 0}, kSamples);
+  for (int k = 0; k < 5; ++k) {
+    const Pose2 from{0.04 * k, 0, 0}, to{0.04 * (k + 1), 0, 0};
+    model.apply(from, to, 0.0, &fifths, &random, nullptr, 1, newViewShare(between(from, to)));
+    model.apply(from, to, 0.0, &textbook, &random, nullptr);
+  }
+  const auto x = [](const ParticleSet& p) {
+    return stats(kSamples, [&](std::size_t i) { return p.x[i]; });
+  };
+  const auto yaw = [](const ParticleSet& p) {
+    return stats(kSamples, [&](std::size_t i) { return p.yaw[i]; });
+  };
+  // sigma_trans^2 = alpha3 * 0.2^2 for the whole step, 5 * alpha3 * 0.04 * 0.2 in fifths.
+  EXPECT_NEAR(std::sqrt(0.2 * 0.04), x(whole).stddev, 0.002);
+  EXPECT_NEAR(x(whole).stddev, x(fifths).stddev, 0.003);
+  EXPECT_NEAR(yaw(whole).stddev, yaw(fifths).stddev, 0.003);
+  EXPECT_NEAR(std::sqrt(0.2 * 0.04 / 5), x(textbook).stddev, 0.002);
+}
+
+TEST(ApplyPartialView, AStalledRobotsSpreadIsItsShareOfTheMargin) {
+  OdometryMotionParams params;
+  params.alpha1 = params.alpha2 = params.alpha3 = params.alpha4 = 0.0;
+  params.fault_fraction = 0.5;
+  params.fault_margin = 0.1;
+  const OdometryMotionModel model(params);
+  ParticleSet p = manyAt({0, 0, 0}, kSamples);
+  Random random(32);
+  model.apply({0, 0, 0}, {0.1, 0, 0}, 0.5, &p, &random, nullptr, 1, 0.5);
+  double widest = 0.0;
+  for (std::size_t i = 0; i < kSamples; ++i) {
+    if (std::fabs(p.x[i]) < 0.09) widest = std::max(widest, std::fabs(p.x[i]));  // the stalled
+  }
+  EXPECT_LE(widest, 0.05);  // half of fault_margin for half a view
+  EXPECT_GT(widest, 0.049);
+}
+
 // The fault mixture: with noise-free alphas, a particle either moves exactly
 // by the odometry, or (the faulty share) exactly the reverse, or stalls
 // within +-fault_margin, in equal halves of the faulty share.

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <numeric>
 
 #include "pf_localization/core/random_free_pose.h"
@@ -30,14 +31,14 @@ TEST(AugmentedMclInjection, InjectsTheDipOnlyAfterPatience) {
   RecoveryPlan plan;
   injection.contribute(context(0.5, 0.5, LocalizationState::kUncertain), p, &plan);
   EXPECT_EQ(0.0, plan.inject_probability);
-  EXPECT_EQ(0, injection.lowFitUpdates());
+  EXPECT_DOUBLE_EQ(0, injection.lowFitViews());
   // Half the usual fit: a dip of 1 - 0.25 / 0.35, held back for `patience` updates.
   const RecoveryContext low = context(0.5, 0.25, LocalizationState::kUncertain);
   for (int k = 1; k <= p.patience; ++k) {
     plan = RecoveryPlan();
     injection.contribute(low, p, &plan);
     EXPECT_EQ(0.0, plan.inject_probability) << k;
-    EXPECT_EQ(k, injection.lowFitUpdates());
+    EXPECT_DOUBLE_EQ(k, injection.lowFitViews());
   }
   plan = RecoveryPlan();
   injection.contribute(low, p, &plan);
@@ -49,7 +50,7 @@ TEST(AugmentedMclInjection, InjectsTheDipOnlyAfterPatience) {
   injection.contribute(walled, p, &plan);
   EXPECT_EQ(0.0, plan.inject_probability);
   injection.restart();
-  EXPECT_EQ(0, injection.lowFitUpdates());
+  EXPECT_DOUBLE_EQ(0, injection.lowFitViews());
 }
 
 TEST(AugmentedMclInjection, ALostFilterDoesNotWaitAndALocalizedOneWaitsLonger) {
@@ -105,17 +106,58 @@ TEST(Recovery, TheAveragesStartAtTheFirstFitAndFollowAtTheirRates) {
   // one to 0.496, and 0.42 < 0.7 * 0.496 is not yet a dip.
   recovery.observe(0.1, p);
   RecoveryPlan plan = recovery.plan(LocalizationState::kLost, 500, 5000, true, p);
-  EXPECT_EQ(0, recovery.lowFitUpdates());
+  EXPECT_DOUBLE_EQ(0, recovery.lowFitViews());
   EXPECT_TRUE(plan.spread);                 // 0.1 < 0.3 * 0.5
   EXPECT_EQ(0.5, plan.inject_probability);  // lost and compact: lost_share
   for (int k = 0; k < 3; ++k) recovery.observe(0.1, p);
   plan = recovery.plan(LocalizationState::kUncertain, 500, 5000, true, p);
-  EXPECT_EQ(1, recovery.lowFitUpdates());
+  EXPECT_DOUBLE_EQ(1, recovery.lowFitViews());
   recovery.restart();
   recovery.observe(0.1, p);  // the first fit again
   plan = recovery.plan(LocalizationState::kUncertain, 500, 5000, true, p);
   EXPECT_FALSE(plan.spread);
-  EXPECT_EQ(0, recovery.lowFitUpdates());
+  EXPECT_DOUBLE_EQ(0, recovery.lowFitViews());
+}
+
+// Updates closer together than a view (new_view.h) each count their share
+// of it: the patience, the injected share, the averages' rates and the
+// spread are per view, so that a view's worth of them does what one update
+// a view apart does.
+TEST(Recovery, UpdatesAFifthOfAViewApartCountAFifthEach) {
+  RecoveryParams p;  // patience 5, alpha_slow 0.01, alpha_fast 0.2, expansion_ratio 0.3
+  AugmentedMclInjection injection;
+  RecoveryContext low = context(0.5, 0.25, LocalizationState::kUncertain);
+  low.view = 0.2;
+  RecoveryPlan plan;
+  for (int k = 1; k <= 25; ++k) {  // five views: patient still
+    plan = RecoveryPlan();
+    injection.contribute(low, p, &plan);
+    ASSERT_EQ(0.0, plan.inject_probability) << k;
+  }
+  EXPECT_NEAR(5.0, injection.lowFitViews(), 1e-9);
+  plan = RecoveryPlan();
+  injection.contribute(low, p, &plan);
+  EXPECT_NEAR(0.2 * (1.0 - 0.25 / 0.35), plan.inject_probability, 1e-12);
+
+  // The averages: five fifths move them about as far as one whole update.
+  Recovery whole, fifths;
+  whole.observe(0.5, p);
+  fifths.observe(0.5, p);
+  whole.observe(0.1, p);
+  for (int k = 0; k < 5; ++k) fifths.observe(0.1, p, 0.2);
+  const RecoveryPlan w = whole.plan(LocalizationState::kUncertain, 500, 5000, true, p);
+  const RecoveryPlan f = fifths.plan(LocalizationState::kUncertain, 500, 5000, true, p);
+  // fast: 0.5 - 0.4 * 0.2 = 0.42 in one; 0.1 + 0.4 * 0.96^5 = 0.426 in five.
+  EXPECT_TRUE(w.spread);
+  EXPECT_TRUE(f.spread);  // one scan far below the usual fit, either way
+  EXPECT_DOUBLE_EQ(1.0, w.spread_scale);
+  EXPECT_NEAR(std::sqrt(0.2), f.spread_scale, 1e-12);  // five spreads add up to one
+  Recovery none;
+  none.observe(0.5, p);
+  for (int k = 0; k < 50; ++k) none.observe(0.1, p, 0.0);  // standing still: no new view
+  EXPECT_FALSE(none.plan(LocalizationState::kUncertain, 500, 5000, true, p).inject_probability >
+               0.0);
+  EXPECT_DOUBLE_EQ(0.0, none.lowFitViews());
 }
 
 ParticleSet cloudAt(const Pose2& pose, std::size_t n) {

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <memory>
 #include <numeric>
 
@@ -56,6 +57,39 @@ TEST(SensorUpdate, StrongEvidenceIsTemperedToKeepTheAskedESS) {
   const Weighing w = sensor.weigh(scan, 0.5, 1.0, &particles);
   EXPECT_LT(w.tempering, 1.0);
   EXPECT_GE(effectiveSampleSize(particles.weight), 0.5 * 100 - 1.0);
+}
+
+// An update that brings a share s of a new view weighs by the likelihood
+// to the power s; one that brings none leaves the weights, and its mean
+// beam likelihood is the scan's own either way.
+TEST(SensorUpdate, APartialViewWeighsByItsShareOfTheLikelihood) {
+  const OccupancyGrid grid = small_world::room();
+  SensorUpdate sensor;
+  sensor.setModel(std::make_unique<LikelihoodFieldModel>(grid, LikelihoodFieldModelParams()));
+  const std::vector<PreparedScan> scans = {
+      sensor.model().prepare(small_world::castScan(grid, small_world::kTruth))};
+  const auto weighed = [&](double share, Weighing* w) {
+    ParticleSet particles;
+    particles.resize(2);
+    particles.setPose(0, small_world::kTruth);
+    particles.setPose(1, compose(small_world::kTruth, {0.1, 0.0, 0.0}));
+    particles.setUniformWeights();
+    *w = sensor.weigh(sensor.model(), scans, 0.0, 1.0, &particles, 1, share);
+    return std::log(particles.weight[0] / particles.weight[1]);
+  };
+  Weighing whole, half, none;
+  const double log_ratio = weighed(1.0, &whole);
+  ASSERT_GT(log_ratio, 1.0);
+  EXPECT_NEAR(0.5 * log_ratio, weighed(0.5, &half), 1e-9);
+  EXPECT_DOUBLE_EQ(0.0, weighed(0.0, &none));
+  EXPECT_DOUBLE_EQ(0.5, half.tempering);
+  EXPECT_DOUBLE_EQ(0.0, none.tempering);
+  // The fit is the scan's, whatever share of it the weights took.
+  EXPECT_GT(whole.mean_beam_likelihood, 0.0);
+  EXPECT_NEAR(whole.mean_beam_likelihood, half.mean_beam_likelihood,
+              0.2 * whole.mean_beam_likelihood);
+  ASSERT_TRUE(std::isfinite(none.mean_beam_likelihood));
+  EXPECT_GT(none.mean_beam_likelihood, 0.0);
 }
 
 TEST(TemperingEssFraction, CautiousUnlessLocalizedOrOnlySpread) {

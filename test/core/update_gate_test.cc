@@ -8,6 +8,7 @@
 #include <memory>
 
 #include "pf_localization/core/likelihood_field_model.h"
+#include "pf_localization/core/new_view.h"
 #include "small_world.h"
 
 namespace pf {
@@ -142,6 +143,45 @@ TEST_F(UpdateGateTest, AScanThatStopsFittingRunsBeforeTheThresholds) {
                    true, kTruth, false, params_);
   EXPECT_TRUE(d.runs()) << toString(d.skip);
   EXPECT_TRUE(d.fit_dropped);
+}
+
+TEST(NewViewShare, IsTheLargerOfTravelAndTurnOverAViewAtMostOne) {
+  EXPECT_DOUBLE_EQ(0.0, newViewShare({0.0, 0.0, 0.0}));
+  EXPECT_DOUBLE_EQ(0.25, newViewShare({0.05, 0.0, 0.0}));
+  EXPECT_DOUBLE_EQ(0.25, newViewShare({0.0, -0.05, 0.0}));
+  EXPECT_DOUBLE_EQ(0.5, newViewShare({0.0, 0.0, -M_PI / 12}));
+  EXPECT_DOUBLE_EQ(0.5, newViewShare({0.05, 0.0, M_PI / 12}));  // the turn
+  EXPECT_DOUBLE_EQ(1.0, newViewShare({0.2, 0.0, 0.0}));
+  EXPECT_DOUBLE_EQ(1.0, newViewShare({3.0, 0.0, 2.0}));
+}
+
+TEST_F(UpdateGateTest, AnUpdateCarriesTheShareOfANewViewItsMotionBrings) {
+  params_.update_min_d = params_.update_min_a = 0.0;  // every scan updates
+  const Pose2 odom{1.0, 2.0, 0.0};
+  EXPECT_DOUBLE_EQ(1.0, decide(odom, kTruth).view);  // the first: a whole view
+  const Pose2 step{0.05, 0.0, 0.0};
+  EXPECT_DOUBLE_EQ(0.25, decide(compose(odom, step), kTruth).view);
+  EXPECT_DOUBLE_EQ(0.0, decide(compose(odom, step), kTruth).view);  // standing still
+  // Requested, or while the odometry is suspect: a whole view, as at the
+  // default thresholds, where every update brings one.
+  gate_.requestUpdate();
+  EXPECT_DOUBLE_EQ(1.0, decide(compose(odom, step), kTruth).view);
+  EXPECT_DOUBLE_EQ(1.0, decide(compose(odom, step), kTruth, true).view);
+  params_.update_min_d = 0.2;
+  params_.update_min_a = M_PI / 6;
+  EXPECT_DOUBLE_EQ(1.0, decide(compose(odom, {0.3, 0.0, 0.0}), kTruth).view);
+}
+
+TEST_F(UpdateGateTest, AScanThatStopsFittingBringsAWholeView) {
+  params_.update_fit_drop = 0.2;
+  const Pose2 odom{1.0, 2.0, 0.0};
+  ASSERT_TRUE(decide(odom, kTruth).runs());
+  gate_.recordFit(model_, {model_.prepare(castScan(grid_, kTruth))}, kTruth, params_);
+  const GateDecision d = gate_.decide(compose(odom, {0.05, 0.0, 0.0}),
+                                      castScan(grid_, compose(kTruth, {0.45, 0.3, 0.0})), &model_,
+                                      true, kTruth, false, params_);
+  ASSERT_TRUE(d.fit_dropped);
+  EXPECT_DOUBLE_EQ(1.0, d.view);  // whatever the odometry says, the scan changed
 }
 
 TEST_F(UpdateGateTest, RestartMakesTheNextUpdateTheFirst) {

@@ -58,9 +58,10 @@ class ConfidenceTracker {
   /// look-alike places, which a fit of the best one cannot narrow: then it
   /// widens it to cover the fit's too.
   void addFit(const Eigen::Matrix3d& fit_covariance);
-  /// "localized" becomes "uncertain" after more than `patience` consecutive
-  /// updates with a fit below recovery's trigger.
-  void demoteAfterLowFit(int low_fit_updates, int patience);
+  /// "localized" becomes "uncertain" when the consecutive updates with a
+  /// fit below recovery's trigger brought more than `patience` new views
+  /// (new_view.h; with the default thresholds, one each).
+  void demoteAfterLowFit(double low_fit_views, int patience);
 
   const Confidence& confidence() const { return confidence_; }
   /// This update's verdict from its scan alone, before holdAfterJump and the

@@ -65,9 +65,13 @@ class OdometryFaultTracker {
   /// The new share from the posterior weight of the flagged particles
   /// (`weights` normalised, in the order of the flags) against the share
   /// they were given, clamped; summed on up to `threads` threads (the same
-  /// result for any count).
+  /// result for any count). After an update that brings a share
+  /// `view_share` of a new view (new_view.h), whose weights carry that
+  /// share of a scan's evidence, the evidence ratio is taken to the power
+  /// 1 / view_share and the memory to the power view_share: a view's worth
+  /// of such updates moves the share as one update a view apart does.
   void adapt(const std::vector<double>& weights, const OdometryMotionParams& params,
-             int threads = 1);
+             int threads = 1, double view_share = 1.0);
 
   /// Prefaults room for `n` particles' flags.
   void reserve(std::size_t n);

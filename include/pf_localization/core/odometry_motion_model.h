@@ -55,6 +55,7 @@
 #include <limits>
 #include <vector>
 
+#include "pf_localization/core/new_view.h"
 #include "pf_localization/core/parameter_table.h"
 #include "pf_localization/core/particle_blocks.h"
 #include "pf_localization/core/particle_set.h"
@@ -129,15 +130,19 @@ class OdometryMotionModel {
   /// a fault (1) and which the odometry's step (0), on up to `threads`
   /// threads: each block of particles draws from its own stream
   /// (particle_blocks.h), so the result is the same for any thread count.
+  /// In an update that brings a share `view_share` < 1 of a new view
+  /// (new_view.h), each component's variance below a view's size is linear
+  /// in it, and the stalled particles' spread is fault_margin times the share.
   void apply(const Pose2& from, const Pose2& to, double fault_fraction, ParticleSet* particles,
-             Random* random, std::vector<uint8_t>* faulty, int threads = 1) const;
+             Random* random, std::vector<uint8_t>* faulty, int threads = 1,
+             double view_share = 1.0) const;
 
  private:
   void applyDifferential(const Pose2& from, const Pose2& to, double fault_fraction,
-                         ParticleSet* particles, BlockStreams* random, uint8_t* faulty,
-                         int threads) const;
-  void applyOmni(const Pose2& from, const Pose2& to, double fault_fraction, ParticleSet* particles,
-                 BlockStreams* random, uint8_t* faulty, int threads) const;
+                         double view_share, ParticleSet* particles, BlockStreams* random,
+                         uint8_t* faulty, int threads) const;
+  void applyOmni(const Pose2& from, const Pose2& to, double fault_fraction, double view_share,
+                 ParticleSet* particles, BlockStreams* random, uint8_t* faulty, int threads) const;
 
   OdometryMotionParams params_;
   OneUpdateStep update_step_;

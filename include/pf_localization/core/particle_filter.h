@@ -163,7 +163,9 @@ class ParticleFilter {
   // The scans with the beams that see something that moved in while the
   // robot stood masked (transient_beams.h), judged from the last estimate.
   ScanGroup maskTransients(const Pose2& odom, const ScanGroup& measured);
-  void weigh(const std::vector<PreparedScan>& scans, UpdateReport* report);
+  // Weighs the cloud by `scans`, an update that brings a share `view` of a
+  // new view (new_view.h), and takes its fit into recovery's averages.
+  void weigh(const std::vector<PreparedScan>& scans, double view, UpdateReport* report);
   // The estimate of the weighted cloud and the verdict on it; `predicted`:
   // the last estimate moved by the odometry since (none on a first update).
   void estimateAndJudge(const std::vector<PreparedScan>& scans,

@@ -8,7 +8,9 @@
 //   (2005), table 8.3: a short-term average of the mean beam likelihood below
 //   trigger_ratio times the long-term one injects that dip's share; unless
 //   lost, only after the fit stayed low for more than `patience` updates
-//   (patience_localized while localized).
+//   (patience_localized while localized). Updates closer together than a
+//   view (new_view.h) count their share of it, inject that share of the dip,
+//   and move the averages by it.
 // - LostShareInjection: a compact cloud that is lost searches at once with
 //   lost_share of max_particles.
 // - ExpansionResetting: Ueda et al., "Expansion resetting for recovery from
@@ -45,6 +47,7 @@ struct RecoveryContext {
   LocalizationState state = LocalizationState::kLost;  // this scan's verdict
   std::size_t particles = 0;                           // in the cloud now
   std::size_t max_particles = 0;                       // the budget (kld.max_particles)
+  double view = 1.0;                      // the share of a new view this scan brings (new_view.h)
   bool has_free_space = false;            // the map has free cells to draw random particles from
   std::vector<Pose2> better_look_alikes;  // map motions to look-alikes the scan fits clearly better
 };
@@ -53,6 +56,7 @@ struct RecoveryContext {
 struct RecoveryPlan {
   double inject_probability = 0.0;  // share of max_particles drawn at random
   bool spread = false;              // spread the survivors (expansion resetting)
+  double spread_scale = 1.0;        // times expansion_std_xy and expansion_std_yaw
   std::vector<Pose2> moves;         // map motions a share of the survivors take (LookAlikeMove)
 };
 
@@ -71,12 +75,14 @@ class AugmentedMclInjection final : public RecoveryStrategy {
  public:
   void contribute(const RecoveryContext& context, const RecoveryParams& params,
                   RecoveryPlan* plan) override;
-  void restart() override { low_fit_updates_ = 0; }
-  /// Consecutive updates so far with the short-term average below the trigger.
-  int lowFitUpdates() const { return low_fit_updates_; }
+  void restart() override { low_fit_views_ = 0.0; }
+  /// The new views (new_view.h) the consecutive updates so far with the
+  /// short-term average below the trigger brought; with the default
+  /// thresholds, their count.
+  double lowFitViews() const { return low_fit_views_; }
 
  private:
-  int low_fit_updates_ = 0;
+  double low_fit_views_ = 0.0;
 };
 
 class LostShareInjection final : public RecoveryStrategy {
@@ -90,9 +96,9 @@ class ExpansionResetting final : public RecoveryStrategy {
   void contribute(const RecoveryContext& context, const RecoveryParams& params,
                   RecoveryPlan* plan) override;
   /// Spreads the first `n` particles by expansion_std_xy / expansion_std_yaw
-  /// (x, y, yaw from `random`, particle by particle).
+  /// times `scale` (x, y, yaw from `random`, particle by particle).
   static void spread(const RecoveryParams& params, std::size_t n, Random* random,
-                     ParticleSet* particles);
+                     ParticleSet* particles, double scale = 1.0);
 };
 
 class LookAlikeMove final : public RecoveryStrategy {
@@ -126,8 +132,11 @@ class Recovery {
   void restart();
 
   /// Takes this scan's mean beam likelihood into the averages (alpha_slow,
-  /// alpha_fast; alpha_slow 0 keeps them at 0, which disables recovery).
-  void observe(double mean_beam_likelihood, const RecoveryParams& params);
+  /// alpha_fast; alpha_slow 0 keeps them at 0, which disables recovery), at
+  /// their rates times `view`, the share of a new view the scan brings
+  /// (new_view.h): the averages, the patience, the injected share and the
+  /// spread of the next plan() are per view, not per update.
+  void observe(double mean_beam_likelihood, const RecoveryParams& params, double view = 1.0);
   /// The plan for this update, from the last observe() and this scan's
   /// verdict `state`, for a cloud of `particles` with the budget
   /// `max_particles`.
@@ -137,8 +146,9 @@ class Recovery {
   void observeLookAlikes(std::vector<Pose2> better) {
     context_.better_look_alikes = std::move(better);
   }
-  /// Consecutive updates with a fit below the trigger (AugmentedMclInjection).
-  int lowFitUpdates() const { return injection_.lowFitUpdates(); }
+  /// The views of the consecutive updates with a fit below the trigger
+  /// (AugmentedMclInjection).
+  double lowFitViews() const { return injection_.lowFitViews(); }
 
   /// Resamples `particles` by `plan` when their effective sample size `ess`
   /// is below resample_ess_fraction of their count or the plan asks for

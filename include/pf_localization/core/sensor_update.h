@@ -57,12 +57,15 @@ class SensorUpdate {
                  double likelihood_exponent, ParticleSet* particles, int threads = 1);
 
   /// The same two, weighing by `model` instead of the update's own (a
-  /// smoothed copy of it: global_search.h).
+  /// smoothed copy of it: global_search.h). The second takes the scans'
+  /// likelihood to the power `evidence_share`, the share of a new view the
+  /// update brings (new_view.h; 0: the weights stay as they are); the mean
+  /// beam likelihood is the scans' own.
   Weighing weigh(const SensorModel& model, const PreparedScan& scan, double min_ess_fraction,
                  double likelihood_exponent, ParticleSet* particles, int threads = 1);
   Weighing weigh(const SensorModel& model, const std::vector<PreparedScan>& scans,
                  double min_ess_fraction, double likelihood_exponent, ParticleSet* particles,
-                 int threads = 1);
+                 int threads = 1, double evidence_share = 1.0);
 
   /// Prefaults the scratch for `n` particles.
   void reserve(std::size_t n);
@@ -70,7 +73,8 @@ class SensorUpdate {
  private:
   // Tempers and normalises log_likelihood_ into the weights; the report.
   Weighing finish(std::size_t beams, std::size_t beams_counted, double min_ess_fraction,
-                  double likelihood_exponent, ParticleSet* particles, int threads);
+                  double likelihood_exponent, ParticleSet* particles, int threads,
+                  double evidence_share = 1.0);
 
   std::unique_ptr<SensorModel> model_;
   std::vector<double> log_likelihood_;

@@ -1,0 +1,13 @@
+#include "pf_localization/core/new_view.h"
+
+#include <algorithm>
+
+namespace pf {
+
+double newViewShare(const Pose2& delta) {
+  const double travel = std::hypot(delta.x, delta.y) / kViewDistance;
+  const double turn = std::fabs(normalizeAngle(delta.yaw)) / kViewAngle;
+  return std::min(1.0, std::max(travel, turn));
+}
+
+}  // namespace pf
