@@ -389,12 +389,18 @@ TEST(ApplyPartialView, FiveFifthsOfAViewAddUpToOneWholeUpdatesNoise) {
   EXPECT_NEAR(std::sqrt(0.2 * 0.04 / 5), x(textbook).stddev, 0.002);
 }
 
-TEST(ApplyPartialView, AStalledRobotsSpreadIsItsShareOfTheMargin) {
+// A model whose only noise is the fault mixture: a share `fraction` of the
+// particles reverses or stalls within +-`margin`.
+OdometryMotionModel faultsOnly(double fraction, double margin) {
   OdometryMotionParams params;
   params.alpha1 = params.alpha2 = params.alpha3 = params.alpha4 = 0.0;
-  params.fault_fraction = 0.5;
-  params.fault_margin = 0.1;
-  const OdometryMotionModel model(params);
+  params.fault_fraction = fraction;
+  params.fault_margin = margin;
+  return OdometryMotionModel(params);
+}
+
+TEST(ApplyPartialView, AStalledRobotsSpreadIsItsShareOfTheMargin) {
+  const OdometryMotionModel model = faultsOnly(0.5, 0.1);
   ParticleSet p = manyAt({0, 0, 0}, kSamples);
   Random random(32);
   model.apply({0, 0, 0}, {0.1, 0, 0}, 0.5, &p, &random, nullptr, 1, 0.5);
@@ -410,11 +416,7 @@ TEST(ApplyPartialView, AStalledRobotsSpreadIsItsShareOfTheMargin) {
 // by the odometry, or (the faulty share) exactly the reverse, or stalls
 // within +-fault_margin, in equal halves of the faulty share.
 TEST(ApplyFaults, AShareOfTheParticlesReversesOrStalls) {
-  OdometryMotionParams params;
-  params.alpha1 = params.alpha2 = params.alpha3 = params.alpha4 = 0.0;
-  params.fault_fraction = 0.25;
-  params.fault_margin = 0.1;
-  const OdometryMotionModel model(params);
+  const OdometryMotionModel model = faultsOnly(0.25, 0.1);
   ParticleSet p = manyAt({0, 0, 0}, kSamples);
   Random random(21);
   model.apply({0, 0, 0}, {1, 0, 0}, &p, &random);
