@@ -44,7 +44,7 @@ void OdometryFaultTracker::adapt(const std::vector<double>& weights,
   // Faults come in runs: the belief before this scan is the last one, half
   // way back to the floor, so that without evidence it decays.
   double memory = kFaultMemory;
-  if (view_share > 0.0 && view_share < 1.0) {
+  if (view_share < 1.0) {
     // In log space: a tiny share would raise the ratio beyond a double.
     ratio = std::exp(std::clamp(std::log(ratio) / view_share, -kMaxLogRatio, kMaxLogRatio));
     memory = std::pow(kFaultMemory, view_share);
