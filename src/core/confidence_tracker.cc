@@ -86,7 +86,7 @@ void ConfidenceTracker::addFit(const Eigen::Matrix3d& fit_covariance) {
 
 void ConfidenceTracker::demoteAfterLowFit(double low_fit_views, int patience) {
   if (confidence_.state == LocalizationState::kLocalized &&
-      low_fit_views > patience + kViewRounding) {
+      moreViewsThan(low_fit_views, patience)) {
     confidence_.state = LocalizationState::kUncertain;
     char views[32];
     std::snprintf(views, sizeof(views), "%.3g", low_fit_views);

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "pf_localization/core/fast_math.h"
+#include "pf_localization/core/new_view.h"
 #include "pf_localization/core/parameter_check.h"
 #include "pf_localization/core/thread_scratch.h"
 

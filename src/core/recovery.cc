@@ -4,6 +4,7 @@
 #include <cmath>
 #include <utility>
 
+#include "pf_localization/core/new_view.h"
 #include "pf_localization/core/prefault.h"
 #include "pf_localization/core/random_free_pose.h"
 #include "pf_localization/core/resampler.h"
@@ -24,7 +25,7 @@ void AugmentedMclInjection::contribute(const RecoveryContext& context, const Rec
   const int patience =
       context.state == LocalizationState::kLocalized ? params.patience_localized : params.patience;
   const bool patient =
-      context.state != LocalizationState::kLost && low_fit_views_ <= patience + kViewRounding;
+      context.state != LocalizationState::kLost && !moreViewsThan(low_fit_views_, patience);
   // A view's worth of closer updates injects what one update would.
   if (context.has_free_space && !patient) {
     plan->inject_probability = std::max(plan->inject_probability, dip * context.view);

@@ -58,15 +58,15 @@ Weighing SensorUpdate::finish(std::size_t beams, std::size_t beams_counted, doub
   // A partial view's evidence: the likelihood to the power of its share
   // (the mean below divides the share out again).
   double share = 1.0;
-  if (evidence_share < 1.0 && evidence_share > 0.0) {
-    share = evidence_share;
-    for (double& l : log_likelihood_) l *= share;
-  }
-  if (evidence_share > 0.0) {
+  if (evidence_share <= 0.0) {
+    w.tempering = 0.0;  // no new view: the weights stay as they are
+  } else {
+    if (evidence_share < 1.0) {
+      share = evidence_share;
+      for (double& l : log_likelihood_) l *= share;
+    }
     w.tempering = share * applyLikelihood(log_likelihood_, min_ess_fraction, &particles->weight,
                                           &scratch_, threads);
-  } else {
-    w.tempering = 0.0;  // no new view: the weights stay as they are
   }
   w.beams_skipped = static_cast<int>(beams - beams_counted);
   // The per-beam geometric mean is independent of the beam count, so

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "expect_pose.h"
+#include "pf_localization/core/new_view.h"
 
 namespace pf {
 namespace {

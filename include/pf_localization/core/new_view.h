@@ -29,6 +29,9 @@ constexpr double kViewAngle = M_PI / 6.0;  // rad
 /// counts of views compare with this much slack.
 constexpr double kViewRounding = 1e-9;
 
+/// Whether `views`, summed from shares, exceed `count` whole views.
+inline bool moreViewsThan(double views, int count) { return views > count + kViewRounding; }
+
 /// The share of a new view that odometry motion `delta` (between two
 /// updates) brings: its travel over kViewDistance or its turn over
 /// kViewAngle, whichever is larger, at most 1.

@@ -55,7 +55,6 @@
 #include <limits>
 #include <vector>
 
-#include "pf_localization/core/new_view.h"
 #include "pf_localization/core/parameter_table.h"
 #include "pf_localization/core/particle_blocks.h"
 #include "pf_localization/core/particle_set.h"
