@@ -10,4 +10,8 @@ double newViewShare(const Pose2& delta) {
   return std::min(1.0, std::max(travel, turn));
 }
 
+double leastUpdateShare(double update_min_d, double update_min_a) {
+  return std::min(1.0, std::min(update_min_d / kViewDistance, update_min_a / kViewAngle));
+}
+
 }  // namespace pf

@@ -1,5 +1,6 @@
 #include "pf_localization/core/update_gate.h"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -47,7 +48,17 @@ GateDecision UpdateGate::decide(const Pose2& odom, const ScanGroup& scans, const
   if (!first) {
     const Pose2 delta = between(*odom_at_update_, odom);
     d.step = std::hypot(delta.x, delta.y);
-    if (!force_ && !odometry_suspect) d.view = newViewShare(delta);
+    // While the odometry is suspect every scan is an update, and the motion
+    // it shows may be what is wrong: it counts as much as the least update
+    // the thresholds let through (at the defaults, a whole view). Counting
+    // whole views there let a run of such scans use up recovery's patience
+    // in a fraction of a view.
+    if (!force_) {
+      d.view = odometry_suspect
+                   ? std::max(newViewShare(delta),
+                              leastUpdateShare(params.update_min_d, params.update_min_a))
+                   : newViewShare(delta);
+    }
     if (!(d.step <= params.odom_jump_limit)) {
       // Wheels do not carry a robot this far between two scans: moving the
       // particles by it would throw them away.

@@ -162,14 +162,36 @@ TEST_F(UpdateGateTest, AnUpdateCarriesTheShareOfANewViewItsMotionBrings) {
   const Pose2 step{0.05, 0.0, 0.0};
   EXPECT_DOUBLE_EQ(0.25, decide(compose(odom, step), kTruth).view);
   EXPECT_DOUBLE_EQ(0.0, decide(compose(odom, step), kTruth).view);  // standing still
-  // Requested, or while the odometry is suspect: a whole view, as at the
-  // default thresholds, where every update brings one.
+  // Requested: a whole view, as at the default thresholds, where every
+  // update brings one.
   gate_.requestUpdate();
   EXPECT_DOUBLE_EQ(1.0, decide(compose(odom, step), kTruth).view);
-  EXPECT_DOUBLE_EQ(1.0, decide(compose(odom, step), kTruth, true).view);
   params_.update_min_d = 0.2;
   params_.update_min_a = M_PI / 6;
   EXPECT_DOUBLE_EQ(1.0, decide(compose(odom, {0.3, 0.0, 0.0}), kTruth).view);
+}
+
+// While the odometry is suspect every scan updates, however little the
+// odometry moved: such an update counts what the least update the
+// thresholds let through brings, or its motion's share if that is more.
+TEST_F(UpdateGateTest, ASuspectOdometrysUpdateCountsAtLeastWhatTheThresholdsLetThrough) {
+  const Pose2 odom{1.0, 2.0, 0.0};
+  ASSERT_TRUE(decide(odom, kTruth).runs());
+  // The defaults: every update is a whole view, suspect or not.
+  GateDecision d = decide(odom, kTruth, true);
+  ASSERT_TRUE(d.runs()) << toString(d.skip);  // standing still, yet it runs
+  EXPECT_DOUBLE_EQ(1.0, d.view);
+  // 0.05 m or 0.1 rad: a quarter of 0.2 m, a fifth of pi/6; the least is the turn's.
+  params_.update_min_d = 0.05;
+  params_.update_min_a = 0.1;
+  d = decide(odom, kTruth, true);
+  ASSERT_TRUE(d.runs()) << toString(d.skip);
+  EXPECT_DOUBLE_EQ(0.1 / (M_PI / 6), d.view);
+  EXPECT_DOUBLE_EQ(0.5, decide(compose(odom, {0.1, 0.0, 0.0}), kTruth, true).view);  // its motion
+  // Updates on every scan: the motion's share alone.
+  params_.update_min_d = params_.update_min_a = 0.0;
+  EXPECT_NEAR(0.25, decide(compose(odom, {0.15, 0.0, 0.0}), kTruth, true).view, 1e-12);
+  EXPECT_NEAR(0.0, decide(compose(odom, {0.15, 0.0, 0.0}), kTruth, true).view, 1e-12);
 }
 
 TEST_F(UpdateGateTest, AScanThatStopsFittingBringsAWholeView) {

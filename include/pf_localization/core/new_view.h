@@ -37,4 +37,10 @@ inline bool moreViewsThan(double views, int count) { return views > count + kVie
 /// kViewAngle, whichever is larger, at most 1.
 double newViewShare(const Pose2& delta);
 
+/// The least share of a new view that an update let through by the
+/// thresholds brings: update_min_d over kViewDistance or update_min_a over
+/// kViewAngle, whichever is smaller, at most 1 (a whole view at amcl's
+/// defaults, none with updates on every scan).
+double leastUpdateShare(double update_min_d, double update_min_a);
+
 }  // namespace pf

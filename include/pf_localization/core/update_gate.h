@@ -46,9 +46,9 @@ struct GateDecision {
   double step = 0.0;         // m of odometry travelled since the last update
   bool fit_dropped = false;  // runs before the thresholds: the scan stopped fitting
   // The share of a new view the update brings (new_view.h): of its motion
-  // since the last update; 1 for the first, for a requested one, while the
-  // odometry is suspect and when the fit dropped (the scan changed, whatever
-  // the odometry says).
+  // since the last update; 1 for the first, for a requested one and when the
+  // fit dropped (the scan changed, whatever the odometry says); while the
+  // odometry is suspect, at least leastUpdateShare of the thresholds.
   double view = 1.0;
   // The scans, prepared by the sensor model: when the update runs, and for
   // kNoValidBeam (to count the dropped beams).
