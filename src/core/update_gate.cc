@@ -48,16 +48,16 @@ GateDecision UpdateGate::decide(const Pose2& odom, const ScanGroup& scans, const
   if (!first) {
     const Pose2 delta = between(*odom_at_update_, odom);
     d.step = std::hypot(delta.x, delta.y);
-    // While the odometry is suspect every scan is an update, and the motion
-    // it shows may be what is wrong: it counts as much as the least update
-    // the thresholds let through (at the defaults, a whole view). Counting
-    // whole views there let a run of such scans use up recovery's patience
-    // in a fraction of a view.
     if (!force_) {
-      d.view = odometry_suspect
-                   ? std::max(newViewShare(delta),
-                              leastUpdateShare(params.update_min_d, params.update_min_a))
-                   : newViewShare(delta);
+      d.view = newViewShare(delta);
+      // While the odometry is suspect every scan is an update, and the
+      // motion it shows may be what is wrong: such an update counts at least
+      // what the least update the thresholds let through brings (at the
+      // defaults, a whole view), so that a run of them cannot use up
+      // recovery's patience in a fraction of a view.
+      if (odometry_suspect) {
+        d.view = std::max(d.view, leastUpdateShare(params.update_min_d, params.update_min_a));
+      }
     }
     if (!(d.step <= params.odom_jump_limit)) {
       // Wheels do not carry a robot this far between two scans: moving the
