@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <fstream>
-#include <sstream>
+
+#include "pf_localization/sim/script_line.h"
 
 namespace pf::sim {
 
@@ -27,50 +27,6 @@ double PathScript::duration() const {
   return total;
 }
 
-namespace {
-
-// Parses one script line's arguments and reports errors with file:line.
-class LineParser {
- public:
-  LineParser(const std::string& file, int line, std::vector<std::string> words)
-      : file_(file), line_(line), words_(std::move(words)) {}
-
-  [[noreturn]] void fail(const std::string& message) const {
-    throw PathScriptError(file_ + ":" + std::to_string(line_) + ": " + message);
-  }
-
-  const std::string& command() const { return words_[0]; }
-
-  /// The arguments as numbers; exactly `count` of them, named in `usage`.
-  std::vector<double> numbers(std::size_t count, const std::string& usage) const {
-    if (words_.size() != count + 1) {
-      fail("'" + command() + "' takes " + std::to_string(count) + " number(s): " + usage);
-    }
-    std::vector<double> out;
-    for (std::size_t i = 1; i < words_.size(); ++i) {
-      const char* begin = words_[i].c_str();
-      char* end = nullptr;
-      const double value = std::strtod(begin, &end);
-      if (end == begin || *end != '\0' || !std::isfinite(value)) {
-        fail("'" + words_[i] + "' is not a number (in '" + command() + "')");
-      }
-      out.push_back(value);
-    }
-    return out;
-  }
-
-  void requirePositive(double value, const std::string& what) const {
-    if (!(value > 0.0)) fail(what + " must be positive, got " + std::to_string(value));
-  }
-
- private:
-  const std::string& file_;
-  int line_;
-  std::vector<std::string> words_;
-};
-
-}  // namespace
-
 PathScript parsePathScript(std::istream& in, const std::string& file) {
   PathScript script;
   script.file = file;
@@ -80,12 +36,10 @@ PathScript parsePathScript(std::istream& in, const std::string& file) {
 
   std::string text;
   for (int line = 1; std::getline(in, text); ++line) {
-    std::istringstream words_in(text.substr(0, text.find('#')));
-    std::vector<std::string> words;
-    for (std::string w; words_in >> w;) words.push_back(w);
+    const std::vector<std::string> words = scriptWords(text);
     if (words.empty()) continue;
 
-    const LineParser p(file, line, words);
+    const LineParser<PathScriptError> p(file, line, words);
     const std::string& cmd = p.command();
     if (!started && cmd != "start" && cmd != "person") {
       p.fail("'start x y yaw' must come before '" + cmd + "'");
