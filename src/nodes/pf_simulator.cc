@@ -5,6 +5,7 @@
 //                --seed 1 --out bags/tracking.bag [--rig neato|amr|cloud|warehouse]
 //                [--compression bz2|lz4|none] [--odom-error K] [--unsigned-odometry]
 //                [--no-people] [--scan-period S] [--block NAME:T0:T1] [--start-time SECONDS]
+//                [--changes FILE [--change-mask OUT.yaml]]
 //
 // Every rig publishes, as the Neato's AC109 recording does:
 //   /odom          nav_msgs/Odometry odom -> base_link, 20 Hz
@@ -43,6 +44,16 @@
 // range_min (sensor_block.h). Bag time equals header stamp, and the bag
 // depends on nothing but the map, the script, the seed and the options: the
 // same inputs give the same bytes.
+//
+// --changes FILE makes the world differ from the map (map_changes.h): every
+// sensor of every rig looks at the changed world (the 3D worlds' walls
+// included), the path must keep clear of it, and the changed share is
+// printed. --change-mask OUT.yaml writes the true change mask as a map_server
+// pair, OUT.yaml and OUT.pgm, with the map's resolution and origin: pixel 0
+// (black) an object the map lacks, 205 (grey) an object the map has that is
+// gone, 254 (white) unchanged (mode trinary: loaded as a map, the added
+// objects are its obstacles and the removed ones unknown). Without
+// --changes the world is the map, and the bag is what it was before.
 #include <geometry_msgs/PoseStamped.h>
 #include <nav_msgs/Odometry.h>
 #include <rosbag/bag.h>
@@ -67,6 +78,7 @@
 #include "pf_localization/sim/amr_rig.h"
 #include "pf_localization/sim/building_clutter.h"
 #include "pf_localization/sim/diff_drive_robot.h"
+#include "pf_localization/sim/map_changes.h"
 #include "pf_localization/sim/path_script.h"
 #include "pf_localization/sim/planar_lidar.h"
 #include "pf_localization/sim/planar_sensor.h"
@@ -107,6 +119,7 @@ struct Options {
   // a sparse log's period (the CARMEN logs keep one scan every few seconds).
   std::optional<int> scan_every;
   std::vector<pf::sim::SensorBlock> blocks;
+  std::string changes, change_mask;  // a changes file, where to write its mask
 };
 
 constexpr char kUsage[] =
@@ -130,7 +143,11 @@ constexpr char kUsage[] =
     "                    [--block NAME:T0:T1]  cover the lidar NAME (neato: laser; amr:\n"
     "                                       front, rear; cloud, warehouse: laser) from T0 to T1 s\n"
     "                                       after the start: all its beams read range_min;\n"
-    "                                       may be repeated\n";
+    "                                       may be repeated\n"
+    "                    [--changes FILE]   the world differs from the map by FILE's\n"
+    "                                       changes (map_changes.h): the sensors see it\n"
+    "                    [--change-mask OUT.yaml]  write the true change mask (map_server\n"
+    "                                       pair; pixels 0 added, 205 removed, 254 unchanged)\n";
 
 // A wrong call: the problem and the usage on stderr, exit 2.
 [[noreturn]] void usage(const std::string& problem) {
@@ -204,6 +221,10 @@ Options parseOptions(int argc, char** argv) {
       } catch (const std::invalid_argument& e) {
         usage(std::string("--block: ") + e.what());
       }
+    } else if (arg == "--changes") {
+      o.changes = value();
+    } else if (arg == "--change-mask") {
+      o.change_mask = value();
     } else if (arg == "--start-time") {
       o.start_time = number();
       if (o.start_time <= 0.0) usage("--start-time must be positive");
@@ -213,6 +234,7 @@ Options parseOptions(int argc, char** argv) {
   }
   if (o.map.empty() || o.path.empty() || o.out.empty())
     usage("--map, --path and --out are required");
+  if (!o.change_mask.empty() && o.changes.empty()) usage("--change-mask needs --changes");
   if (o.rig == RigKind::kAmr && o.scan_every) {
     usage("--scan-period: the amr rig's lidars keep their own rates");
   }
@@ -281,14 +303,14 @@ void checkObjectsOnMap(const pf::OccupancyGrid& map, const std::vector<pf::sim::
     for (double x = box.x0; x <= box.x1; x += 0.5 * map.resolution()) {
       for (double y = box.y0; y <= box.y1; y += 0.5 * map.resolution()) {
         if (map.state(map.worldToCell(x, y)) != pf::CellState::kFree) {
-          throw std::runtime_error(whose + " are not in free space of this map");
+          throw std::runtime_error(whose + " are not in free space of this map (or its world)");
         }
       }
     }
   }
 }
 
-Rig makeRig(const Options& o, const pf::OccupancyGrid& map,
+Rig makeRig(const Options& o, const pf::OccupancyGrid& world,
             const std::vector<pf::sim::Person>& people) {
   using Model = pf::sim::PlanarSensor::Model;
   Rig rig;
@@ -305,25 +327,25 @@ Rig makeRig(const Options& o, const pf::OccupancyGrid& map,
       add(pf::sim::amrRearLidar(), Model::kSafety);
       break;
     case RigKind::kCloud: {
-      checkObjectsOnMap(map, pf::sim::buildingClutter(),
+      checkObjectsOnMap(world, pf::sim::buildingClutter(),
                         "the cloud rig's objects (building_clutter.h; it is made for "
                         "maps/building.yaml)");
       const pf::sim::ScanSchedule schedule = offsetSchedule(o.scan_every.value_or(kCloudEvery));
       rig.ring = pf::sim::amrRingLidar(schedule);
       rig.ring_random = pf::sim::SimRandom(sensorSeed(o.seed, 0));
       add(pf::sim::amrMastLidar(schedule), Model::kSafety);
-      rig.scene.emplace(map, pf::sim::kBuildingCeiling, pf::sim::buildingClutter(), people);
+      rig.scene.emplace(world, pf::sim::kBuildingCeiling, pf::sim::buildingClutter(), people);
       break;
     }
     case RigKind::kWarehouse: {
       const std::vector<pf::sim::Box3> pallets = pf::sim::warehousePallets();
-      checkObjectsOnMap(map, pallets,
+      checkObjectsOnMap(world, pallets,
                         "the warehouse rig's pallets (warehouse_map.h; it is made for "
                         "maps/warehouse.yaml)");
       add(pf::sim::amrWarehouseLidar(offsetSchedule(o.scan_every.value_or(kWarehouseEvery))),
           Model::kSafety);
       // No ceiling: a level lidar never reaches a warehouse's roof.
-      rig.scene.emplace(map, std::numeric_limits<double>::infinity(), pallets, people);
+      rig.scene.emplace(world, std::numeric_limits<double>::infinity(), pallets, people);
       break;
     }
   }
@@ -448,17 +470,17 @@ bool isValidReading(float r) { return r > 0.0f && std::isfinite(r); }
 
 // Writes the run into the bag; returns the fraction of invalid beams of the
 // planar lidars (covered ones included).
-double simulate(const Options& o, const pf::OccupancyGrid& map, const pf::sim::PathScript& script,
+double simulate(const Options& o, const pf::OccupancyGrid& world, const pf::sim::PathScript& script,
                 rosbag::Bag* bag) {
   const std::vector<pf::sim::Person> people =
       o.people ? script.people : std::vector<pf::sim::Person>{};
-  Rig rig = makeRig(o, map, people);
+  Rig rig = makeRig(o, world, people);
   // Separate streams, so that changing a sensor model leaves the odometry alone.
   pf::sim::SimRandom odom_random(o.seed * 2 + 1);
   pf::sim::DiffDriveParams odometry = odometryErrors(o.odom_error);
   odometry.unsigned_translation = o.unsigned_odometry;
   pf::sim::DiffDriveRobot robot(odometry, script.start);
-  const pf::sim::RayCaster walls(map);
+  const pf::sim::RayCaster walls(world);
 
   const int64_t start_ns = std::llround(o.start_time * 1e9);
   const int64_t last_tick = static_cast<int64_t>(std::ceil(script.duration() / kTick - 1e-9));
@@ -500,14 +522,30 @@ double clearanceRadius(RigKind rig) {
   return rig == RigKind::kNeato ? kNeatoRadius : pf::sim::kAmrRadius;
 }
 
+// The world the sensors see: the map, or with --changes the map changed,
+// whose changed share is printed and whose mask --change-mask writes.
+pf::OccupancyGrid worldOf(const Options& o, pf::OccupancyGrid map) {
+  if (o.changes.empty()) return map;
+  pf::sim::ChangedWorld changed = pf::sim::applyMapChanges(map, pf::sim::loadMapChanges(o.changes));
+  std::printf(
+      "%s: %d cells changed: %d added, %d removed, %.1f %% of the map's %d occupied cells\n",
+      o.changes.c_str(), changed.added + changed.removed, changed.added, changed.removed,
+      100.0 * changed.changedShare(), changed.map_occupied);
+  if (!o.change_mask.empty()) {
+    pf::saveMap(changed.maskGrid(), o.change_mask);
+    std::printf("wrote %s: the true change mask\n", o.change_mask.c_str());
+  }
+  return std::move(changed.world);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const Options o = parseOptions(argc, argv);
   try {
-    const pf::OccupancyGrid map = pf::loadMap(o.map);
+    const pf::OccupancyGrid world = worldOf(o, pf::loadMap(o.map));
     const pf::sim::PathScript script = pf::sim::loadPathScript(o.path);
-    if (const auto error = pf::sim::checkClearance(script, map, clearanceRadius(o.rig))) {
+    if (const auto error = pf::sim::checkClearance(script, world, clearanceRadius(o.rig))) {
       std::cerr << "pf_simulator: " << *error << "\n";
       return 1;
     }
@@ -515,7 +553,7 @@ int main(int argc, char** argv) {
     bag.setCompression(o.compression == "bz2"   ? rosbag::compression::BZ2
                        : o.compression == "lz4" ? rosbag::compression::LZ4
                                                 : rosbag::compression::Uncompressed);
-    const double invalid = simulate(o, map, script, &bag);
+    const double invalid = simulate(o, world, script, &bag);
     bag.close();
     std::printf("wrote %s: %.1f s, %zu motions, %.1f %% invalid beams\n", o.out.c_str(),
                 script.duration(), script.motions.size(), 100.0 * invalid);
