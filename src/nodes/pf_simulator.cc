@@ -155,6 +155,14 @@ constexpr char kUsage[] =
   std::exit(2);
 }
 
+RigKind rigKind(const std::string& name) {
+  if (name == "neato") return RigKind::kNeato;
+  if (name == "amr") return RigKind::kAmr;
+  if (name == "cloud") return RigKind::kCloud;
+  if (name != "warehouse") usage("--rig must be neato, amr, cloud or warehouse");
+  return RigKind::kWarehouse;
+}
+
 Options parseOptions(int argc, char** argv) {
   Options o;
   for (int i = 1; i < argc; ++i) {
@@ -185,18 +193,7 @@ Options parseOptions(int argc, char** argv) {
       if (s < 0 || s != std::floor(s)) usage("--seed must be a non-negative integer");
       o.seed = static_cast<uint64_t>(s);
     } else if (arg == "--rig") {
-      const std::string rig = value();
-      if (rig == "neato") {
-        o.rig = RigKind::kNeato;
-      } else if (rig == "amr") {
-        o.rig = RigKind::kAmr;
-      } else if (rig == "cloud") {
-        o.rig = RigKind::kCloud;
-      } else if (rig == "warehouse") {
-        o.rig = RigKind::kWarehouse;
-      } else {
-        usage("--rig must be neato, amr, cloud or warehouse");
-      }
+      o.rig = rigKind(value());
     } else if (arg == "--compression") {
       o.compression = value();
       if (o.compression != "bz2" && o.compression != "lz4" && o.compression != "none") {
