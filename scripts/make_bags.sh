@@ -1,8 +1,11 @@
 #!/usr/bin/env bash
 # Regenerates the package's maps and simulated bags, byte for byte: the maps
 # are drawn by code (pf_make_map), each bag comes from a map, a path script
-# in bags/ and a seed (pf_simulator). The tables below are the only place the
-# seeds live; bags/README.md repeats them.
+# in bags/ and a seed (pf_simulator), and for some a changes file in bags/
+# (pf_simulator --changes: the world differs from the map), whose true change
+# mask is written beside it (bags/NAME_mask.yaml and .pgm) and checked like the
+# bags. The tables below are the only place the seeds live; bags/README.md
+# repeats them.
 #
 #   scripts/make_bags.sh           rewrite maps/ and bags/ in the repository
 #   scripts/make_bags.sh --check   regenerate into a temporary folder and compare
@@ -39,21 +42,43 @@ bags="tracking           building  1
       two_lidar_covered  building  9     --rig amr --block front:30:42
       warehouse_tracking warehouse 11    --rig warehouse --scan-period 0.2
       warehouse_global   warehouse 12    --rig warehouse --scan-period 0.2
-      warehouse_kidnap   warehouse 13    --rig warehouse --scan-period 0.2"
+      warehouse_kidnap   warehouse 13    --rig warehouse --scan-period 0.2
+      changed_10         building  14
+      changed_20         building  15
+      changed_30         building  16
+      crowd_changed      building  17
+      warehouse_changed  warehouse 18    --rig warehouse --scan-period 0.2"
 # The bags' path scripts are bags/BAG.path, but for these, which share one.
 path_of() {
   case "$1" in
     two_lidar_covered) echo two_lidar ;;
+    changed_10 | changed_20 | changed_30) echo tracking ;;
+    crowd_changed) echo crowd ;;
+    warehouse_changed) echo warehouse_tracking ;;
     *) echo "$1" ;;
+  esac
+}
+# The bags whose world differs from their map: their changes file is
+# bags/NAME.changes, NAME as this prints it (nothing: the world is the map).
+changes_of() {
+  case "$1" in
+    changed_10 | changed_20 | changed_30 | warehouse_changed) echo "$1" ;;
+    crowd_changed) echo changed_20 ;;
   esac
 }
 #          bag    map       seed  simulator options
 generated="cloud  building  10    --rig cloud --scan-period 0.4"
 
-# simulate BIN MAPS_DIR OUT_DIR BAG MAP SEED OPTIONS...
+# simulate BIN MAPS_DIR OUT_DIR BAG MAP SEED OPTIONS...: a bag with changes
+# also writes its changes' mask into OUT_DIR.
 simulate() {
-  local bin=$1 maps=$2 outdir=$3 bag=$4 map=$5 seed=$6
+  local bin=$1 maps=$2 outdir=$3 bag=$4 map=$5 seed=$6 changes
   shift 6
+  changes=$(changes_of "$bag")
+  if [ -n "$changes" ]; then
+    set -- "$@" --changes "$repo/bags/$changes.changes" \
+      --change-mask "$outdir/${changes}_mask.yaml"
+  fi
   "$bin/pf_simulator" --map "$maps/$map.yaml" --path "$repo/bags/$(path_of "$bag").path" \
     --seed "$seed" --out "$outdir/$bag.bag" "$@"
 }
@@ -110,7 +135,9 @@ if $check; then
   status=0
   for f in maps/building.yaml maps/building.pgm maps/small.yaml maps/small.pgm \
            maps/corridor.yaml maps/corridor.pgm maps/warehouse.yaml maps/warehouse.pgm \
-           $(awk '{print "bags/" $1 ".bag"}' <<<"$bags"); do
+           $(awk '{print "bags/" $1 ".bag"}' <<<"$bags") \
+           $(while read -r bag _; do changes_of "$bag"; done <<<"$bags" | sort -u |
+               awk '{print "bags/" $1 "_mask.yaml bags/" $1 "_mask.pgm"}'); do
     want=$(sha256sum <"$repo/$f" 2>/dev/null | cut -d' ' -f1 || true)
     got=$(sha256sum <"$out/$f" | cut -d' ' -f1)
     if [ "$want" = "$got" ]; then
