@@ -37,31 +37,20 @@ OccupancyGrid room() {
                             1.0);
 }
 
-// The world's (or the mask's) rows, top row first, as room() draws them:
-// '#' occupied, '.' free, '?' unknown; for the mask '+' added, '-' removed,
-// '.' unchanged.
-std::vector<std::string> rowsOf(const OccupancyGrid& g) {
-  std::vector<std::string> rows;
-  for (int j = g.height() - 1; j >= 0; --j) {
-    std::string row;
-    for (int i = 0; i < g.width(); ++i) {
-      const CellState s = g.state({i, j});
-      row += s == CellState::kOccupied ? '#' : s == CellState::kFree ? '.' : '?';
-    }
-    rows.push_back(row);
-  }
-  return rows;
-}
-
-std::vector<std::string> maskRows(const ChangedWorld& w) {
+// The world and its mask side by side, row by row from the top as room()
+// draws them: the world '#' occupied, '.' free, '?' unknown; the mask '+'
+// added, '-' removed, '.' unchanged.
+std::vector<std::string> picture(const ChangedWorld& w) {
   std::vector<std::string> rows;
   for (int j = w.world.height() - 1; j >= 0; --j) {
-    std::string row;
+    std::string world, mask;
     for (int i = 0; i < w.world.width(); ++i) {
+      const CellState s = w.world.state({i, j});
+      world += s == CellState::kOccupied ? '#' : s == CellState::kFree ? '.' : '?';
       const CellChange c = w.mask[w.world.linearIndex({i, j})];
-      row += c == CellChange::kAdded ? '+' : c == CellChange::kRemoved ? '-' : '.';
+      mask += c == CellChange::kAdded ? '+' : c == CellChange::kRemoved ? '-' : '.';
     }
-    rows.push_back(row);
+    rows.push_back(world + " " + mask);
   }
   return rows;
 }
@@ -121,16 +110,11 @@ TEST(MapChangesTest, NoChangesGiveTheMap) {
 TEST(MapChangesTest, AddFillsTheCellsWhoseCentresAreInTheBox) {
   // Centres (1.5, 3.5) and (2.5, 3.5) are inside; (3.5, 3.5) is not.
   const ChangedWorld w = apply("add 1.2 3.0 3.0 3.9\n");
-  EXPECT_EQ(rowsOf(w.world), (std::vector<std::string>{"#######",  //
-                                                       "###...#",  //
-                                                       "#..##.#",  //
-                                                       "#....?#",  //
-                                                       "#######"}));
-  EXPECT_EQ(maskRows(w), (std::vector<std::string>{".......",  //
-                                                   ".++....",  //
-                                                   ".......",  //
-                                                   ".......",  //
-                                                   "......."}));
+  EXPECT_EQ(picture(w), (std::vector<std::string>{"####### .......",  //
+                                                  "###...# .++....",  //
+                                                  "#..##.# .......",  //
+                                                  "#....?# .......",  //
+                                                  "####### ......."}));
   EXPECT_EQ(w.added, 2);
   EXPECT_EQ(w.removed, 0);
   EXPECT_DOUBLE_EQ(w.changedShare(), 2.0 / 22.0);
@@ -147,16 +131,11 @@ TEST(MapChangesTest, RemoveFreesOnlyOccupiedCells) {
   // The box takes the table and the unknown cell: the table goes, the
   // unknown cell stays unknown, the free cells stay free.
   const ChangedWorld w = apply("remove 2.6 1.1 5.9 2.9   # the table\n");
-  EXPECT_EQ(rowsOf(w.world), (std::vector<std::string>{"#######",  //
-                                                       "#.....#",  //
-                                                       "#.....#",  //
-                                                       "#....?#",  //
-                                                       "#######"}));
-  EXPECT_EQ(maskRows(w), (std::vector<std::string>{".......",  //
-                                                   ".......",  //
-                                                   "...--..",  //
-                                                   ".......",  //
-                                                   "......."}));
+  EXPECT_EQ(picture(w), (std::vector<std::string>{"####### .......",  //
+                                                  "#.....# .......",  //
+                                                  "#.....# ...--..",  //
+                                                  "#....?# .......",  //
+                                                  "####### ......."}));
   EXPECT_EQ(w.added, 0);
   EXPECT_EQ(w.removed, 2);
   EXPECT_DOUBLE_EQ(w.changedShare(), 2.0 / 22.0);
@@ -166,16 +145,11 @@ TEST(MapChangesTest, MoveCountsOnlyTheCellsLeftAndEntered) {
   // The table one cell west: it leaves (4, 2), enters (2, 2), and (3, 2)
   // stays occupied. 0.6 m rounds to one 1 m cell.
   const ChangedWorld w = apply("move 3 2 5 3 -0.6 0\n");
-  EXPECT_EQ(rowsOf(w.world), (std::vector<std::string>{"#######",  //
-                                                       "#.....#",  //
-                                                       "#.##..#",  //
-                                                       "#....?#",  //
-                                                       "#######"}));
-  EXPECT_EQ(maskRows(w), (std::vector<std::string>{".......",  //
-                                                   ".......",  //
-                                                   "..+.-..",  //
-                                                   ".......",  //
-                                                   "......."}));
+  EXPECT_EQ(picture(w), (std::vector<std::string>{"####### .......",  //
+                                                  "#.....# .......",  //
+                                                  "#.##..# ..+.-..",  //
+                                                  "#....?# .......",  //
+                                                  "####### ......."}));
   EXPECT_EQ(w.added, 1);
   EXPECT_EQ(w.removed, 1);
 }
@@ -184,11 +158,11 @@ TEST(MapChangesTest, MoveTakesTheWallsInItsBoxAlong) {
   // A box over the east wall moved one cell west: the wall cells in it move
   // into the room and leave free cells (a gap in the wall) behind.
   const ChangedWorld w = apply("move 6 2 7 4 -1 0\n");
-  EXPECT_EQ(rowsOf(w.world), (std::vector<std::string>{"#######",  //
-                                                       "#....#.",  //
-                                                       "#..###.",  //
-                                                       "#....?#",  //
-                                                       "#######"}));
+  EXPECT_EQ(picture(w), (std::vector<std::string>{"####### .......",  //
+                                                  "#....#. .....+-",  //
+                                                  "#..###. .....+-",  //
+                                                  "#....?# .......",  //
+                                                  "####### ......."}));
   EXPECT_EQ(w.added, 2);
   EXPECT_EQ(w.removed, 2);
 }
@@ -201,11 +175,11 @@ TEST(MapChangesTest, CommandsApplyInOrder) {
       "move 1 1 2 2 0 2\n"
       "remove 3 2 5 3\n"
       "add 3 2 4 3\n");
-  EXPECT_EQ(maskRows(w), (std::vector<std::string>{".......",  //
-                                                   ".+.....",  //
-                                                   "....-..",  //
-                                                   ".......",  //
-                                                   "......."}));
+  EXPECT_EQ(picture(w), (std::vector<std::string>{"####### .......",  //
+                                                  "##....# .+.....",  //
+                                                  "#..#..# ....-..",  //
+                                                  "#....?# .......",  //
+                                                  "####### ......."}));
   EXPECT_EQ(w.added, 1);
   EXPECT_EQ(w.removed, 1);
 }
@@ -215,14 +189,14 @@ TEST(MapChangesTest, AddDiscTakesTheCellsWithinItsRadius) {
   // cells whose centres are within 0.2 m: 3 in each quadrant.
   const OccupancyGrid map = test::gridFromRows(std::vector<std::string>(8, "........"), 0.1);
   const ChangedWorld w = applyMapChanges(map, parse("add_disc 0.4 0.4 0.2\n"));
-  EXPECT_EQ(rowsOf(w.world), (std::vector<std::string>{"........",  //
-                                                       "........",  //
-                                                       "...##...",  //
-                                                       "..####..",  //
-                                                       "..####..",  //
-                                                       "...##...",  //
-                                                       "........",  //
-                                                       "........"}));
+  EXPECT_EQ(picture(w), (std::vector<std::string>{"........ ........",  //
+                                                  "........ ........",  //
+                                                  "...##... ...++...",  //
+                                                  "..####.. ..++++..",  //
+                                                  "..####.. ..++++..",  //
+                                                  "...##... ...++...",  //
+                                                  "........ ........",  //
+                                                  "........ ........"}));
   EXPECT_EQ(w.added, 12);
   EXPECT_EQ(w.map_occupied, 0);
   EXPECT_DOUBLE_EQ(w.changedShare(), 0.0);
