@@ -7,8 +7,8 @@
 set -euo pipefail
 
 packages=(
-  # build tools
-  build-essential cmake catkin catkin-lint python3-catkin-pkg clang-format
+  # build tools; ccache: every build of the tests after the first reuses its objects
+  build-essential cmake catkin catkin-lint python3-catkin-pkg clang-format ccache
   # scripts/make_deb.sh: dpkg-shlibdeps, dpkg-architecture (build-essential pulls it in too)
   dpkg-dev
   # `catkin build` (catkin_tools; Debian calls it catkin-tools, not python3-catkin-tools)

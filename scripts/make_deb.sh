@@ -128,15 +128,20 @@ mkdir -p "$build" "$stage"
 echo "make_deb: building $name $version in $build" >&2
 # A clean environment: a sourced workspace (CMAKE_PREFIX_PATH, ROS_PACKAGE_PATH,
 # PYTHONPATH) must not leak into a package built against /usr.
-clean_env=(env -i HOME="${HOME:-/tmp}" PATH=/usr/bin:/bin LANG=C.UTF-8)
-"${clean_env[@]}" cmake -S "$repo" -B "$build" \
-  -DCMAKE_INSTALL_PREFIX=/usr -DCMAKE_BUILD_TYPE=Release \
+clean_env=(env -i HOME="${HOME:-/tmp}" PATH=/usr/bin:/bin LANG=C.UTF-8 ${CCACHE_DIR:+CCACHE_DIR=$CCACHE_DIR})
+# Laid out as a catkin workspace is (src/pf_localization, build/pf_localization,
+# devel/), so that ccache finds the objects a workspace compiled
+# (CMakeLists.txt, PF_CCACHE): the compile lines are the same relative to $build.
+mkdir -p "$build/src" "$build/build/$name"
+ln -sfn "$repo" "$build/src/$name"
+"${clean_env[@]}" cmake -S "$build/src/$name" -B "$build/build/$name" \
+  -DCMAKE_INSTALL_PREFIX=/usr -DCMAKE_BUILD_TYPE=Release -DCATKIN_DEVEL_PREFIX="$build/devel" \
   -DCATKIN_BUILD_BINARY_PACKAGE=ON -DCATKIN_ENABLE_TESTING=OFF \
   -DPYTHON_EXECUTABLE=/usr/bin/python3 >"$build/make_deb_cmake.log" 2>&1 ||
   { tail -n 30 "$build/make_deb_cmake.log" >&2; die "cmake failed (log: $build/make_deb_cmake.log)"; }
-"${clean_env[@]}" make -C "$build" -j"$jobs" >"$build/make_deb_build.log" 2>&1 ||
+"${clean_env[@]}" make -C "$build/build/$name" -j"$jobs" >"$build/make_deb_build.log" 2>&1 ||
   { grep -E 'error|Error' "$build/make_deb_build.log" | head -n 20 >&2; die "build failed (log: $build/make_deb_build.log)"; }
-"${clean_env[@]}" DESTDIR="$stage" make -C "$build" install >"$build/make_deb_install.log" 2>&1 ||
+"${clean_env[@]}" DESTDIR="$stage" make -C "$build/build/$name" install >"$build/make_deb_install.log" 2>&1 ||
   { tail -n 20 "$build/make_deb_install.log" >&2; die "make install failed (log: $build/make_deb_install.log)"; }
 
 # Everything under /usr, and no workspace files (setup.bash, .catkin, ...): a
