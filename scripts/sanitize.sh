@@ -17,7 +17,8 @@ tests=(pf_core_test pf_sim_test pf_ros_test pf_fuzz_replay_test)
 start=$(date +%s)
 
 echo "sanitize: building ${tests[*]} with PF_SANITIZE=ON in $ws"
-if ! PF_WS=$ws PF_CMAKE_ARGS="-DPF_SANITIZE=ON" bash "$repo/scripts/build.sh" "${tests[@]}" \
+# -j2: catkin_make's default adds -l2, which on a busy machine compiles one file at a time.
+if ! PF_WS=$ws PF_CMAKE_ARGS="-DPF_SANITIZE=ON" bash "$repo/scripts/build.sh" "${tests[@]}" -j2 \
   >"$ws.build.log" 2>&1; then
   tail -40 "$ws.build.log"
   echo "sanitize: build failed (log: $ws.build.log)" >&2
