@@ -1,355 +1,221 @@
 #!/usr/bin/env bash
-# Installs the dependencies, builds the package and runs every test: the
-# GoogleTest unit tests, the rostest integration tests on the bundled bags,
-# the catkin checks (catkin_lint, rosrun and bag_demo.launch from the devel
-# and the install space: scripts/space_checks.bash), the Debian package
-# (scripts/make_deb.sh: its contents, and the demo from it unpacked), the Python unit tests,
-# the source checks (clang-format, a ROS-free core) and
-# the unit tests once more under AddressSanitizer + UndefinedBehaviorSanitizer.
-# Ends with one line "N passed, N failed"; exits non-zero when anything failed
-# or when no test ran at all.
+# The project's tests, in two tiers.
+#
+#   bash scripts/test.sh           every check: what .ci/run runs, and what a change must pass
+#   bash scripts/test.sh --quick   the edit-test loop: build what changed, then the unit tests
+#                                  (GoogleTest, Python) and the source checks; no bag replay,
+#                                  no second build
+#
+# Both install the dependencies (scripts/install_deps.sh; nothing when they are there)
+# and build the package and its test binaries on both cores, through ccache
+# (CMakeLists.txt, PF_CCACHE). --quick then runs its checks two at a time. The full
+# run runs, on two lanes:
+#   - side by side at normal priority, PF_TEST_JOBS at a time (default 6): the README
+#     walked through (scripts/readme_walkthrough.sh: its clean builds come from
+#     ccache), the Python tests, the GoogleTest binaries, the source checks, the
+#     rostests (each starts its own master on a free port and mostly waits for its
+#     bag's clock: about 0.15 of a core each; the longest first, by the last run's
+#     times) and the rviz click test;
+#   - one after another at the lowest priority (nice 19), so that the rostests'
+#     clocks keep their pace: the unit tests built and run under ASan + UBSan
+#     (scripts/sanitize.sh), the Debian package (scripts/make_deb.sh) and the
+#     replays whose figures do not depend on the machine's load (pf_bag_runner is
+#     deterministic for a seed: test_checks.bash);
+# then the install space and its demo.
+#
+# Every check's output goes to a log in <workspace>/test_logs/ (its tail is shown when
+# it fails); each prints one line with its time, and the end lists the ten slowest,
+# the total, and last one line "N passed, N failed": every GoogleTest case, every
+# rostest's test node, every Python test and every other check count one. Exits
+# non-zero when anything failed or nothing ran; the full run also fails when it took
+# longer than PF_TEST_BUDGET_S (1500 s).
 set -uo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
+quick=0
+case "${1:-}" in
+  --quick) quick=1 ;;
+  "") ;;
+  -h | --help) sed -n '2,/^set -uo/p' "$0" | sed '$d; s/^# \{0,1\}//'; exit 0 ;;
+  *) echo "test.sh: unknown argument '$1' (see --help)" >&2; exit 2 ;;
+esac
 # shellcheck source=scripts/workspace.bash
 source "$repo/scripts/workspace.bash"
+# shellcheck source=scripts/space_checks.bash
+source "$repo/scripts/space_checks.bash"
+# shellcheck source=scripts/test_checks.bash
+source "$repo/scripts/test_checks.bash"
 ws=$(pf_default_ws "$repo")
 export PATH=/usr/bin:$PATH
+# One compiler cache for every build of the run, wherever XDG_CACHE_HOME points later.
+export CCACHE_DIR=${CCACHE_DIR:-${XDG_CACHE_HOME:-${HOME:-/tmp}/.cache}/ccache}
 cd "$repo" || exit 1
+start=$EPOCHREALTIME
+budget=${PF_TEST_BUDGET_S:-1500}
+jobs=${PF_TEST_JOBS:-6}
 
 bash scripts/install_deps.sh || { echo "install failed"; echo "0 passed, 1 failed"; exit 1; }
-rm -rf "$ws/build/test_results"
-if ! bash scripts/build.sh; then
-  echo "build failed"; echo "0 passed, 1 failed"; exit 1
+mkdir -p "$ws"
+logs=$ws/test_logs
+results=$ws/build/test_results
+rm -rf "$logs" "$results"
+mkdir -p "$logs"
+if ! bash scripts/build.sh all tests -j2 >"$logs/build.log" 2>&1; then
+  tail -n 40 "$logs/build.log"
+  echo "build failed (log: $logs/build.log)"; echo "0 passed, 1 failed"; exit 1
 fi
+echo "built in $(awk -v a="$start" -v b="$EPOCHREALTIME" 'BEGIN {printf "%.0f", b - a}') s"
+mkdir -p "$results/pf_localization"
+pf_source_workspace "$ws" test || { echo "0 passed, 1 failed"; exit 1; }
 
-passed=0 failed=0
-check() {  # check NAME COMMAND...: a source check counted as one test
-  local name=$1; shift
-  if "$@"; then echo "[check] $name: ok"; passed=$((passed + 1));
-  else echo "[check] $name: FAILED"; failed=$((failed + 1)); fi
+# --- Jobs ----------------------------------------------------------------------------
+# job KIND NAME COMMAND...: runs COMMAND with its output in $logs/KIND_NAME.log and
+# appends "KIND NAME EXIT SECONDS" to $logs/times. KIND check: COMMAND's exit
+# status is the verdict (one test); for the others (gtest, rostest, python) their
+# cases are counted.
+job() {
+  local kind=$1 name=$2 t0=$EPOCHREALTIME rc secs log
+  shift 2
+  log=$logs/${kind}_${name//[^A-Za-z0-9_.-]/_}.log
+  "$@" </dev/null >"$log" 2>&1
+  rc=$?
+  secs=$(awk -v a="$t0" -v b="$EPOCHREALTIME" 'BEGIN {printf "%.1f", b - a}')
+  printf '%s\t%s\t%d\t%s\n' "$kind" "$name" "$rc" "$secs" >>"$logs/times"
+  if [ "$rc" -eq 0 ]; then
+    printf '[%s] %s: ok (%s s)\n' "$kind" "$name" "$secs"
+  else
+    printf '[%s] %s: FAILED (%s s; log: %s)\n' "$kind" "$name" "$secs" "$log"
+    tail -n 15 "$log" | sed 's/^/    /'
+  fi
+  return "$rc"
 }
 
-# --- GoogleTest and rostest, through catkin ---------------------------------
-bash scripts/build.sh run_tests -j1 2>&1 | tee "$ws/run_tests.log" | grep -E "^\[ *(OK|FAILED|PASSED) *\]|^\[ROSTEST\]|^\[Testcase|FAILURE|Error" || true
-pf_source_workspace "$ws" test || failed=$((failed + 1))
-catkin_test_results "$ws/build/test_results" 2>&1 | grep -vE "^Skipping" | tail -n 20
-read -r ok bad < <(/usr/bin/python3 scripts/count_test_results.py "$ws/build/test_results")
-passed=$((passed + ${ok:-0}))
-failed=$((failed + ${bad:-1}))
+# Jobs queued with `queue KIND NAME COMMAND...` run by run_queue N, N at a time,
+# in the order queued.
+queued=()
+queue() { queued+=("$(printf '%q ' "$@")"); }
+run_queue() {
+  local n=$1 spec pid finished
+  local -a running=() still
+  for spec in "${queued[@]}"; do
+    while [ ${#running[@]} -ge "$n" ]; do
+      wait -n -p finished "${running[@]}"
+      still=()
+      for pid in "${running[@]}"; do [ "$pid" = "$finished" ] || still+=("$pid"); done
+      running=("${still[@]}")
+    done
+    eval "job $spec" &
+    running+=("$!")
+  done
+  for pid in "${running[@]}"; do wait "$pid"; done
+  queued=()
+}
+
+# gtest BINARY: one GoogleTest binary, its cases in gtest-BINARY.xml.
+gtest() {
+  "$ws/devel/lib/pf_localization/$1" --gtest_output="xml:$results/pf_localization/gtest-$1.xml"
+}
+# rostest FILE ARGS...: one rostest as catkin's run_tests target runs it (run_tests.py
+# writes a failure when the test left no result file).
+rostest_run() {
+  local file=$1 name
+  shift
+  name=test_rostest_$(basename "$file" .test)
+  /usr/bin/python3 /usr/share/catkin/cmake/test/run_tests.py \
+    "$results/pf_localization/rostest-$name.xml" \
+    "/usr/bin/python3 /usr/bin/rostest --pkgdir=$ws/src/pf_localization --package=pf_localization \
+--results-filename $name.xml --results-base-dir $results $ws/src/pf_localization/$file $*"
+}
+
+queue_unit_tier() {  # the unit tests and the source checks
+  local t
+  queue python "Python unit tests (test/python)" python_unit_tests "$logs/python_counts"
+  for t in pf_core_test pf_sim_test pf_ros_test pf_fuzz_replay_test; do queue gtest "$t" gtest "$t"; done
+  queue check "catkin_lint -W1 clean" catkin_lint_clean
+  queue check "the core and the simulator include no ROS header" core_is_ros_free
+  queue check "no function in src/ longer than 80 lines" no_long_functions
+  queue check "clang-format clean" clang_format_clean
+}
+
+# The low-priority lane: what needs a core for long but no clock.
+background_lane() {
+  job check "unit tests under ASan + UBSan (scripts/sanitize.sh)" bash scripts/sanitize.sh
+  if job check "make_deb.sh builds ros-pf-localization_VERSION_ARCH.deb" make_deb; then
+    job check "the .deb: fields, files under /usr, Depends cover its libraries and nodes" \
+      pf_check_deb "$(built_deb)" package.xml
+    job check "bag_demo.launch from the .deb unpacked with dpkg -x: pf_node publishes pf_pose" \
+      pf_check_deb_demo "$(built_deb)"
+  fi
+  job check "warehouse global localization, 1M particles: never localized wrong, the truth listed" \
+    warehouse_global
+  job check "warehouse global localization, default budget, 10 seeds: never localized wrong, the truth listed, localized by 44.1 s, an honest covariance" \
+    warehouse_global_default
+  job check "warehouse kidnap into the twin aisle, 10 seeds: found within 10 s of the first distinguishing scans" \
+    warehouse_kidnap
+  job check "corridor.bag at 5000 particles, 10 seeds: within 0.05 m RMSE and 0.15 m max" \
+    corridor_small_budget
+  job check "crowd.bag with updates every 0.05 m or 0.1 rad, 16 seeds: never confidently wrong, 15 tracked as with the defaults" \
+    close_updates
+  job check "the real recordings (intel_lab, fr079, neato_ac109_1): their precision" real_recordings
+}
+
+# The rostests, the longest first when an earlier run left their times.
+rostests_by_length() {
+  local file args secs
+  local previous=$ws/test_times
+  while read -r file args; do
+    [ -n "$file" ] || continue
+    secs=$(awk -F'\t' -v n="$(basename "$file" .test)" '$1 == "rostest" && $2 == n {print $4}' \
+      "$previous" 2>/dev/null | tail -n 1)
+    printf '%s\t%s\t%s\n' "${secs:-0}" "$file" "$args"
+  done <"$ws/build/pf_localization/rostests.txt" | sort -t$'\t' -k1,1nr | cut -f2-
+}
+
+full_tier() {
+  local file args
+  (renice -n 19 -p "$BASHPID" >/dev/null && background_lane) &
+  local background=$!
+  # The longest first: the walkthrough and the Python tests (each about 2 minutes).
+  queue check "the README, step by step (scripts/readme_walkthrough.sh)" bash scripts/readme_walkthrough.sh
+  queue_unit_tier
+  while IFS=$'\t' read -r file args; do
+    # shellcheck disable=SC2086  # the arguments are words
+    queue rostest "$(basename "$file" .test)" rostest_run "$file" $args
+  done < <(rostests_by_length)
+  queue check "rviz: 2D Pose Estimate clicked re-initialises pf_node (scripts/rviz_click_test.sh)" \
+    bash scripts/rviz_click_test.sh --out "$ws/rviz_click_test"
+  run_queue "$jobs"
+  job check "rosrun pf_evaluate from the devel space: no prompt, no loop" pf_check_rosrun "$ws/devel/setup.bash"
+  if job check "catkin_make install" install_space; then
+    job check "rosrun pf_evaluate from the install space: no prompt, no loop" pf_check_rosrun "$ws/install/setup.bash"
+    job check "no rostest checker node in the install space" pf_check_no_test_nodes "$ws/install/lib/pf_localization"
+    job check "bag_demo.launch from the install space alone: pf_node publishes pf_pose" pf_check_install_demo "$ws"
+  fi
+  wait "$background"
+}
+
+if [ "$quick" -eq 1 ]; then
+  export PF_TEST_TIER=quick
+  queue_unit_tier
+  run_queue 2
+else
+  full_tier
+fi
+
+# --- The verdict -----------------------------------------------------------------------
+total=$(awk -v a="$start" -v b="$EPOCHREALTIME" 'BEGIN {printf "%.0f", b - a}')
+if [ "$quick" -eq 0 ]; then
+  job check "the whole run within its budget of $budget s (it took $total s)" test "$total" -le "$budget"
+  cp "$logs/times" "$ws/test_times"
+fi
+echo "the ten slowest (s):"
+sort -t$'\t' -k4,4nr "$logs/times" | head -n 10 | awk -F'\t' '{printf "  %7.1f  %s %s\n", $4, $1, $2}'
+read -r ok bad < <(/usr/bin/python3 scripts/count_test_results.py "$results")
+read -r py_ok py_bad < <(cat "$logs/python_counts" 2>/dev/null || echo "0 1")
+checks_ok=$(awk -F'\t' '$1 == "check" && $3 == 0' "$logs/times" | wc -l)
+checks_bad=$(awk -F'\t' '$1 == "check" && $3 != 0' "$logs/times" | wc -l)
+passed=$((${ok:-0} + py_ok + checks_ok))
+failed=$((${bad:-1} + py_bad + checks_bad))
 [ "${ok:-0}" -eq 0 ] && { echo "no gtest or rostest result found"; failed=$((failed + 1)); }
-
-# --- A standard catkin package: lint, rosrun, the install space ----------------
-# shellcheck source=scripts/space_checks.bash
-source scripts/space_checks.bash
-catkin_lint_clean() {
-  local out
-  out=$(catkin_lint -W1 --strict --offline . 2>&1) && return 0
-  echo "$out" | head -n 30
-  return 1
-}
-install_space() {  # catkin_make install; from scratch in the scripts' own workspace
-  # (not in a PF_WS of the user's, whose install space may hold other packages)
-  case $ws in "$(pf_cache_dir "$repo")"/*) rm -rf "$ws/install" ;; esac
-  bash scripts/build.sh install >"$ws/install.log" 2>&1 && return 0
-  tail -n 30 "$ws/install.log"
-  return 1
-}
-check "catkin_lint -W1 clean" catkin_lint_clean
-check "rosrun pf_evaluate from the devel space: no prompt, no loop" pf_check_rosrun "$ws/devel/setup.bash"
-check "catkin_make install" install_space
-check "rosrun pf_evaluate from the install space: no prompt, no loop" pf_check_rosrun "$ws/install/setup.bash"
-check "no rostest checker node in the install space" pf_check_no_test_nodes "$ws/install/lib/pf_localization"
-check "bag_demo.launch from the install space alone: pf_node publishes pf_pose" pf_check_install_demo "$ws"
-
-# --- The Debian package (scripts/make_deb.sh) -------------------------------------
-# Built in $ws/build_deb (kept: the next run recompiles only what changed),
-# written to $ws/deb; read, then unpacked with dpkg -x into a temporary root
-# and run from there (installing it would need root and change /usr).
-make_deb() {
-  rm -rf "$ws/deb"
-  bash scripts/make_deb.sh --out "$ws/deb" --build-dir "$ws/build_deb" >"$ws/make_deb.log" 2>&1 && return 0
-  tail -n 30 "$ws/make_deb.log"
-  return 1
-}
-check "make_deb.sh builds ros-pf-localization_VERSION_ARCH.deb" make_deb
-deb=$(tail -n 1 "$ws/make_deb.log" 2>/dev/null)
-check "the .deb: fields, files under /usr, Depends cover its libraries and nodes" pf_check_deb "$deb" package.xml
-check "bag_demo.launch from the .deb unpacked with dpkg -x: pf_node publishes pf_pose" pf_check_deb_demo "$deb"
-
-# --- The simulated warehouse's twin aisles (issue 30) -----------------------
-# bag_run DIR BAG MAP MAX_GAP RUNNER_ARGS...: pf_bag_runner on BAG and MAP
-# into DIR (deterministic for a seed), then pf_evaluate into DIR/eval (a
-# reference pose matched within MAX_GAP s), with the published covariance's
-# honesty.
-bag_run() {
-  local dir=$1 bag=$2 map=$3 max_gap=$4 lib="$ws/devel/lib/pf_localization"
-  shift 4
-  rm -rf "$dir" && mkdir -p "$dir"
-  "$lib/pf_bag_runner" --bag "$bag" --map "$map" "$@" --out "$dir/traj.tum" \
-    --log "$dir/updates.csv" --hypotheses "$dir/hypotheses.csv" --covariance "$dir/cov.csv" \
-    --quiet >"$dir/runner.log" 2>&1 ||
-    { tail -n 5 "$dir/runner.log"; return 1; }
-  /usr/bin/python3 "$lib/pf_evaluate" --traj "$dir/traj.tum" --bag "$bag" --map "$map" \
-    --log "$dir/updates.csv" --hypotheses "$dir/hypotheses.csv" --cov "$dir/cov.csv" \
-    --max-gap "$max_gap" --out "$dir/eval" --no-plots >"$dir/eval.log" 2>&1 ||
-    { tail -n 5 "$dir/eval.log"; return 1; }
-}
-
-# warehouse_run DIR BAG RUNNER_ARGS...: bag_run on maps/warehouse.yaml.
-warehouse_run() {
-  local dir=$1 bag=$2
-  shift 2
-  bag_run "$dir" "$bag" maps/warehouse.yaml 0.5 "$@"
-}
-
-# warehouse_seeds DIR BAG RUNNER_ARGS...: warehouse_run for seeds 1-10, into
-# DIR/seed1 ... DIR/seed10.
-warehouse_seeds() {
-  local dir=$1 bag=$2 seed
-  shift 2
-  for seed in 1 2 3 4 5 6 7 8 9 10; do
-    warehouse_run "$dir/seed$seed" "$bag" --seed $seed "$@" || return 1
-  done
-}
-
-# Global localization with a million particles (seed 2): never "localized" at
-# the wrong place, and the true place among the published hypotheses (within
-# 1 m of one's mean or inside its 95 % ellipse) in every update. Without
-# GlobalSearch (the smoothed likelihood, then the settling), seed 1: 57
-# updates confidently wrong, the truth listed in 59 %; with 32 hypotheses
-# listed instead of 64, seed 2 misses it in 2 updates. About 10 s.
-warehouse_global() {
-  local out="$ws/warehouse_global"
-  warehouse_run "$out" bags/warehouse_global.bag --seed 2 --particles 1000000 || return 1
-  /usr/bin/python3 - "$out/eval/summary.json" <<'PY'
-import json, sys
-d = json.load(open(sys.argv[1]))
-wrong, share = d['confidently_wrong_updates'], d['hypotheses']['contain_truth_share']
-print('warehouse_global.bag, 1 000 000 particles, seed 2: %d updates confidently wrong, '
-      'the truth among the hypotheses in %.1f %% of %d' % (wrong, 100 * share, d['hypotheses']['updates']))
-# Every update: with 32 listed (before 64), seed 2 left the truth off in 2.
-sys.exit(0 if wrong == 0 and share == 1.0 else 1)
-PY
-}
-check "warehouse global localization, 1M particles: never localized wrong, the truth listed" warehouse_global
-
-# The same at the default budget (50 000), seeds 1-10: never "localized" at
-# the wrong place; the true place among the hypotheses in at least 99.9 %
-# of the updates (one miss in 2 500); and "localized" (so, at the right
-# place) within 10 s of the first scan that tells the aisles apart (34.1 s,
-# README), by 44.1 s. Such a cloud may hold the true aisle only a rack bay
-# or two from the truth: with the look-alikes of the estimate alone listed,
-# not those of every place the cloud holds, seeds 2, 4 and 8 left the truth
-# off in 10 updates between 0.9 and 1.7 s (99.6 %). While the fit had to be
-# below the usual one too before a better look-alike got a copy of the
-# cloud, seeds 4 and 8 were localized only at 45.9 and 44.3 s. And the
-# published covariance covers the look-alikes until a scan tells the place
-# apart (ConfidenceTracker::coverLookAlikes), and the map's error once it is
-# told apart (ScanRefiner::mapErrorCovariance): each seed has 85-99 % of the
-# reference poses inside its 95 % ellipse (90.4-93.4 % today) and a NEES
-# mean of at most 5 (2.2-2.8). While it was one aisle's, 33-77 % and up to
-# 8e5 (7 seeds over 3e4), the cloud alone in a wrong twin aisle saying 1 cm;
-# without the map's error, 72-77 %, the simulator's walls half a cell nearer
-# than the map's and the fit saying 1 cm. About 30 s.
-warehouse_global_default() {
-  local out="$ws/warehouse_global_default"
-  warehouse_seeds "$out" bags/warehouse_global.bag || return 1
-  /usr/bin/python3 - "$out" <<'PY'
-import csv, json, sys
-runs = [json.load(open('%s/seed%d/eval/summary.json' % (sys.argv[1], s))) for s in range(1, 11)]
-def localized_at(seed, start):
-    for row in csv.DictReader(open('%s/seed%d/updates.csv' % (sys.argv[1], seed))):
-        if row['state'] == 'localized':
-            return float(row['t']) - start
-    return float('inf')
-BY = 44.1  # s: 10 s after the first scan that tells the aisles apart
-localized = [localized_at(s + 1, d['reference_start_s']) for s, d in enumerate(runs)]
-wrong = sum(d['confidently_wrong_updates'] for d in runs)
-updates = sum(d['hypotheses']['updates'] for d in runs)
-listed = sum(d['hypotheses']['contain_truth_share'] * d['hypotheses']['updates'] for d in runs)
-misses = ['seed %d at %s s' % (s + 1, ', '.join('%.2f' % t for t in d['hypotheses']['misses_s']))
-          for s, d in enumerate(runs) if d['hypotheses']['misses_s']]
-inside = [d['covariance']['inside_95_percent'] for d in runs]
-nees = [d['covariance']['nees_mean'] for d in runs]
-print('warehouse_global.bag, 50 000 particles, seeds 1-10: %d updates confidently wrong, the truth '
-      'among the hypotheses in %.2f %% of %d (missed: %s), localized at %s s (bound %.1f s); '
-      'inside the published 95 %% ellipse %.1f-%.1f %% (bounds 85-99), NEES mean %.2f-%.2f (bound 5)'
-      % (wrong, 100 * listed / updates, updates, '; '.join(misses) or 'none',
-         ', '.join('%.1f' % t for t in localized), BY, min(inside), max(inside), min(nees), max(nees)))
-sys.exit(0 if wrong == 0 and listed >= 0.999 * updates and max(localized) <= BY
-         and min(inside) >= 85 and max(inside) <= 99 and max(nees) <= 5 else 1)
-PY
-}
-check "warehouse global localization, default budget, 10 seeds: never localized wrong, the truth listed, localized by 44.1 s, an honest covariance" warehouse_global_default
-
-# Kidnapped into the twin aisle: the default budget, seeds 1-10, never
-# "localized" wrong, and back within 0.3 m for good by 84.5 s, 10 s after the
-# scans first fit the twin clearly better (74.5 s, docs/design.md, "Look-alike
-# places"). With each look-alike given a share of the survivors instead of a
-# copy of them, seed 8 lost the twin on the next scan and was back only at
-# 87.5 s. About 20 s.
-warehouse_kidnap() {
-  local out="$ws/warehouse_kidnap"
-  warehouse_seeds "$out" bags/warehouse_kidnap.bag --initial-pose 5.0 6.0 1.5707963 || return 1
-  /usr/bin/python3 - "$out" <<'PY'
-import json, sys
-runs = [json.load(open('%s/seed%d/eval/summary.json' % (sys.argv[1], s))) for s in range(1, 11)]
-back = [d['convergence_time_s'] for d in runs]
-wrong = sum(d['confidently_wrong_updates'] for d in runs)
-print('warehouse_kidnap.bag, seeds 1-10: back within 0.3 m for good at %s s (bound 84.5 s); '
-      '%d updates confidently wrong' % (', '.join('%.1f' % b if b is not None else 'never' for b in back), wrong))
-sys.exit(0 if wrong == 0 and all(b is not None and b <= 84.5 for b in back) else 1)
-PY
-}
-check "warehouse kidnap into the twin aisle, 10 seeds: found within 10 s of the first distinguishing scans" warehouse_kidnap
-
-# --- The corridor bag's scans 2.5 s apart (issue 28) -------------------------
-# At a 5000-particle budget, seeds 1-10: within issue 28's corridor bounds
-# (RMSE 0.05 m, max 0.15 m) on every seed. While a step's motion noise grew
-# with its square (odometry_motion_model.h), a 1.9 m step turned the
-# direction of travel by 0.84 rad, the cloud fell 3.6 m behind the robot in
-# the featureless stretch, and seeds 4 and 6 published a pose 1.8 and 1.2 m
-# off where it ends. About 10 s.
-corridor_small_budget() {
-  local out="$ws/corridor_5000" seed
-  for seed in 1 2 3 4 5 6 7 8 9 10; do
-    bag_run "$out/seed$seed" bags/corridor.bag maps/corridor.yaml 0.1 \
-      --initial-pose 2.5 3.95 0.0 --particles 5000 --seed $seed || return 1
-  done
-  /usr/bin/python3 - "$out" <<'PY'
-import json, sys
-runs = [json.load(open('%s/seed%d/eval/summary.json' % (sys.argv[1], s))) for s in range(1, 11)]
-rmse, worst = [d['ate_rmse_m'] for d in runs], [d['max_m'] for d in runs]
-print('corridor.bag, 5000 particles, seeds 1-10: ATE RMSE %.3f-%.3f m (bound 0.05), max %.3f-%.3f m '
-      '(bound 0.15)' % (min(rmse), max(rmse), min(worst), max(worst)))
-sys.exit(0 if max(rmse) <= 0.05 and max(worst) <= 0.15 else 1)
-PY
-}
-check "corridor.bag at 5000 particles, 10 seeds: within 0.05 m RMSE and 0.15 m max" corridor_small_budget
-
-# --- Updates closer together than the defaults -------------------------------
-# crowd.bag with an amcl configuration's update_min_d 0.05 m and update_min_a
-# 0.1 rad, seeds 1-16: never "localized" more than 1 m off, and at least 15
-# of the 16 tracked as with the defaults (RMSE within 0.03 m, max within
-# 0.15 m; seed 2 jumps and comes back, "uncertain" meanwhile). While the
-# filter's evidence, motion noise, fault tracking and recovery counted
-# updates instead of views (new_view.h), every seed jumped 9-16 m to a place
-# that fits the scans people hide (ATE 3.6-5.9 m); while the scans of a
-# suspect odometry counted whole views, 5 of the 16 did (383 updates
-# confidently wrong). About 20 s.
-close_updates() {
-  local out="$ws/close_updates" seed
-  mkdir -p "$out"
-  printf 'update_min_d: 0.05\nupdate_min_a: 0.1\n' >"$out/params.yaml"
-  for seed in $(seq 1 16); do
-    bag_run "$out/seed$seed" bags/crowd.bag maps/building.yaml 0.5 \
-      --initial-pose 1.5 7.6 0.0 --params "$out/params.yaml" --seed $seed || return 1
-  done
-  /usr/bin/python3 - "$out" <<'PY'
-import json, sys
-runs = [json.load(open('%s/seed%d/eval/summary.json' % (sys.argv[1], s))) for s in range(1, 17)]
-tracked = [s for s, d in enumerate(runs, 1) if d['ate_rmse_m'] <= 0.03 and d['max_m'] <= 0.15]
-off = ['seed %d: %.3f m, max %.1f m' % (s, d['ate_rmse_m'], d['max_m'])
-       for s, d in enumerate(runs, 1) if s not in tracked]
-wrong = sum(d['confidently_wrong_updates'] for d in runs)
-print('crowd.bag, update_min_d 0.05 m, update_min_a 0.1 rad, seeds 1-16: %d tracked within 0.03 m '
-      'RMSE and 0.15 m max (bound 15)%s; %d updates confidently wrong (bound 0)'
-      % (len(tracked), ' (off: %s)' % '; '.join(off) if off else '', wrong))
-sys.exit(0 if len(tracked) >= 15 and wrong == 0 else 1)
-PY
-}
-check "crowd.bag with updates every 0.05 m or 0.1 rad, 16 seeds: never confidently wrong, 15 tracked as with the defaults" close_updates
-
-# --- The real recordings of ../shared/data (issue 28) -----------------------
-# scripts/benchmark_datasets on every recording there with a reference, with
-# the defaults (seed 1: each run is the same every time), held to issue 28's
-# targets: Intel <= 0.035 m, fr079 <= 0.065 m, AC109 <= 0.065 m after the
-# best rigid fit (its AprilTags are turned 3 deg from the map) and no worse
-# than 0.13 m raw; never more than 0.5 m off (issue 28 asks it of fr079 after
-# its first 10 s; every pose of all three meets it); never "localized" more
-# than 1 m off; where the reference's
-# noise is known well enough to judge it (not AC109, where 100 % of the tags
-# fall inside: docs/design.md, "An honest covariance"), 85-99 % of the
-# reference inside the published 95 % ellipse. The figures the defaults reach
-# are printed. Without the recordings this fails: CI always has them. About
-# 3 s.
-real_recordings() {
-  local out="$ws/real_recordings"
-  rm -rf "$out" && mkdir -p "$out"
-  PF_WS="$ws" /usr/bin/python3 scripts/benchmark_datasets 0 --no-bundled --no-plots --out "$out" \
-    >"$out/benchmark.log" 2>&1 || { tail -n 5 "$out/benchmark.log"; return 1; }
-  /usr/bin/python3 - "$out" <<'PY'
-import json, os, sys
-# name: (ATE RMSE bound, the same after the best rigid fit, whether the
-# published covariance is judged), metres.
-bounds = {'intel_lab': (0.035, None, True), 'fr079': (0.065, None, True),
-          'neato_ac109_1': (0.13, 0.065, False)}
-MAX_ERROR = 0.5  # m, of any pose
-ok = True
-for name, (raw, aligned, judge_cov) in sorted(bounds.items()):
-    path = os.path.join(sys.argv[1], name + '_default', 'eval', 'summary.json')
-    if not os.path.exists(path):
-        print('%s: no result (is ../shared/data/%s there?)' % (name, name))
-        ok = False
-        continue
-    d = json.load(open(path))
-    inside = d['covariance']['inside_95_percent']
-    good = (d['ate_rmse_m'] <= raw and (aligned is None or d['ate_aligned_rmse_m'] <= aligned)
-            and d['max_m'] <= MAX_ERROR and d['confidently_wrong_updates'] == 0
-            and (not judge_cov or 85.0 <= inside <= 99.0))
-    print('%s: ATE %.3f m (bound %.3f), after the rigid fit %.3f m%s, max %.2f m (bound %.1f), '
-          '%d updates confidently wrong, %.1f %% inside the 95 %% ellipse%s: %s'
-          % (name, d['ate_rmse_m'], raw, d['ate_aligned_rmse_m'],
-             ' (bound %.3f)' % aligned if aligned else '', d['max_m'], MAX_ERROR,
-             d['confidently_wrong_updates'], inside,
-             ' (85-99)' if judge_cov else ' (not judged)', 'ok' if good else 'FAILED'))
-    ok = ok and good
-sys.exit(0 if ok else 1)
-PY
-}
-check "the real recordings (intel_lab, fr079, neato_ac109_1): issue 28's precision" real_recordings
-
-# --- Python unit tests (pf_evaluate's metrics) ------------------------------
-if [ -d test/python ]; then
-  py_out=$(/usr/bin/python3 -m unittest discover -s test/python -p 'test_*.py' 2>&1)
-  echo "$py_out" | tail -n 5
-  ran=$(echo "$py_out" | sed -nE 's/^Ran ([0-9]+) tests?.*/\1/p')
-  bad=$(echo "$py_out" | sed -nE 's/^FAILED \((.*)\)/\1/p' | grep -oE '[0-9]+' | awk '{s += $1} END {print s + 0}')
-  passed=$((passed + ${ran:-0} - ${bad:-0}))
-  failed=$((failed + ${bad:-0}))
-  [ -z "$ran" ] && failed=$((failed + 1))
-fi
-
-# --- Source checks ------------------------------------------------------------
-core_is_ros_free() { ! grep -rnE '#include [<"](ros|tf2|sensor_msgs|nav_msgs|geometry_msgs|rosbag)/' include/pf_localization/core src/core include/pf_localization/sim src/sim; }
-clang_format_clean() {
-  local out
-  out=$(git ls-files '*.h' '*.cc' | xargs -r clang-format --dry-run -Werror 2>&1)
-  [ -z "$out" ] && return 0
-  echo "$out" | head -n 20
-  return 1
-}
-check "the core and the simulator include no ROS header" core_is_ros_free
-# The unit tests again, built with AddressSanitizer and UndefinedBehaviorSanitizer
-# (about 10 minutes from cold; PF_SKIP_SANITIZE=1 skips it in a hurry).
-if [ "${PF_SKIP_SANITIZE:-0}" != 1 ]; then
-  check "unit tests under ASan + UBSan (scripts/sanitize.sh)" bash scripts/sanitize.sh
-fi
-no_long_functions() {
-  local sources
-  mapfile -t sources < <(git ls-files 'src/*.cc')
-  /usr/bin/python3 scripts/long_functions.py --max 80 "${sources[@]}"
-}
-check "no function in src/ longer than 80 lines" no_long_functions
-check "clang-format clean" clang_format_clean
-# The rviz workflow in a real rviz under Xvfb (about 45 s).
-check "rviz: 2D Pose Estimate clicked re-initialises pf_node (scripts/rviz_click_test.sh)" \
-  bash scripts/rviz_click_test.sh --out "$ws/rviz_click_test"
-# The README followed as a user follows it, from clean builds (about 10 minutes;
-# PF_SKIP_WALKTHROUGH=1 skips it in a hurry).
-if [ "${PF_SKIP_WALKTHROUGH:-0}" != 1 ]; then
-  check "the README, step by step (scripts/readme_walkthrough.sh)" bash scripts/readme_walkthrough.sh
-fi
-
+echo "$total s in all"
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ] && [ "$passed" -gt 0 ]

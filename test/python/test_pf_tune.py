@@ -38,6 +38,10 @@ SMALL = ['--bags', os.path.join(REPO, 'bags', 'small.bag'), '--map', os.path.joi
 TWO_BAGS = ['--bags', os.path.join(REPO, 'bags', 'small.bag'), os.path.join(REPO, 'bags', 'tracking.bag'),
             '--map', os.path.join(REPO, 'maps', 'small.yaml'), '--map', os.path.join(REPO, 'maps', 'building.yaml'),
             '--initial-pose', '2.5', '2.6', '0', '--initial-pose', '1.5', '7.6', '0']
+# The quick tier (scripts/test.sh --quick) leaves out what replays bags: the score, the studies and
+# benchmark_datasets on Dask (about 100 s of the 2 minutes); the full run has them.
+REPLAYS = unittest.skipIf(os.environ.get('PF_TEST_TIER') == 'quick',
+                          'replays bags: scripts/test.sh runs it, --quick does not')
 # A bad parameter set: motion noise ten to fifteen times too large, a hit model seven times too wide.
 BAD = dict(odom_alpha1=3.0, odom_alpha2=3.0, odom_alpha3=3.0, odom_alpha4=3.0, laser_sigma_hit=1.5)
 
@@ -165,6 +169,7 @@ class SpaceAndParamsTest(unittest.TestCase):
         self.assertIsNone(pft.choose(base, {}, 0.005)[0])
 
 
+@REPLAYS
 class ScoreTest(unittest.TestCase):
     def setUp(self):
         self.assertTrue(RUNNER, NO_RUNNER)
@@ -221,6 +226,7 @@ class ScoreTest(unittest.TestCase):
         self.assertIn('pf_bag_runner exit', r['error'])
 
 
+@REPLAYS
 class StudyTest(unittest.TestCase):
     def setUp(self):
         self.assertTrue(RUNNER, NO_RUNNER)
@@ -365,6 +371,7 @@ def bundled_datasets():
     return list(benchmark.BUNDLED)
 
 
+@REPLAYS
 class BenchmarkOnDaskTest(unittest.TestCase):
     def test_benchmark_datasets_on_a_local_cluster_gives_the_sequential_table(self):
         self.assertTrue(RUNNER, NO_RUNNER)
