@@ -74,7 +74,12 @@ show_log() { tail -n "${2:-20}" "$1" | sed 's/^/    /'; echo "    (log: $1)"; }
 # --- "Two commands" -------------------------------------------------------------
 demo() {
   local log=$tmp/demo.log report
-  if ! (cd "$repo" && bash scripts/demo.sh) >"$log" 2>&1; then show_log "$log"; return 1; fi
+  # As a new user's shell runs it: no workspace sourced (a sourced one would
+  # put its devel space on the include path, and the build would differ).
+  if ! (cd "$repo" && env -i HOME="${HOME:-/tmp}" PATH=/usr/bin:/bin LANG=C.UTF-8 \
+      XDG_CACHE_HOME="$XDG_CACHE_HOME" CCACHE_DIR="$CCACHE_DIR" bash scripts/demo.sh) >"$log" 2>&1; then
+    show_log "$log"; return 1
+  fi
   report=$(sed -n 's/^demo: report in //p' "$log")
   for f in summary.json trajectory.png error.png spread.png cpu.png particles.gif; do
     [ -s "$report/$f" ] || { echo "    no $report/$f"; show_log "$log"; return 1; }
