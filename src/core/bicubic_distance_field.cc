@@ -51,7 +51,7 @@ FieldSample BicubicDistanceField::sample(double wx, double wy) const {
   const auto clamp = [](int v, int size) { return v < 0 ? 0 : (v >= size ? size - 1 : v); };
   int xs[4];
   for (int i = 0; i < 4; ++i) xs[i] = clamp(ix - 1 + i, width_);
-  const float* d = field_.distances().data();
+  const float* d = field_.surfaceDistances().data();
   double value = 0.0, dgx = 0.0, dgy = 0.0;
   for (int j = 0; j < 4; ++j) {
     const float* row_cells = d + static_cast<std::size_t>(clamp(iy - 1 + j, height_)) * width_;

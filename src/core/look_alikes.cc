@@ -8,6 +8,7 @@
 #include <unsupported/Eigen/FFT>
 #include <utility>
 
+#include "pf_localization/core/scan_group.h"
 #include "pf_localization/core/sensor_update.h"
 
 namespace pf {
@@ -277,8 +278,35 @@ void LookAlikes::lookAlikesOf(const OccupancyGrid& grid, const Pose2& pose,
   }
 }
 
+namespace {
+
+// Beams that pass a mapped obstacle or leave the map, placed from `pose`.
+std::size_t throughOrOff(const MapEvidence& evidence, const std::vector<PreparedScan>& scans,
+                         const Pose2& pose) {
+  const EvidenceCounts c = evidence.count(scans, pose);
+  return c.throughMap() + c.off_map;
+}
+
+// Whether the scans placed at the look-alike `place` pass the map's obstacles
+// or leave the map no more often than at `estimate` (kSeenMargin of the beams
+// more at most). A changed map can make a place fit better only by beams
+// that would have to see through its walls there.
+bool seenAsWell(const MapEvidence& evidence, const std::vector<PreparedScan>& scans,
+                const Pose2& estimate, const Pose2& place) {
+  const double beams = static_cast<double>(beamCount(scans));
+  return static_cast<double>(throughOrOff(evidence, scans, place)) <=
+         static_cast<double>(throughOrOff(evidence, scans, estimate)) +
+             LookAlikes::kSeenMargin * beams;
+}
+
+}  // namespace
+
+bool LookAlikes::considering() const {
+  return std::any_of(streaks_.begin(), streaks_.end(), [](int s) { return s > 0; });
+}
+
 LookAlikeView LookAlikes::judge(const SensorModel& model, const std::vector<PreparedScan>& scans,
-                                const Pose2& estimate) {
+                                const Pose2& estimate, const MapEvidence* evidence) {
   LookAlikeView view;
   if (symmetries_.empty()) return view;
   std::vector<Pose2> poses{estimate};  // the estimate, then its look-alikes in free space
@@ -297,7 +325,7 @@ LookAlikeView LookAlikes::judge(const SensorModel& model, const std::vector<Prep
       ++view.as_good;
       view.places.push_back({poses[j], fits[j]});
     }
-    if (fits[j] >= better) {
+    if (fits[j] >= better && (!evidence || seenAsWell(*evidence, scans, estimate, poses[j]))) {
       streaks[i] = streaks_[i] + 1;
       if (streaks[i] >= kBetterUpdates) view.better.push_back(symmetries_[i].motion);
     }

@@ -92,6 +92,7 @@ void ParticleFilter::setParams(const ParticleFilterParams& params) {
   motion_.setModel(motion);
   if (model) {
     sensor_.setModel(std::move(model));
+    evidence_.emplace(sensor_.model().field());
     search_.forgetModel();
   }
 }
@@ -99,6 +100,7 @@ void ParticleFilter::setParams(const ParticleFilterParams& params) {
 bool ParticleFilter::setMap(const OccupancyGrid& grid) {
   if (grid.empty()) throw std::invalid_argument("the map is empty");
   sensor_.setModel(makeSensorModel(grid, params_));
+  evidence_.emplace(sensor_.model().field());
   look_alikes_.setMap(sensor_.model().field());
   look_alike_places_.clear();
   search_.forgetModel();
@@ -178,6 +180,11 @@ namespace {
 // believed to be, agrees with the map: it is never taken for something that
 // moved in. Two cells of the usual 0.05 m map, about three beam_std.
 constexpr double kOnMapDistance = 0.1;
+// m of odometry since the last update beyond which the tracked pose is not
+// known well enough to judge beams from (map_change_mask.h): between
+// updates every update_min_d a robot goes 0.2 m; a sparse log (the Intel
+// lab's, a scan every metre) goes further.
+constexpr double kMaxJudgedStep = 0.5;
 
 // The report of what the gate decided (taking its detail).
 UpdateReport gateReport(GateDecision* gate, std::size_t particles) {
@@ -203,27 +210,70 @@ bool pinsAlong(const Eigen::Matrix3d& fit, double yaw, double margin) {
 
 }  // namespace
 
-ScanGroup ParticleFilter::maskTransients(const Pose2& odom, const ScanGroup& measured) {
-  if (!sensor_.hasModel() || !gate_.hasUpdated() || !odom.isFinite()) {
-    return transients_.mask(odom, measured, {}, &masked_scans_);
+std::optional<Pose2> ParticleFilter::trackedPose(const Pose2& odom) const {
+  if (!sensor_.hasModel() || !odom.isFinite()) return std::nullopt;
+  if (gate_.hasUpdated()) {
+    return compose(refinement_.mapToOdom(estimate_.pose, *gate_.odomAtUpdate()), odom);
   }
-  // The robot where the last estimate would be now had the odometry been right.
-  const Pose2 robot = compose(refinement_.mapToOdom(estimate_.pose, *gate_.odomAtUpdate()), odom);
+  // Before the first update, a pose the cloud was drawn around is where the
+  // robot is now (the first update moves nothing).
+  if (isInitialized() && confidence_.placeKnown()) return estimate_.pose;
+  return std::nullopt;
+}
+
+ScanGroup ParticleFilter::maskTransients(const Pose2& odom, const ScanGroup& measured) {
+  const std::optional<Pose2> robot = trackedPose(odom);
+  if (!robot) return transients_.mask(odom, measured, {}, &masked_scans_);
   const LikelihoodField& field = sensor_.model().field();
   // Two references: std::function holds them without allocating.
   const auto on_map = [&field, &robot](double x, double y) {
-    const Pose2 end = compose(robot, {x, y, 0.0});
+    const Pose2 end = compose(*robot, {x, y, 0.0});
     return field.distanceAt(end.x, end.y) < kOnMapDistance;
   };
   return transients_.mask(odom, measured, on_map, &masked_scans_);
 }
 
+ScanGroup ParticleFilter::maskMapChanges(const Pose2& odom, const ScanGroup& scans) {
+  const std::optional<Pose2> robot = trackedPose(odom);
+  if (!robot || !judgesFromTrackedPose(odom)) {
+    changes_.clear();
+    return scans;
+  }
+  return changes_.mask(*evidence_, scans, *robot, &changed_scans_);
+}
+
+bool ParticleFilter::judgesFromTrackedPose(const Pose2& odom) const {
+  // A place not told apart from its look-alikes, a cloud that holds several,
+  // a look-alike that just fitted clearly better, an estimate that jumped
+  // and is not confirmed yet, a lost one: for the filter's evidence to
+  // settle, and what the map lacks at the tracked place may be what tells.
+  if (!evidence_ || !confidence_.placeKnown() || confidence_.settling() ||
+      confidence_.confidence().state == LocalizationState::kLost || places_ > 1 ||
+      look_alikes_.considering()) {
+    return false;
+  }
+  // After a long step, or odometry that may be what is wrong, the tracked
+  // pose is not known well enough to tell a change of the map from its own
+  // error (the CARMEN logs keep a scan every metre; odometry_fault_tracker.h).
+  if (motion_.faults().suspect(params_.motion)) return false;
+  if (!gate_.hasUpdated()) return true;
+  const Pose2 step = between(*gate_.odomAtUpdate(), odom);
+  return std::hypot(step.x, step.y) <= kMaxJudgedStep;
+}
+
 UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& measured) {
-  const ScanGroup scans = maskTransients(odom, measured);
-  GateDecision gate = gate_.decide(odom, scans, sensor_.get(), isInitialized(), estimate_.pose,
+  const ScanGroup unmasked = maskTransients(odom, measured);
+  // Judged from the pose tracked since the last update, before the gate
+  // makes this one the last.
+  const ScanGroup scans = maskMapChanges(odom, unmasked);
+  // The gate judges the odometry by every beam: a scan that stops fitting
+  // where it says is what the beams masked for changes of the map would hide.
+  GateDecision gate = gate_.decide(odom, unmasked, sensor_.get(), isInitialized(), estimate_.pose,
                                    motion_.faults().suspect(params_.motion), params_);
   UpdateReport report = gateReport(&gate, particles_.size());
   report.beams_masked = transients_.masked();
+  report.beams_changed = changes_.masked();
+  report.map_evidence = changes_.counts();
   if (gate.scans) report.beams_dropped -= report.beams_masked;
   if (gate.skip == SkipReason::kNotMoved) {
     report.refinement =
@@ -238,13 +288,17 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& measured
     predicted = compose(refinement_.mapToOdom(estimate_.pose, *gate.from), odom);
     motion_.apply(*gate.from, odom, &particles_, &random_, threads_, gate.view);
   }
-  weigh(*gate.scans, gate.view, &report);
+  // What the filter weighs: the beams the map explains at the tracked pose.
+  std::vector<PreparedScan> masked;
+  if (changes_.masked() > 0) masked = prepareScans(sensor_.model(), scans);
+  const std::vector<PreparedScan>& weighed = changes_.masked() > 0 ? masked : *gate.scans;
+  weigh(weighed, gate.view, &report);
   if (gate.from && OdometryFaultTracker::observable(gate.step, params_.motion)) {
     motion_.faults().adapt(particles_.weight, params_.motion, threads_, gate.view);
   }
   report.fault_fraction = motion_.faults().fraction();
   report.ess = effectiveSampleSize(particles_.weight, threads_);
-  estimateAndJudge(*gate.scans, predicted, &report);
+  estimateAndJudge(weighed, *gate.scans, predicted, &report);
   report.refinement = refinement_.atUpdate(sensor_.model(), scans, odom, predicted,
                                            confidence_.confidence().state, params_, &estimate_);
   if (report.refinement.accepted) confidence_.addFit(report.refinement.covariance);
@@ -260,6 +314,7 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& measured
 }
 
 void ParticleFilter::estimateAndJudge(const std::vector<PreparedScan>& scans,
+                                      const std::vector<PreparedScan>& all_beams,
                                       const std::optional<Pose2>& predicted, UpdateReport* report) {
   // The estimate comes from the weighted cloud, before resampling: resampling
   // only adds noise, and the random particles recovery injects must not count.
@@ -268,16 +323,17 @@ void ParticleFilter::estimateAndJudge(const std::vector<PreparedScan>& scans,
   confidence_.assess(particles_, estimate_,
                      hitFraction(model, scans, estimate_.pose, params_.confidence.hit_distance),
                      params_.confidence, threads_);
-  gate_.recordFit(model, scans, estimate_.pose, params_);
+  gate_.recordFit(model, all_beams, estimate_.pose, params_);
   // Tempering and recovery follow the evidence of this scan (fitState());
   // only the published verdict waits for a jumped estimate to be confirmed.
   confidence_.holdAfterJump(predicted, estimate_.pose, params_.confidence);
   const std::size_t places =
       hypothesesOf(estimate_, params_.confidence.rival_weight_ratio, 0).count;
-  const LookAlikeView view = look_alikes_.judge(model, scans, estimate_.pose);
+  const LookAlikeView view = look_alikes_.judge(model, all_beams, estimate_.pose, &*evidence_);
   confidence_.holdWhileAmbiguous(places, view.as_good);
   search_.observe(places);
-  listLookAlikes(scans, view, places);
+  listLookAlikes(all_beams, view, places);
+  places_ = places;
   confidence_.coverLookAlikes(estimate_.pose, view.fit, look_alike_places_);
   report->look_alikes = view.as_good;
   report->look_alikes_better = view.better.size();

@@ -32,6 +32,29 @@ TEST(LikelihoodField, DistancesAreInMetres) {
   EXPECT_NEAR(0.5 * std::sqrt(13.0), field.distances()[3 * 5 + 4], kTol);
 }
 
+TEST(LikelihoodField, InsideAThickObstacleTheSurfaceDistanceIsHowFarPastItsSurface) {
+  // 9 x 3 cells of 0.1 m: a wall 6 cells thick (x 1-6) between free cells.
+  std::vector<int8_t> data(27, 0);
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 1; x <= 6; ++x) data[y * 9 + x] = 100;
+  }
+  const LikelihoodField field(OccupancyGrid(9, 3, 0.1, {}, data), 2.0);
+  const auto at = [&field](int x) { return field.surfaceDistances()[1 * 9 + x]; };
+  // The surface cells and the next (kFreeDepth) are on the wall ...
+  EXPECT_NEAR(0.0, at(1), kTol);
+  EXPECT_NEAR(0.0, at(2), kTol);
+  EXPECT_NEAR(0.0, at(6), kTol);
+  // ... a cell three deep is one cell past that: a beam ending there went
+  // through the wall's face by that much more than the map's blur allows.
+  EXPECT_NEAR(0.1, at(3), kTol);
+  EXPECT_NEAR(0.1, at(4), kTol);
+  // Outside, the distance to the nearest occupied cell as always; and the
+  // likelihood field's own distances are 0 on every occupied cell.
+  EXPECT_NEAR(0.1, at(0), kTol);
+  EXPECT_NEAR(0.2, at(8), kTol);
+  EXPECT_NEAR(0.0, field.distance({3, 1}), kTol);
+}
+
 TEST(LikelihoodField, DistancesAreCappedAtMaxDistance) {
   const LikelihoodField field(oneObstacle(), 1.0);
   EXPECT_EQ(1.0, field.maxDistance());

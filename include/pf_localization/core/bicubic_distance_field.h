@@ -1,5 +1,7 @@
-// A smooth distance field: the likelihood field's per-cell distances,
-// interpolated bicubically between cell centres, with the gradient.
+// A smooth distance field: the likelihood field's per-cell distances to the
+// obstacles' surfaces (LikelihoodField::surfaceDistances: inside a thick
+// obstacle they grow again), interpolated bicubically between cell centres,
+// with the gradient.
 //
 // Keys, "Cubic convolution interpolation for digital image processing", IEEE
 // Trans. ASSP 29(6), 1981, with a = -0.5: the Catmull-Rom spline through the

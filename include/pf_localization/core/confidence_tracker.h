@@ -67,6 +67,10 @@ class ConfidenceTracker {
   /// This update's verdict from its scan alone, before holdAfterJump and the
   /// low-fit demotion: what tempering and recovery follow.
   LocalizationState fitState() const { return fit_state_; }
+  /// Whether the place is told apart from its look-alikes (holdWhileAmbiguous).
+  bool placeKnown() const { return place_known_; }
+  /// Whether a jump of the estimate is still to be confirmed (holdAfterJump).
+  bool settling() const { return settle_left_ > 0; }
 
  private:
   Confidence confidence_;

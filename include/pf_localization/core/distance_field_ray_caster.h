@@ -24,6 +24,7 @@
 
 #include <vector>
 
+#include "pf_localization/core/likelihood_field.h"
 #include "pf_localization/core/occupancy_grid.h"
 #include "pf_localization/core/pose2.h"
 
@@ -32,6 +33,10 @@ namespace pf {
 class DistanceFieldRayCaster {
  public:
   explicit DistanceFieldRayCaster(const OccupancyGrid& grid);
+  /// The same from a likelihood field's distances, without a transform of
+  /// its own: capped at the field's max_distance, they only shorten the jumps
+  /// through open space, and every range is the same.
+  explicit DistanceFieldRayCaster(const LikelihoodField& field);
 
   /// The range in metres from (x, y) along `angle` (world frame) to the first
   /// occupied cell, or max_range when there is none within max_range on the map.
@@ -45,6 +50,11 @@ class DistanceFieldRayCaster {
   const Pose2& origin() const { return origin_; }
 
  private:
+  // The skip table from each cell's distance in cells to the nearest occupied
+  // cell's centre (`cells(x, y)`).
+  template <typename Cells>
+  void fill(const OccupancyGrid& grid, Cells cells);
+
   // Per cell of the bordered table: kOccupied, kOutside, or the distance in
   // cells the ray may jump from anywhere in the cell (0: walk to the next cell).
   static constexpr float kOccupied = -1.0f;

@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "pf_localization/core/likelihood_field.h"
+#include "pf_localization/core/map_evidence.h"
 #include "pf_localization/core/pose2.h"
 #include "pf_localization/core/sensor_model.h"
 
@@ -72,17 +73,25 @@ class LookAlikes {
   /// object that is not on the map, seen from one spot, can make a shifted
   /// pose fit better for a scan or three.
   static constexpr int kBetterUpdates = 5;
+  /// ... and only where its scan passes the map's obstacles or leaves the
+  /// map on at most this share of the beams more than at the estimate
+  /// (MapEvidence): a look-alike the changes of a map make fit better sees
+  /// through its walls; the place a robot was kidnapped to does not.
+  static constexpr double kSeenMargin = 0.2;
 
   /// Finds the symmetries of `field`'s map (findMapSymmetries).
   void setMap(const LikelihoodField& field);
   /// Forgets the streaks of better fits (after an initialisation).
   void restart();
+  /// Whether a look-alike fitted clearly better on the last update (a streak
+  /// under way, kBetterUpdates not yet reached or reached).
+  bool considering() const;
   const std::vector<MapSymmetry>& symmetries() const { return symmetries_; }
 
   /// Places `scans` at the estimate and at each of its look-alikes (those in
   /// free space) and compares the model's log-likelihoods.
   LookAlikeView judge(const SensorModel& model, const std::vector<PreparedScan>& scans,
-                      const Pose2& estimate);
+                      const Pose2& estimate, const MapEvidence* evidence = nullptr);
   /// The look-alikes (in free space) of each of `held`, the other places a
   /// spread cloud holds, where `scans` fit at least `min_fit`. Such a cloud
   /// may hold no particle near the true place but one a rack bay along it.

@@ -37,6 +37,8 @@
 #include "pf_localization/core/laser_scan.h"
 #include "pf_localization/core/likelihood_field_model.h"
 #include "pf_localization/core/look_alikes.h"
+#include "pf_localization/core/map_change_mask.h"
+#include "pf_localization/core/map_evidence.h"
 #include "pf_localization/core/motion_update.h"
 #include "pf_localization/core/occupancy_grid.h"
 #include "pf_localization/core/particle_filter_params.h"
@@ -67,6 +69,11 @@ struct UpdateReport {
   int beams_used = 0;
   int beams_dropped = 0;  // without a reading (the masked ones not counted)
   int beams_masked = 0;  // seeing something that moved in while the robot stood (transient_beams.h)
+  int beams_changed =
+      0;  // seeing a change of the map where the tracked pose fits the rest (map_change_mask.h)
+  // What the beams said of the map at the tracked pose (map_change_mask.h):
+  // all zero when they were not judged (no tracked pose).
+  EvidenceCounts map_evidence;
   int beams_skipped = 0;  // of beams_used, left out by beam skipping
   std::size_t particles = 0;
   double ess = 0.0;  // before resampling
@@ -160,15 +167,30 @@ class ParticleFilter {
   std::optional<Pose2> mapToOdom() const;
 
  private:
+  // Where the last estimate would be now had the odometry been right (or the
+  // pose a cloud was just drawn around); none after a global initialisation
+  // until its first update.
+  std::optional<Pose2> trackedPose(const Pose2& odom) const;
   // The scans with the beams that see something that moved in while the
   // robot stood masked (transient_beams.h), judged from the last estimate.
   ScanGroup maskTransients(const Pose2& odom, const ScanGroup& measured);
+  // The scans with the beams that see a change of the map masked, while the
+  // tracked pose explains the rest (map_change_mask.h).
+  ScanGroup maskMapChanges(const Pose2& odom, const ScanGroup& scans);
+  // Whether the tracked pose at `odom` is known well enough to judge beams
+  // from: one place, told apart, not lost, a short step of odometry since.
+  bool judgesFromTrackedPose(const Pose2& odom) const;
   // Weighs the cloud by `scans`, an update that brings a share `view` of a
   // new view (new_view.h), and takes its fit into recovery's averages.
   void weigh(const std::vector<PreparedScan>& scans, double view, UpdateReport* report);
   // The estimate of the weighted cloud and the verdict on it; `predicted`:
   // the last estimate moved by the odometry since (none on a first update).
+  // `scans` are the beams weighed; `all_beams` every beam, those masked for
+  // changes of the map too: the gate's fit and the look-alikes take them (what
+  // the map lacks at the tracked place may be what the place the robot was
+  // carried to has).
   void estimateAndJudge(const std::vector<PreparedScan>& scans,
+                        const std::vector<PreparedScan>& all_beams,
                         const std::optional<Pose2>& predicted, UpdateReport* report);
   // The places pf_hypotheses lists after the cloud's: the look-alikes of
   // the estimate (`view`) and, when the cloud holds several `places`, of
@@ -189,12 +211,16 @@ class ParticleFilter {
   PoseEstimate estimate_;
   TransientBeams transients_;            // what the beams saw while the robot stood still
   std::vector<LaserScan> masked_scans_;  // the scans with the transient beams masked
-  UpdateGate gate_;                      // holds the odometry of the last update
+  std::optional<MapEvidence> evidence_;  // the map's rays (none without a map)
+  MapChangeMask changes_;
+  std::vector<LaserScan> changed_scans_;  // the scans with the beams seeing changes masked
+  UpdateGate gate_;                       // holds the odometry of the last update
   ConfidenceTracker confidence_;
   LookAlikes look_alikes_;  // the map's symmetries, and what each scan says of them
   // The last scan's look-alikes of the places the cloud holds, fitting as
   // well as the estimate.
   std::vector<LookAlikePlace> look_alike_places_;
+  std::size_t places_ = 0;  // the places the last update's cloud holds (hypothesesOf)
   EstimateRefinement refinement_;
   Recovery recovery_;
 };
