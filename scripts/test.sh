@@ -110,9 +110,13 @@ run_queue() {
   queued=()
 }
 
-# gtest BINARY: one GoogleTest binary, its cases in gtest-BINARY.xml.
+# gtest BINARY: one GoogleTest binary, its cases in gtest-BINARY.xml, run
+# as catkin's run_tests target runs it (run_tests.py writes a failure when
+# the binary left no result file); one that hangs is stopped after 10 minutes.
 gtest() {
-  "$ws/devel/lib/pf_localization/$1" --gtest_output="xml:$results/pf_localization/gtest-$1.xml"
+  local xml=$results/pf_localization/gtest-$1.xml
+  /usr/bin/python3 /usr/share/catkin/cmake/test/run_tests.py "$xml" \
+    "timeout -k 10 600 $ws/devel/lib/pf_localization/$1 --gtest_output=xml:$xml" --return-code
 }
 # rostest FILE ARGS...: one rostest as catkin's run_tests target runs it (run_tests.py
 # writes a failure when the test left no result file).
