@@ -1,10 +1,19 @@
 #include "pf_localization/ros/map_to_odom_republisher.h"
 
+#include <pthread.h>
+
 #include <algorithm>
 #include <chrono>
 #include <utility>
 
 namespace pf_ros {
+namespace {
+
+// s of wall time the thread waits at most, so that a stop or a rate change
+// by another way is seen.
+constexpr double kMaxWait = 0.1;
+
+}  // namespace
 
 bool RepublishSchedule::due(const ros::Time& now, const ros::Duration& period) {
   if (next_.isZero() || now + period < next_) next_ = now;
@@ -15,11 +24,18 @@ MapToOdomRepublisher::MapToOdomRepublisher(const MapToOdomRepublisherOptions& op
                                            TickHook hook)
     : options_(options), hook_(std::move(hook)) {}
 
-void MapToOdomRepublisher::start() {
-  if (!thread_.joinable()) thread_ = std::thread([this] { run(); });
+void MapToOdomRepublisher::start(ros::NodeHandle clock_nh) {
+  if (thread_.joinable() || clock_sub_) return;
+  if (ros::Time::isSimTime()) {
+    clock_sub_ = clock_nh.subscribe<rosgraph_msgs::Clock>(
+        "/clock", 1, [this](const rosgraph_msgs::ClockConstPtr& msg) { onClock(msg->clock); });
+  } else {
+    thread_ = std::thread([this] { run(); });
+  }
 }
 
 MapToOdomRepublisher::~MapToOdomRepublisher() {
+  clock_sub_.shutdown();
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stop_ = true;
@@ -69,32 +85,38 @@ std::size_t MapToOdomRepublisher::published() const {
   return published_;
 }
 
+void MapToOdomRepublisher::onClock(const ros::Time& now) {
+  std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
+  if (lock.owns_lock() && !stop_) tick(now, &lock);
+}
+
 void MapToOdomRepublisher::run() {
+  pthread_setname_np(pthread_self(), "pf_map_odom");
   std::unique_lock<std::mutex> lock(mutex_);
   while (!stop_) {
-    const ros::Duration period(1.0 / options_.rate);
-    const ros::Time now = ros::Time::now();
-    // Zero: simulated time has not started.
-    if (!now.isZero() && schedule_.due(now, period)) {
-      // The tick counts as a publication even when it has nothing new to
-      // send (no map -> odom yet, or no later stamp): otherwise it would
-      // stay due and the loop would spin.
-      schedule_.published(now, period);
-      lock.unlock();
-      if (hook_) hook_(now);
-      lock.lock();
-      if (stop_) break;
-      const ros::Time stamp =
-          std::max(now, scan_stamp_) + ros::Duration(options_.transform_tolerance);
-      // Between updates, only a later stamp is news (and tf2 refuses a repeated one).
-      if (stamp > last_stamp_) publishLocked(stamp);
-    }
-    double wait = 0.001;
-    if (!ros::Time::isSimTime() && !now.isZero()) {
-      wait = std::clamp((schedule_.next() - ros::Time::now()).toSec(), 0.0005, 0.1);
-    }
-    wake_.wait_for(lock, std::chrono::duration<double>(wait));
+    tick(ros::Time::now(), &lock);
+    if (stop_) break;
+    const double left = (schedule_.next() - ros::Time::now()).toSec();
+    wake_.wait_for(lock, std::chrono::duration<double>(std::clamp(left, 0.0005, kMaxWait)));
   }
+}
+
+void MapToOdomRepublisher::tick(const ros::Time& now, std::unique_lock<std::mutex>* lock) {
+  const ros::Duration period(1.0 / options_.rate);
+  // Zero: simulated time has not started.
+  if (now.isZero() || !schedule_.due(now, period)) return;
+  // The tick counts as a publication even when it has nothing new to send
+  // (no map -> odom yet, or no later stamp): otherwise it would stay due.
+  schedule_.published(now, period);
+  if (hook_) {
+    lock->unlock();
+    hook_(now);
+    lock->lock();
+    if (stop_) return;
+  }
+  const ros::Time stamp = std::max(now, scan_stamp_) + ros::Duration(options_.transform_tolerance);
+  // Between updates, only a later stamp is news (and tf2 refuses a repeated one).
+  if (stamp > last_stamp_) publishLocked(stamp);
 }
 
 bool MapToOdomRepublisher::publishLocked(ros::Time stamp) {

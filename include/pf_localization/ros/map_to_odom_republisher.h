@@ -1,17 +1,27 @@
-// map -> odom on /tf from a thread of its own: published after every filter
-// update, and again whenever 1 / tf_publish_rate s pass without one. A
-// filter update (80 ms for 500 000 particles) or anything else on the
-// node's spinner therefore never delays it (issue 15: under load the
-// ros::Timer used to wait behind the filter on the one spinner, and tf users
-// downstream saw 8 s gaps). It only ever touches the latest transform handed
-// to it, under its own mutex, never the filter. Its own loop rather than a ros::Timer on a
-// callback queue of its own: that would take two thread hops (roscpp's timer
-// thread, then the queue's spinner) per tick, each a chance to be descheduled
-// on a loaded computer.
+// map -> odom on /tf: published after every filter update, and again
+// whenever 1 / tf_publish_rate s pass without one. Neither a filter update
+// (80 ms for 500 000 particles) nor anything else on the node's spinner
+// delays it (under load a ros::Timer on the one spinner waited behind the
+// filter, and tf users downstream saw 8 s gaps). It only ever touches the
+// latest transform handed to it, under its own mutex, never the filter.
+//
+// What times the republishing depends on the clock:
+// - on the wall clock, a thread of its own that sleeps until a publication
+//   is due (rather than a ros::Timer on a callback queue of its own: two
+//   thread hops per tick, roscpp's timer thread then the queue's spinner,
+//   each a chance to be descheduled on a loaded computer);
+// - under simulated time, /clock itself: no sleep can be timed on a clock
+//   that only /clock moves, so start() subscribes to it on the handle it is
+//   given (pf_node's poll thread), and the /clock message at which a
+//   publication is due publishes it, on the thread that brought it. No
+//   thread polls the clock (a roscpp timer, or a thread of this kind, would
+//   wake every millisecond of wall time to look: docs/performance.md, "The
+//   fixed cost").
 #pragma once
 
 #include <geometry_msgs/TransformStamped.h>
 #include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <condition_variable>
@@ -50,15 +60,17 @@ struct MapToOdomRepublisherOptions {
 
 class MapToOdomRepublisher {
  public:
-  /// Called on the republishing thread with the clock's time before each
-  /// timed publication, without any lock held (pf_node checks there whether
-  /// simulated time jumped back).
+  /// Called with the clock's time before each timed publication, on the
+  /// thread that times it (see above), without any lock held (pf_node checks
+  /// there whether simulated time jumped back).
   using TickHook = std::function<void(const ros::Time& now)>;
 
   explicit MapToOdomRepublisher(const MapToOdomRepublisherOptions& options, TickHook hook = {});
 
-  /// Starts the thread (once; the hook may be called from then on).
-  void start();
+  /// Starts the timed republishing (once; the hook may be called from then
+  /// on): under simulated time by subscribing to /clock on `clock_nh` (its
+  /// callback queue runs onClock()), on the wall clock by starting the thread.
+  void start(ros::NodeHandle clock_nh);
   ~MapToOdomRepublisher();
   MapToOdomRepublisher(const MapToOdomRepublisher&) = delete;
   MapToOdomRepublisher& operator=(const MapToOdomRepublisher&) = delete;
@@ -82,10 +94,17 @@ class MapToOdomRepublisher {
   /// Number of map -> odom messages published since start.
   std::size_t published() const;
 
+  /// Simulated time moved to `now` (/clock): the timed publication when one
+  /// is due. Never waits: while set() publishes (which puts the next timed
+  /// publication off anyway) the next /clock looks again.
+  void onClock(const ros::Time& now);
+
  private:
-  // The thread: under simulated time it polls the clock every ms of wall
-  // time (as roscpp's timers do); under wall time it sleeps until due.
+  // The wall clock's thread: sleeps until a timed publication is due.
   void run();
+  // The timed publication at `now`, when due; `lock` holds mutex_ (and is
+  // released around the hook).
+  void tick(const ros::Time& now, std::unique_lock<std::mutex>* lock);
   // Publishes the stored transform stamped `stamp`; mutex_ held.
   bool publishLocked(ros::Time stamp);
 
@@ -99,6 +118,7 @@ class MapToOdomRepublisher {
   ros::Time scan_stamp_, last_stamp_;
   RepublishSchedule schedule_;
   std::size_t published_ = 0;
+  ros::Subscriber clock_sub_;
   std::thread thread_;
 };
 
