@@ -1,17 +1,19 @@
 #include "pf_localization/ros/map_to_odom_republisher.h"
 
 #include <pthread.h>
+#include <sys/timerfd.h>
+#include <unistd.h>
 
 #include <algorithm>
-#include <chrono>
+#include <cerrno>
+#include <cstdint>
 #include <utility>
 
 namespace pf_ros {
 namespace {
 
-// s of wall time the thread waits at most, so that a stop or a rate change
-// by another way is seen.
-constexpr double kMaxWait = 0.1;
+// s: the shortest the timer is armed for (0 would disarm it).
+constexpr double kMinWait = 1e-6;
 
 }  // namespace
 
@@ -30,6 +32,12 @@ void MapToOdomRepublisher::start(ros::NodeHandle clock_nh) {
     clock_sub_ = clock_nh.subscribe<rosgraph_msgs::Clock>(
         "/clock", 1, [this](const rosgraph_msgs::ClockConstPtr& msg) { onClock(msg->clock); });
   } else {
+    timer_fd_ = ::timerfd_create(CLOCK_MONOTONIC, TFD_CLOEXEC);
+    if (timer_fd_ < 0) {
+      ROS_ERROR("pf_node: no timer for republishing map -> odom (timerfd_create: errno %d)", errno);
+      return;
+    }
+    armLocked(kMinWait);  // the first publication is due at once
     thread_ = std::thread([this] { run(); });
   }
 }
@@ -39,9 +47,10 @@ MapToOdomRepublisher::~MapToOdomRepublisher() {
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stop_ = true;
+    armLocked(kMinWait);  // wakes the thread
   }
-  wake_.notify_all();
   if (thread_.joinable()) thread_.join();
+  if (timer_fd_ >= 0) ::close(timer_fd_);
 }
 
 bool MapToOdomRepublisher::set(const std::optional<geometry_msgs::TransformStamped>& map_to_odom,
@@ -55,7 +64,10 @@ bool MapToOdomRepublisher::set(const std::optional<geometry_msgs::TransformStamp
   // the last timed publication.
   if (!last_stamp_.isZero() && stamp <= last_stamp_) stamp = last_stamp_ + ros::Duration(1e-3);
   if (!publishLocked(stamp)) return false;
-  if (!now.isZero()) schedule_.published(now, ros::Duration(1.0 / options_.rate));
+  if (!now.isZero()) {
+    schedule_.published(now, ros::Duration(1.0 / options_.rate));
+    armLocked(1.0 / options_.rate);  // puts the thread's wake-up off, without waking it
+  }
   return true;
 }
 
@@ -68,11 +80,9 @@ void MapToOdomRepublisher::reset() {
 }
 
 void MapToOdomRepublisher::setRate(double hz) {
-  {
-    std::lock_guard<std::mutex> lock(mutex_);
-    options_.rate = hz;
-  }
-  wake_.notify_all();
+  std::lock_guard<std::mutex> lock(mutex_);
+  options_.rate = hz;
+  armLocked(kMinWait);  // the thread times the next publication by the new rate
 }
 
 void MapToOdomRepublisher::setTransformTolerance(double seconds) {
@@ -92,13 +102,28 @@ void MapToOdomRepublisher::onClock(const ros::Time& now) {
 
 void MapToOdomRepublisher::run() {
   pthread_setname_np(pthread_self(), "pf_map_odom");
-  std::unique_lock<std::mutex> lock(mutex_);
-  while (!stop_) {
+  for (;;) {
+    std::uint64_t expirations = 0;
+    if (::read(timer_fd_, &expirations, sizeof expirations) < 0 && errno != EINTR) {
+      ROS_ERROR("pf_node: the map -> odom timer failed (errno %d): republishing stops", errno);
+      return;
+    }
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (stop_) return;
     tick(ros::Time::now(), &lock);
-    if (stop_) break;
-    const double left = (schedule_.next() - ros::Time::now()).toSec();
-    wake_.wait_for(lock, std::chrono::duration<double>(std::clamp(left, 0.0005, kMaxWait)));
+    if (stop_) return;
+    // Until the next is due; set() moves that later without waking the thread.
+    armLocked(std::max((schedule_.next() - ros::Time::now()).toSec(), kMinWait));
   }
+}
+
+void MapToOdomRepublisher::armLocked(double seconds) {
+  if (timer_fd_ < 0) return;
+  itimerspec spec{};
+  const auto ns = static_cast<std::int64_t>(std::max(seconds, kMinWait) * 1e9);
+  spec.it_value.tv_sec = static_cast<time_t>(ns / 1000000000);
+  spec.it_value.tv_nsec = static_cast<decltype(spec.it_value.tv_nsec)>(ns % 1000000000);
+  ::timerfd_settime(timer_fd_, 0, &spec, nullptr);
 }
 
 void MapToOdomRepublisher::tick(const ros::Time& now, std::unique_lock<std::mutex>* lock) {

@@ -6,10 +6,14 @@
 // latest transform handed to it, under its own mutex, never the filter.
 //
 // What times the republishing depends on the clock:
-// - on the wall clock, a thread of its own that sleeps until a publication
-//   is due (rather than a ros::Timer on a callback queue of its own: two
-//   thread hops per tick, roscpp's timer thread then the queue's spinner,
-//   each a chance to be descheduled on a loaded computer);
+// - on the wall clock, a thread of its own that sleeps on a timer (timerfd)
+//   until a publication is due. Each publication after an update re-arms
+//   the timer one period on, without waking the thread, so that while
+//   updates come faster than the period it never wakes. (Not a ros::Timer
+//   on a callback queue of its own: two thread hops per tick, roscpp's timer
+//   thread then the queue's spinner, each a chance to be descheduled on a
+//   loaded computer; nor a condition variable's timed wait: the thread
+//   would wake at every period to find the publication put off);
 // - under simulated time, /clock itself: no sleep can be timed on a clock
 //   that only /clock moves, so start() subscribes to it on the handle it is
 //   given (pf_node's poll thread), and the /clock message at which a
@@ -24,7 +28,6 @@
 #include <rosgraph_msgs/Clock.h>
 #include <tf2_ros/transform_broadcaster.h>
 
-#include <condition_variable>
 #include <functional>
 #include <mutex>
 #include <optional>
@@ -100,8 +103,12 @@ class MapToOdomRepublisher {
   void onClock(const ros::Time& now);
 
  private:
-  // The wall clock's thread: sleeps until a timed publication is due.
+  // The wall clock's thread: sleeps on the timer until a timed publication
+  // is due.
   void run();
+  // The wall clock's timer fires in `seconds` (no timer: nothing); mutex_
+  // held, or the thread not started.
+  void armLocked(double seconds);
   // The timed publication at `now`, when due; `lock` holds mutex_ (and is
   // released around the hook).
   void tick(const ros::Time& now, std::unique_lock<std::mutex>* lock);
@@ -112,7 +119,7 @@ class MapToOdomRepublisher {
   TickHook hook_;
   tf2_ros::TransformBroadcaster broadcaster_;
   mutable std::mutex mutex_;
-  std::condition_variable wake_;
+  int timer_fd_ = -1;  // the wall clock's timer (timerfd); -1 under simulated time
   bool stop_ = false;
   std::optional<geometry_msgs::TransformStamped> transform_;
   ros::Time scan_stamp_, last_stamp_;
