@@ -76,23 +76,26 @@ def find():
                 return p
         except OSError:
             pass
-seen, start = None, time.time()
+seen, start, cpu = None, time.time(), {}  # cpu: tid -> [label, s], every thread ever seen
 while time.time() - start < 600:
     pid = seen or find()
     if pid:
         seen = pid
-        rows = []
         try:
-            for tid in sorted(os.listdir('/proc/%s/task' % pid), key=int):
+            tids = os.listdir('/proc/%s/task' % pid)
+        except OSError:
+            break  # gone: the last figures stay
+        for tid in tids:
+            try:
                 stat = open('/proc/%s/task/%s/stat' % (pid, tid)).read()
-                comm = stat[stat.index('(') + 1:stat.rindex(')')]
-                f = stat[stat.rindex(')') + 2:].split()
-                label = 'main' if tid == pid else ('ros' if comm == name else comm)
-                rows.append('%s %.2f' % (label, (int(f[11]) + int(f[12])) / tick))
-        except (OSError, ValueError):
-            break  # gone: the last rows stay
+            except OSError:
+                continue  # a thread that just ended keeps its last figure
+            comm = stat[stat.index('(') + 1:stat.rindex(')')]
+            f = stat[stat.rindex(')') + 2:].split()
+            label = 'main' if tid == pid else ('ros' if comm == name else comm)
+            cpu[tid] = [label, (int(f[11]) + int(f[12])) / tick]
         with open(path, 'w') as out:
-            out.write(' '.join(rows) + '\n')
+            out.write(' '.join('%s %.2f' % tuple(cpu[t]) for t in sorted(cpu, key=int)) + '\n')
     time.sleep(0.5)
 EOF
 }
@@ -125,11 +128,12 @@ runner() {
   shift
   mkdir -p "$dir"
   printf '%s\n' "update_min_d: 0" "update_min_a: 0" "$@" >"$dir/params.yaml"
-  cpu=$(/usr/bin/python3 - "$dir" "$data" <<'EOF'
+  # The executable itself: rosrun would add its own start-up (a Python look-up).
+  cpu=$(/usr/bin/python3 - "$dir" "$data" "$ws/devel/lib/pf_localization/pf_bag_runner" <<'EOF'
 import resource, subprocess, sys
-d, data = sys.argv[1], sys.argv[2]
+d, data, runner = sys.argv[1], sys.argv[2], sys.argv[3]
 with open(d + '/runner.log', 'w') as log:
-    subprocess.run(['rosrun', 'pf_localization', 'pf_bag_runner', '--bag', data + '/ac109_1.bag',
+    subprocess.run([runner, '--bag', data + '/ac109_1.bag',
                     '--map', data + '/ac109_1.yaml', '--out', d + '/traj.tum', '--quiet',
                     '--initial-pose', '3.972', '-0.090', '2.904', '--max-beams', '60',
                     '--params', d + '/params.yaml'], stdout=log, stderr=log, check=True)
