@@ -15,6 +15,15 @@ namespace {
 // s: the shortest the timer is armed for (0 would disarm it).
 constexpr double kMinWait = 1e-6;
 
+// Periods without a publication after which map -> odom is republished on
+// the wall clock. tf users are promised no gap over two periods: an update
+// within one and a half makes the timed copy needless (scans at 14 Hz and
+// more: most of them), and the half period left covers the latency of a
+// loaded computer. Under simulated time every delay of the wall clock is
+// multiplied by the bag's rate and the clock moves in steps, so the timed
+// copy comes after one period, as the whole margin is needed there.
+constexpr double kWallClockPeriods = 1.5;
+
 }  // namespace
 
 bool RepublishSchedule::due(const ros::Time& now, const ros::Duration& period) {
@@ -65,8 +74,8 @@ bool MapToOdomRepublisher::set(const std::optional<geometry_msgs::TransformStamp
   if (!last_stamp_.isZero() && stamp <= last_stamp_) stamp = last_stamp_ + ros::Duration(1e-3);
   if (!publishLocked(stamp)) return false;
   if (!now.isZero()) {
-    schedule_.published(now, ros::Duration(1.0 / options_.rate));
-    armLocked(1.0 / options_.rate);  // puts the thread's wake-up off, without waking it
+    schedule_.published(now, delayLocked());
+    armLocked(delayLocked().toSec());  // puts the thread's wake-up off, without waking it
   }
   return true;
 }
@@ -117,6 +126,10 @@ void MapToOdomRepublisher::run() {
   }
 }
 
+ros::Duration MapToOdomRepublisher::delayLocked() const {
+  return ros::Duration((timer_fd_ >= 0 ? kWallClockPeriods : 1.0) / options_.rate);
+}
+
 void MapToOdomRepublisher::armLocked(double seconds) {
   if (timer_fd_ < 0) return;
   itimerspec spec{};
@@ -127,7 +140,7 @@ void MapToOdomRepublisher::armLocked(double seconds) {
 }
 
 void MapToOdomRepublisher::tick(const ros::Time& now, std::unique_lock<std::mutex>* lock) {
-  const ros::Duration period(1.0 / options_.rate);
+  const ros::Duration period = delayLocked();
   // Zero: simulated time has not started.
   if (now.isZero() || !schedule_.due(now, period)) return;
   // The tick counts as a publication even when it has nothing new to send

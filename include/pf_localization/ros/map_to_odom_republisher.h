@@ -1,5 +1,7 @@
 // map -> odom on /tf: published after every filter update, and again
-// whenever 1 / tf_publish_rate s pass without one. Neither a filter update
+// whenever 1.5 periods (1 / tf_publish_rate s) pass without one on the wall
+// clock, one period under simulated time, so that tf users never wait more
+// than two periods (see kWallClockPeriods in the .cc). Neither a filter update
 // (80 ms for 500 000 particles) nor anything else on the node's spinner
 // delays it (under load a ros::Timer on the one spinner waited behind the
 // filter, and tf users downstream saw 8 s gaps). It only ever touches the
@@ -8,8 +10,8 @@
 // What times the republishing depends on the clock:
 // - on the wall clock, a thread of its own that sleeps on a timer (timerfd)
 //   until a publication is due. Each publication after an update re-arms
-//   the timer one period on, without waking the thread, so that while
-//   updates come faster than the period it never wakes. (Not a ros::Timer
+//   the timer, without waking the thread, so that while updates come often
+//   enough it never wakes. (Not a ros::Timer
 //   on a callback queue of its own: two thread hops per tick, roscpp's timer
 //   thread then the queue's spinner, each a chance to be descheduled on a
 //   loaded computer; nor a condition variable's timed wait: the thread
@@ -82,7 +84,7 @@ class MapToOdomRepublisher {
   /// until the next set()), after the scan stamped `scan_stamp` (zero: none):
   /// published at once, stamped max(now, scan_stamp) + transform_tolerance,
   /// or just after the previous stamp when that is not later (tf2 refuses a
-  /// repeated stamp); the next timed publication is then one period later.
+  /// repeated stamp); the next timed publication is then due one delay later.
   /// Returns whether it was published.
   bool set(const std::optional<geometry_msgs::TransformStamped>& map_to_odom,
            const ros::Time& scan_stamp);
@@ -109,6 +111,9 @@ class MapToOdomRepublisher {
   // The wall clock's timer fires in `seconds` (no timer: nothing); mutex_
   // held, or the thread not started.
   void armLocked(double seconds);
+  // How long after the latest publication the next timed one is due: 1.5
+  // periods on the wall clock, one under simulated time (see the .cc).
+  ros::Duration delayLocked() const;
   // The timed publication at `now`, when due; `lock` holds mutex_ (and is
   // released around the hook).
   void tick(const ros::Time& now, std::unique_lock<std::mutex>* lock);
