@@ -68,16 +68,21 @@ threads() {
 import os, sys, time
 name, path, ws = sys.argv[1], sys.argv[2], sys.argv[3]
 tick = os.sysconf('SC_CLK_TCK')
-def find():
+def started(p):  # clock ticks after boot
+    stat = open('/proc/%s/stat' % p).read()
+    return int(stat[stat.rindex(')') + 2:].split()[19])
+me = started('self')
+def find():  # one started after this sampler (not one left over from elsewhere)
     for p in os.listdir('/proc'):
         try:
             if (p.isdigit() and open('/proc/%s/comm' % p).read().strip() == name and
-                    os.path.realpath('/proc/%s/exe' % p).startswith(ws + '/')):
+                    os.path.realpath('/proc/%s/exe' % p).startswith(ws + '/') and
+                    started(p) >= me):
                 return p
-        except OSError:
+        except (OSError, ValueError):
             pass
 seen, start, cpu = None, time.time(), {}  # cpu: tid -> [label, s], every thread ever seen
-while time.time() - start < 600:
+while time.time() - start < 300:
     pid = seen or find()
     if pid:
         seen = pid
@@ -111,7 +116,10 @@ replay() {
   local sampler=$!
   WALL=$wall "$shared/tools/run_localizer.sh" "$dir" "$data/ac109_1.yaml" "$data/ac109_1.bag" \
     "$rate" -- bash -c "$command" >"$dir.log" 2>&1
-  wait "$sampler" || true
+  # It ends by itself once the process is gone; one that never found it is stopped.
+  for _ in 1 2 3 4; do kill -0 "$sampler" 2>/dev/null && sleep 0.5; done
+  kill "$sampler" 2>/dev/null || true
+  wait "$sampler" 2>/dev/null || true
   cpu=$(awk -v p="$process" '$1 == p {print $2}' "$dir/cpu_procs.txt")
   if [ "$process" = pf_node ]; then
     ate=$(/usr/bin/python3 "$shared/tools/ate.py" "$dir/out.bag" 2>/dev/null |
