@@ -115,7 +115,7 @@ class PfNode {
     set_map_srv_ = nh_.advertiseService("set_map", &PfNode::onSetMap, this);
     reconfigure_ = std::make_unique<ReconfigureServer>(
         pnh_, config, [this](const LocalizerConfig& c) { return reconfigure(c); }, "pf_node");
-    // /clock on the poll thread too: it wakes the republisher when due.
+    // /clock on the poll thread too: it republishes when due.
     republisher_->start(withQueue(nh_, &inline_queue_));
     filter_thread_ = std::thread([this] { filterLoop(); });
     // Last: their callbacks may run at once, on roscpp's poll thread.
@@ -127,7 +127,7 @@ class PfNode {
     ros::getGlobalCallbackQueue()->removeByID(reinterpret_cast<uint64_t>(this));
     slot_.close();
     filter_thread_.join();
-    republisher_.reset();  // before live_ goes: its thread's onTfTick() uses live_
+    republisher_.reset();  // before live_ goes: its onTfTick() uses live_
   }
 
   // The main spinner: roscpp's own loop (ros::spin() waits on the queue
@@ -297,11 +297,12 @@ class PfNode {
     return true;
   }
 
-  // On the republishing thread, before each timed map -> odom. Under
-  // simulated time the clock itself shows a bag starting over, often before
-  // any scan of the new timeline gets through tf. (It lags the messages a
-  // little, hence the wider tolerance.) Never waits for the filter: while an
-  // update runs, the check waits for the next tick.
+  // Before each timed map -> odom (under simulated time on the poll thread,
+  // from /clock). Under simulated time the clock itself shows a bag
+  // starting over, often before any scan of the new timeline gets through
+  // tf. (It lags the messages a little, hence the wider tolerance.) Never
+  // waits for the filter: while an update runs, the check waits for the
+  // next tick.
   void onTfTick(const ros::Time& now) {
     if (!ros::Time::isSimTime()) return;
     std::unique_lock<std::mutex> lock(filter_mutex_, std::try_to_lock);
@@ -314,9 +315,9 @@ class PfNode {
     if (config_.save_pose_rate <= 0.0) return;
     const ros::Time now = ros::Time::now();
     const ros::Duration period(1.0 / config_.save_pose_rate);
-    if (now.isZero() || !save_schedule_.due(now, period)) return;
-    // The first call only starts the schedule, as a timer's first period.
+    // The first look only starts the schedule, as a timer's first period.
     const bool first = save_schedule_.next().isZero();
+    if (now.isZero() || !save_schedule_.due(now, period)) return;
     save_schedule_.published(now, period);
     if (!first) savePose();
   }
