@@ -18,6 +18,7 @@ packages=(
   python3-rosservice python3-rosparam python3-rosmsg
   libtf2-dev libtf2-ros-dev libtf2-geometry-msgs-dev libtf2-msgs-dev
   libsensor-msgs-dev libnav-msgs-dev libgeometry-msgs-dev libstd-srvs-dev libdiagnostic-msgs-dev
+  libros-rosgraph-msgs-dev
   librosbag-dev librosbag-storage-dev python3-rosbag
   # msg/PoseHypotheses.msg: message_generation (the C++ and Python generators)
   # and message_runtime; std_msgs for its header

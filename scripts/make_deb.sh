@@ -95,7 +95,7 @@ for d in "${rundeps[@]}"; do
     # linked C++ libraries: dpkg-shlibdeps
     roscpp|rosbag|message_filters|tf2|tf2_ros|dynamic_reconfigure|yaml-cpp) ;;
     # messages and services, tf2_geometry_msgs, Eigen: headers, compiled in
-    tf2_msgs|sensor_msgs|nav_msgs|geometry_msgs|std_msgs|std_srvs|diagnostic_msgs|tf2_geometry_msgs|eigen) ;;
+    tf2_msgs|sensor_msgs|nav_msgs|geometry_msgs|std_msgs|std_srvs|diagnostic_msgs|rosgraph_msgs|tf2_geometry_msgs|eigen) ;;
     # pf_hypotheses' message: compiled into pf_node; its generated Python
     # module (rostopic echo, a Python client) imports genpy and the message
     # packages it is built from

@@ -1,5 +1,6 @@
 #include "pf_localization/core/worker_pool.h"
 
+#include <pthread.h>
 #include <sys/resource.h>
 #include <sys/syscall.h>
 #include <unistd.h>
@@ -76,6 +77,8 @@ void WorkerPool::runErased(int threads, std::size_t tasks, Call call, void* task
 }
 
 void WorkerPool::work(std::size_t id) {
+  // Named for per-thread CPU figures (top, perf, scripts/live_cpu.sh).
+  pthread_setname_np(pthread_self(), "pf_worker");
   std::size_t seen = 0;
   std::unique_lock<std::mutex> lock(mutex_);
   for (;;) {

@@ -14,13 +14,16 @@
 // to a spinner); a scan whose tf is there goes through a one-scan
 // LatestScanSlot to a filter thread of its own, so that under overload the
 // newest scan wins and tf keeps being consumed; the main spinner serves the
-// map, initialpose, odometry, the services, the timers and the scans tf
-// dropped; map -> odom is republished by a MapToOdomRepublisher on a thread
-// that never waits for the filter. filter_mutex_ protects the filter and
+// map, initialpose, odometry, the services, the periodic save and the scans
+// tf dropped; map -> odom is republished by a MapToOdomRepublisher (a thread
+// on the wall clock, /clock on the poll thread under simulated time) that
+// never waits for the filter. No roscpp timer: under simulated time one
+// polls the clock every millisecond. filter_mutex_ protects the filter and
 // everything that goes with it (live_).
 #include <nav_msgs/OccupancyGrid.h>
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/SetMap.h>
+#include <pthread.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
@@ -110,13 +113,10 @@ class PfNode {
     nomotion_srv_ =
         nh_.advertiseService("request_nomotion_update", &PfNode::onNoMotionUpdate, this);
     set_map_srv_ = nh_.advertiseService("set_map", &PfNode::onSetMap, this);
-    if (config.save_pose_rate > 0.0) {
-      save_timer_ = nh_.createTimer(ros::Duration(1.0 / config.save_pose_rate),
-                                    [this](const ros::TimerEvent&) { savePose(); });
-    }
     reconfigure_ = std::make_unique<ReconfigureServer>(
         pnh_, config, [this](const LocalizerConfig& c) { return reconfigure(c); }, "pf_node");
-    republisher_->start();
+    // /clock on the poll thread too: it republishes when due.
+    republisher_->start(withQueue(nh_, &inline_queue_));
     filter_thread_ = std::thread([this] { filterLoop(); });
     // Last: their callbacks may run at once, on roscpp's poll thread.
     scan_inputs_.subscribe(nh_);
@@ -127,12 +127,13 @@ class PfNode {
     ros::getGlobalCallbackQueue()->removeByID(reinterpret_cast<uint64_t>(this));
     slot_.close();
     filter_thread_.join();
-    republisher_.reset();  // before live_ goes: its thread's onTfTick() uses live_
+    republisher_.reset();  // before live_ goes: its onTfTick() uses live_
   }
 
   // The main spinner: roscpp's own loop (ros::spin() waits on the queue
-  // with the same 0.1 s of wall time), plus a look at Ctrl-C after each
-  // wait, so that no timer thread has to wake ten times a second for it.
+  // with the same 0.1 s of wall time), plus a look at Ctrl-C and at the
+  // periodic save after each wait, so that no timer thread has to wake for
+  // them (under simulated time a roscpp timer polls the clock every ms).
   // Ctrl-C (and roslaunch's shutdown) saves the latest pose before the node
   // goes: the periodic save may be up to 1 / save_pose_rate old. Wall
   // time: a paused bag clock must not keep Ctrl-C waiting.
@@ -140,6 +141,7 @@ class PfNode {
     ros::CallbackQueue* queue = ros::getGlobalCallbackQueue();
     while (ros::ok()) {
       queue->callAvailable(ros::WallDuration(0.1));
+      savePoseWhenDue();
       if (!g_sigint) continue;
       // Without a master the save would block, waiting for one.
       if (config_.save_pose_rate > 0.0 && ros::master::check()) savePose();
@@ -208,6 +210,8 @@ class PfNode {
     // Raising the nice value needs no privilege; failing, it changes
     // nothing.
     lowerThreadPriority(kFilterNiceIncrement);
+    // Named for the per-thread CPU in scripts/live_cpu.sh, top and perf.
+    pthread_setname_np(pthread_self(), "pf_filter");
     // The destructor's close() wakes the wait; its time-out only bounds how
     // long a shutdown by another way goes unseen (a shorter one would wake
     // an idle node ten times a second for nothing).
@@ -293,15 +297,29 @@ class PfNode {
     return true;
   }
 
-  // On the republishing thread, before each timed map -> odom. Under
-  // simulated time the clock itself shows a bag starting over, often before
-  // any scan of the new timeline gets through tf. (It lags the messages a
-  // little, hence the wider tolerance.) Never waits for the filter: while an
-  // update runs, the check waits for the next tick.
+  // Before each timed map -> odom (under simulated time on the poll thread,
+  // from /clock). Under simulated time the clock itself shows a bag
+  // starting over, often before any scan of the new timeline gets through
+  // tf. (It lags the messages a little, hence the wider tolerance.) Never
+  // waits for the filter: while an update runs, the check waits for the
+  // next tick.
   void onTfTick(const ros::Time& now) {
     if (!ros::Time::isSimTime()) return;
     std::unique_lock<std::mutex> lock(filter_mutex_, std::try_to_lock);
     if (lock.owns_lock()) live_.timeJumpedBack(now, kSimClockLead);
+  }
+
+  // Every 1 / save_pose_rate s of the clock (amcl's timer), give or take
+  // the spinner's wait.
+  void savePoseWhenDue() {
+    if (config_.save_pose_rate <= 0.0) return;
+    const ros::Time now = ros::Time::now();
+    const ros::Duration period(1.0 / config_.save_pose_rate);
+    // The first look only starts the schedule, as a timer's first period.
+    const bool first = save_schedule_.next().isZero();
+    if (now.isZero() || !save_schedule_.due(now, period)) return;
+    save_schedule_.published(now, period);
+    if (!first) savePose();
   }
 
   // As amcl does, with the map it is on (saved_pose.h). Never waits for the
@@ -327,7 +345,7 @@ class PfNode {
   OdometrySource odometry_;  // main spinner only
   ScanInputs scan_inputs_;   // after slot_ and live_, which its callbacks use
   ros::ServiceServer global_srv_, nomotion_srv_, set_map_srv_;
-  ros::Timer save_timer_;
+  RepublishSchedule save_schedule_;  // main spinner only
   std::unique_ptr<ReconfigureServer> reconfigure_;
   std::thread filter_thread_;  // last: started when everything else exists
 };

@@ -21,14 +21,14 @@ std::optional<StateChangeLog::Line> StateChangeLog::onConfidence(const pf::Confi
   return Line{true, std::string(pf::toString(c.state)) + ": " + c.reason};
 }
 
-EstimatePublisher::EstimatePublisher(ros::NodeHandle& nh) {
-  pose_pub_ = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("pf_pose", 2, true);
-  // amcl's name for the same message, so that its users' tools keep working.
-  amcl_pose_pub_ = nh.advertise<geometry_msgs::PoseWithCovarianceStamped>("amcl_pose", 2, true);
+EstimatePublisher::EstimatePublisher(ros::NodeHandle& nh)
+    : pose_pub_(nh, "pf_pose", 2),
+      // amcl's name for the same message, so that its users' tools keep working.
+      amcl_pose_pub_(nh, "amcl_pose", 2),
+      hypotheses_pub_(nh, "pf_hypotheses", 2),
+      status_pub_(nh, "pf_status", 5) {
   cloud_pub_ = nh.advertise<geometry_msgs::PoseArray>("particlecloud", 2, true);
-  hypotheses_pub_ = nh.advertise<pf_localization::PoseHypotheses>("pf_hypotheses", 2, true);
   diagnostics_pub_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 5);
-  status_pub_ = nh.advertise<diagnostic_msgs::DiagnosticStatus>("pf_status", 5, true);
 }
 
 void EstimatePublisher::publishEstimate(const ScanLocalizer& localizer, const ros::Time& stamp,
@@ -55,7 +55,7 @@ void EstimatePublisher::publishConfidence(const ScanLocalizer& localizer, const 
   hypotheses_msg.header.stamp = stamp;
   hypotheses_msg.header.frame_id = localizer.config().global_frame;
   toHypothesesMsg(hypotheses, &hypotheses_msg);
-  hypotheses_pub_.publish(hypotheses_msg);
+  hypotheses_pub_.publish(std::move(hypotheses_msg));
 
   const std::string name = ros::this_node::getName() + ": localization";
   diagnostic_msgs::DiagnosticArray array;

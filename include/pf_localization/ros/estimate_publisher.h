@@ -8,6 +8,9 @@
 // its filter mutex, since it reads the filter.
 #pragma once
 
+#include <diagnostic_msgs/DiagnosticStatus.h>
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <pf_localization/PoseHypotheses.h>
 #include <ros/ros.h>
 
 #include <cstddef>
@@ -16,6 +19,7 @@
 #include <string>
 
 #include "pf_localization/core/confidence.h"
+#include "pf_localization/ros/latched_topic.h"
 #include "pf_localization/ros/scan_localizer.h"
 #include "pf_localization/ros/update_timing.h"
 
@@ -58,8 +62,11 @@ class EstimatePublisher {
                          const UpdateTiming& timing, std::uint64_t dropped, std::size_t cap);
 
  private:
-  ros::Publisher pose_pub_, amcl_pose_pub_, cloud_pub_, hypotheses_pub_, diagnostics_pub_,
-      status_pub_;
+  // Latched, published only while subscribed (latched_topic.h).
+  LatchedTopic<geometry_msgs::PoseWithCovarianceStamped> pose_pub_, amcl_pose_pub_;
+  LatchedTopic<pf_localization::PoseHypotheses> hypotheses_pub_;
+  LatchedTopic<diagnostic_msgs::DiagnosticStatus> status_pub_;
+  ros::Publisher cloud_pub_, diagnostics_pub_;
   ros::Time last_cloud_stamp_;
   StateChangeLog state_log_;
 };

@@ -1,20 +1,35 @@
-// map -> odom on /tf from a thread of its own: published after every filter
-// update, and again whenever 1 / tf_publish_rate s pass without one. A
-// filter update (80 ms for 500 000 particles) or anything else on the
-// node's spinner therefore never delays it (issue 15: under load the
-// ros::Timer used to wait behind the filter on the one spinner, and tf users
-// downstream saw 8 s gaps). It only ever touches the latest transform handed
-// to it, under its own mutex, never the filter. Its own loop rather than a ros::Timer on a
-// callback queue of its own: that would take two thread hops (roscpp's timer
-// thread, then the queue's spinner) per tick, each a chance to be descheduled
-// on a loaded computer.
+// map -> odom on /tf: published after every filter update, and again
+// whenever 1.5 periods (1 / tf_publish_rate s) pass without one on the wall
+// clock, one period under simulated time, so that tf users never wait more
+// than two periods (see kWallClockPeriods in the .cc). Neither a filter update
+// (80 ms for 500 000 particles) nor anything else on the node's spinner
+// delays it (under load a ros::Timer on the one spinner waited behind the
+// filter, and tf users downstream saw 8 s gaps). It only ever touches the
+// latest transform handed to it, under its own mutex, never the filter.
+//
+// What times the republishing depends on the clock:
+// - on the wall clock, a thread of its own that sleeps on a timer (timerfd)
+//   until a publication is due. Each publication after an update re-arms
+//   the timer, without waking the thread, so that while updates come often
+//   enough it never wakes. (Not a ros::Timer
+//   on a callback queue of its own: two thread hops per tick, roscpp's timer
+//   thread then the queue's spinner, each a chance to be descheduled on a
+//   loaded computer; nor a condition variable's timed wait: the thread
+//   would wake at every period to find the publication put off);
+// - under simulated time, /clock itself: no sleep can be timed on a clock
+//   that only /clock moves, so start() subscribes to it on the handle it is
+//   given (pf_node's poll thread), and the /clock message at which a
+//   publication is due publishes it, on the thread that brought it. No
+//   thread polls the clock (a roscpp timer, or a thread of this kind, would
+//   wake every millisecond of wall time to look: docs/performance.md, "The
+//   fixed cost").
 #pragma once
 
 #include <geometry_msgs/TransformStamped.h>
 #include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
 #include <tf2_ros/transform_broadcaster.h>
 
-#include <condition_variable>
 #include <functional>
 #include <mutex>
 #include <optional>
@@ -50,15 +65,17 @@ struct MapToOdomRepublisherOptions {
 
 class MapToOdomRepublisher {
  public:
-  /// Called on the republishing thread with the clock's time before each
-  /// timed publication, without any lock held (pf_node checks there whether
-  /// simulated time jumped back).
+  /// Called with the clock's time before each timed publication, on the
+  /// thread that times it (see above), without any lock held (pf_node checks
+  /// there whether simulated time jumped back).
   using TickHook = std::function<void(const ros::Time& now)>;
 
   explicit MapToOdomRepublisher(const MapToOdomRepublisherOptions& options, TickHook hook = {});
 
-  /// Starts the thread (once; the hook may be called from then on).
-  void start();
+  /// Starts the timed republishing (once; the hook may be called from then
+  /// on): under simulated time by subscribing to /clock on `clock_nh` (its
+  /// callback queue runs onClock()), on the wall clock by starting the thread.
+  void start(ros::NodeHandle clock_nh);
   ~MapToOdomRepublisher();
   MapToOdomRepublisher(const MapToOdomRepublisher&) = delete;
   MapToOdomRepublisher& operator=(const MapToOdomRepublisher&) = delete;
@@ -67,7 +84,7 @@ class MapToOdomRepublisher {
   /// until the next set()), after the scan stamped `scan_stamp` (zero: none):
   /// published at once, stamped max(now, scan_stamp) + transform_tolerance,
   /// or just after the previous stamp when that is not later (tf2 refuses a
-  /// repeated stamp); the next timed publication is then one period later.
+  /// repeated stamp); the next timed publication is then due one delay later.
   /// Returns whether it was published.
   bool set(const std::optional<geometry_msgs::TransformStamped>& map_to_odom,
            const ros::Time& scan_stamp);
@@ -82,10 +99,24 @@ class MapToOdomRepublisher {
   /// Number of map -> odom messages published since start.
   std::size_t published() const;
 
+  /// Simulated time moved to `now` (/clock): the timed publication when one
+  /// is due. Never waits: while set() publishes (which puts the next timed
+  /// publication off anyway) the next /clock looks again.
+  void onClock(const ros::Time& now);
+
  private:
-  // The thread: under simulated time it polls the clock every ms of wall
-  // time (as roscpp's timers do); under wall time it sleeps until due.
+  // The wall clock's thread: sleeps on the timer until a timed publication
+  // is due.
   void run();
+  // The wall clock's timer fires in `seconds` (no timer: nothing); mutex_
+  // held, or the thread not started.
+  void armLocked(double seconds);
+  // How long after the latest publication the next timed one is due: 1.5
+  // periods on the wall clock, one under simulated time (see the .cc).
+  ros::Duration delayLocked() const;
+  // The timed publication at `now`, when due; `lock` holds mutex_ (and is
+  // released around the hook).
+  void tick(const ros::Time& now, std::unique_lock<std::mutex>* lock);
   // Publishes the stored transform stamped `stamp`; mutex_ held.
   bool publishLocked(ros::Time stamp);
 
@@ -93,12 +124,13 @@ class MapToOdomRepublisher {
   TickHook hook_;
   tf2_ros::TransformBroadcaster broadcaster_;
   mutable std::mutex mutex_;
-  std::condition_variable wake_;
+  int timer_fd_ = -1;  // the wall clock's timer (timerfd); -1 under simulated time
   bool stop_ = false;
   std::optional<geometry_msgs::TransformStamped> transform_;
   ros::Time scan_stamp_, last_stamp_;
   RepublishSchedule schedule_;
   std::size_t published_ = 0;
+  ros::Subscriber clock_sub_;
   std::thread thread_;
 };
 
