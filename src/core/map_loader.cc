@@ -482,6 +482,35 @@ OccupancyGrid loadMap(const std::string& yaml_path) {
 
 void saveMap(const OccupancyGrid& grid, const std::string& yaml_path) {
   if (grid.empty()) throw std::invalid_argument("saveMap: the grid is empty");
+  std::vector<std::uint8_t> pixels(grid.data().size());
+  for (int y = 0; y < grid.height(); ++y) {
+    for (int x = 0; x < grid.width(); ++x) {
+      // The grid's own classification, so the saved map shows the filter's view.
+      std::uint8_t& p = pixels[static_cast<std::size_t>(grid.linearIndex({x, y}))];
+      switch (grid.state({x, y})) {
+        case CellState::kOccupied:
+          p = 0;
+          break;
+        case CellState::kFree:
+          p = 254;
+          break;
+        case CellState::kUnknown:
+          p = 205;
+          break;
+      }
+    }
+  }
+  saveImage(grid, pixels, yaml_path);
+}
+
+void saveImage(const OccupancyGrid& grid, const std::vector<std::uint8_t>& pixels,
+               const std::string& yaml_path) {
+  if (grid.empty()) throw std::invalid_argument("saveMap: the grid is empty");
+  if (pixels.size() != grid.data().size()) {
+    throw std::invalid_argument("saveImage: " + std::to_string(pixels.size()) +
+                                " pixels for a grid of " + std::to_string(grid.data().size()) +
+                                " cells");
+  }
   fs::path image_path(yaml_path);
   image_path.replace_extension(".pgm");
   if (image_path == fs::path(yaml_path)) {
@@ -494,21 +523,10 @@ void saveMap(const OccupancyGrid& grid, const std::string& yaml_path) {
   const std::size_t header = pgm.size();
   pgm.resize(header + static_cast<std::size_t>(w) * h);
   for (int y = 0; y < h; ++y) {
-    char* out = &pgm[header + static_cast<std::size_t>(h - 1 - y) * w];
-    for (int x = 0; x < w; ++x) {
-      // The grid's own classification, so the saved map shows the filter's view.
-      switch (grid.state({x, y})) {
-        case CellState::kOccupied:
-          out[x] = static_cast<char>(0);
-          break;
-        case CellState::kFree:
-          out[x] = static_cast<char>(254);
-          break;
-        case CellState::kUnknown:
-          out[x] = static_cast<char>(205);
-          break;
-      }
-    }
+    // The image's first row is the map's top row.
+    std::copy_n(pixels.begin() + static_cast<std::ptrdiff_t>(y) * w, w,
+                pgm.begin() +
+                    static_cast<std::ptrdiff_t>(header + static_cast<std::size_t>(h - 1 - y) * w));
   }
   writeFile(image_path.string(), pgm);
 

@@ -274,6 +274,8 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& measured
   report.beams_masked = transients_.masked();
   report.beams_changed = changes_.masked();
   report.map_evidence = changes_.counts();
+  report.map_agrees = changes_.agrees();
+  report.map_changed_share = changes_.changedShare();
   if (gate.scans) report.beams_dropped -= report.beams_masked;
   if (gate.skip == SkipReason::kNotMoved) {
     report.refinement =

@@ -55,6 +55,9 @@ constexpr char kUsage[] =
     "                                    at each pose of the trajectory (same stamps)\n"
     "         [--hypotheses HYP.csv]     t,rank,x,y,yaw,weight,std_x,std_y,cov_xy: pf_hypotheses,\n"
     "                                    one line per hypothesis per filter update\n"
+    "         [--changes CHANGES.yaml]   where the world no longer matches the map, as learned\n"
+    "                                    by the end (pf_map_changes): a map_server pair, pixel\n"
+    "                                    0 added, 205 removed, 254 seen as mapped, 128 unseen\n"
     "         [--quiet]                  no progress bar\n";
 
 // How long (bag time) a scan may wait for its odometry before it is used anyway.
@@ -63,7 +66,7 @@ constexpr double kMaxTfWait = 1.0;
 constexpr double kParticleDumpSeconds = 30.0;
 
 struct Options {
-  std::string bag, map, out, params, log, particles_out, covariance, hypotheses;
+  std::string bag, map, out, params, log, particles_out, covariance, hypotheses, changes;
   std::vector<std::string> scan_topics;   // empty: /scan
   std::vector<std::string> cloud_topics;  // PointCloud2 topics, sensors after the scan topics
   std::string odom_topic = "/odom";
@@ -112,6 +115,8 @@ Options parse(int argc, char** argv) {
       o.covariance = value(), ++i;
     else if (a == "--hypotheses")
       o.hypotheses = value(), ++i;
+    else if (a == "--changes")
+      o.changes = value(), ++i;
     else if (a == "--scan-topic")
       o.scan_topics.push_back(value()), ++i;
     else if (a == "--cloud-topic")
@@ -259,7 +264,7 @@ void openOutputs(const Options& opt, Outputs* o) {
     o->log << "t,particles,ess,cpu_ms,mean_beam_likelihood,std_x,std_y,std_yaw,updated,injected,"
               "tempering,hit_fraction,rivals,state,refined,refine_translation,refine_rotation,"
               "refine_rms,refine_matched,fault_fraction,search_sigma,look_alikes,"
-              "look_alikes_better,missing\n";
+              "look_alikes_better,beams_changed,map_changed_share,missing\n";
   }
   if (!opt.particles_out.empty()) {
     o->dump.open(opt.particles_out);
@@ -489,6 +494,7 @@ void Replay::logUpdate(double t, const pf_ros::ScanResult& r, double cpu) {
                << r.report.refinement.rms_distance << "," << r.report.refinement.matched_beams
                << "," << r.report.fault_fraction << "," << r.report.search_sigma << ","
                << r.report.look_alikes << "," << r.report.look_alikes_better << ","
+               << r.report.beams_changed << "," << r.report.map_changed_share << ","
                << missingNames(t) << "\n";
 }
 
@@ -531,6 +537,23 @@ void summarize(const Options& opt, const RunCounts& c) {
   if (c.written == 0) fail("no pose could be estimated (see the warnings above)", 3);
 }
 
+// The map's changes learned over the run: a summary line, and the layer
+// itself with --changes.
+void writeChanges(const Options& opt, const pf_ros::ScanLocalizer& localizer) {
+  const pf::MapChangeLayer* layer = localizer.mapChanges();
+  if (layer == nullptr) return;
+  const pf::MapChangeLayer::Summary s = layer->summary();
+  std::cerr << "pf_bag_runner: map changes: " << s.seen << " cells seen from " << layer->scans()
+            << " updates, " << s.added << " added, " << s.removed << " removed ("
+            << std::setprecision(2) << std::fixed << 100.0 * s.changedShare() << " %)\n";
+  if (opt.changes.empty()) return;
+  try {
+    pf::saveImage(*localizer.filter().map(), layer->pixels(), opt.changes);
+  } catch (const std::exception& e) {
+    fail(opt.changes + ": " + e.what(), 3);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -547,5 +570,6 @@ int main(int argc, char** argv) {
   Replay replay(opt, config, odom_on_tf, &tf, &localizer, &outputs);
   replay.run(bag);
   summarize(opt, replay.counts());
+  writeChanges(opt, localizer);
   return 0;
 }

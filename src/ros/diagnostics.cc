@@ -71,6 +71,10 @@ diagnostic_msgs::DiagnosticStatus toDiagnosticStatus(const pf::ParticleFilter& f
   add(&status, "beams_used", report.beams_used);
   // Left out: they see something that stepped up to the standing robot.
   add(&status, "beams_masked", report.beams_masked);
+  // Left out too: they see where the world no longer matches the map, at a
+  // tracked pose the rest of the scan agrees with (pf_map_changes).
+  add(&status, "beams_changed", report.beams_changed);
+  add(&status, "map_changed_share", report.map_changed_share);
   const pf::ParticleFilterParams& p = filter.params();
   add(&status, "config_generation", config_generation);
   add(&status, "max_particles", p.kld.max_particles);

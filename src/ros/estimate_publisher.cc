@@ -26,7 +26,8 @@ EstimatePublisher::EstimatePublisher(ros::NodeHandle& nh)
       // amcl's name for the same message, so that its users' tools keep working.
       amcl_pose_pub_(nh, "amcl_pose", 2),
       hypotheses_pub_(nh, "pf_hypotheses", 2),
-      status_pub_(nh, "pf_status", 5) {
+      status_pub_(nh, "pf_status", 5),
+      changes_pub_(nh, "pf_map_changes", 1) {
   cloud_pub_ = nh.advertise<geometry_msgs::PoseArray>("particlecloud", 2, true);
   diagnostics_pub_ = nh.advertise<diagnostic_msgs::DiagnosticArray>("/diagnostics", 5);
 }
@@ -66,6 +67,7 @@ void EstimatePublisher::publishConfidence(const ScanLocalizer& localizer, const 
   addSensors(&array.status.front(), localizer.sensorHealth(), stamp.toSec());
   diagnostics_pub_.publish(array);
   status_pub_.publish(array.status.front());
+  publishMapChanges(localizer, stamp);
   if (const auto line = state_log_.onConfidence(localizer.filter().confidence())) {
     if (line->warning) {
       ROS_WARN("pf_node: %s", line->text.c_str());
@@ -73,6 +75,19 @@ void EstimatePublisher::publishConfidence(const ScanLocalizer& localizer, const 
       ROS_INFO("pf_node: %s", line->text.c_str());
     }
   }
+}
+
+void EstimatePublisher::publishMapChanges(const ScanLocalizer& localizer, const ros::Time& stamp) {
+  const pf::MapChangeLayer* layer = localizer.mapChanges();
+  if (layer == nullptr || layer->scans() == changes_scans_) return;
+  // Time going back (a bag started over) makes it due.
+  if (!last_changes_stamp_.isZero() && stamp >= last_changes_stamp_ &&
+      (stamp - last_changes_stamp_).toSec() < kMapChangesPeriod) {
+    return;
+  }
+  if (auto msg = localizer.mapChangesMsg(stamp)) changes_pub_.publish(std::move(*msg));
+  last_changes_stamp_ = stamp;
+  changes_scans_ = layer->scans();
 }
 
 }  // namespace pf_ros

@@ -60,6 +60,8 @@ class MapChangeMask {
   /// The last judgement: what its beams said; how many the last mask() masked.
   const EvidenceCounts& counts() const { return counts_; }
   int masked() const { return masked_; }
+  /// Whether the last judged scans agreed with the map (their changes masked).
+  bool agrees() const { return agrees_; }
   /// The share of the last judged beams that saw a change of the map (0
   /// when the scans did not agree with the map: nothing was masked).
   double changedShare() const;

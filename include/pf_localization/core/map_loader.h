@@ -14,8 +14,10 @@
 // the bottom. No image library: PNG and other formats are rejected.
 #pragma once
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "pf_localization/core/occupancy_grid.h"
 
@@ -60,5 +62,12 @@ OccupancyGrid loadMap(const std::string& yaml_path);
 /// and the YAML names it relatively. Throws std::invalid_argument for an empty
 /// grid and std::runtime_error when a file cannot be written.
 void saveMap(const OccupancyGrid& grid, const std::string& yaml_path);
+
+/// The same pair with `pixels` in the image (row-major from the lower-left
+/// cell, as grid.data()) instead of the grid's classification: a layer over
+/// the map (map_change_layer.h) with `grid`'s size, resolution and origin.
+/// Throws std::invalid_argument when `pixels` is not one per cell.
+void saveImage(const OccupancyGrid& grid, const std::vector<std::uint8_t>& pixels,
+               const std::string& yaml_path);
 
 }  // namespace pf

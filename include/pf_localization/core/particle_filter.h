@@ -74,6 +74,10 @@ struct UpdateReport {
   // What the beams said of the map at the tracked pose (map_change_mask.h):
   // all zero when they were not judged (no tracked pose).
   EvidenceCounts map_evidence;
+  // Whether the scan agreed with the map there (the beams seeing changes
+  // were masked), and the share of its beams that saw a change then.
+  bool map_agrees = false;
+  double map_changed_share = 0.0;
   int beams_skipped = 0;  // of beams_used, left out by beam skipping
   std::size_t particles = 0;
   double ess = 0.0;  // before resampling

@@ -10,6 +10,7 @@
 
 #include <diagnostic_msgs/DiagnosticStatus.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <nav_msgs/OccupancyGrid.h>
 #include <pf_localization/PoseHypotheses.h>
 #include <ros/ros.h>
 
@@ -54,7 +55,13 @@ class EstimatePublisher {
   /// something subscribes to it, as at most `cloud_max_poses` poses.
   void publishEstimate(const ScanLocalizer& localizer, const ros::Time& stamp, bool always);
 
-  /// pf_hypotheses, /diagnostics and pf_status after an update, with
+  /// s: pf_map_changes, the layer of where the world no longer matches the
+  /// map, is published at most this often (stamps' time), when it learned
+  /// something: a building's map of 1 000 x 1 000 cells is a megabyte.
+  static constexpr double kMapChangesPeriod = 2.0;
+
+  /// pf_hypotheses, /diagnostics and pf_status after an update, and
+  /// pf_map_changes when due (kMapChangesPeriod), with
   /// `timing`'s figures, `dropped` scans and the particle `cap`; logs a
   /// change of state.
   void publishConfidence(const ScanLocalizer& localizer, const ros::Time& stamp,
@@ -62,10 +69,16 @@ class EstimatePublisher {
                          const UpdateTiming& timing, std::uint64_t dropped, std::size_t cap);
 
  private:
+  // pf_map_changes when due and the layer learned something since.
+  void publishMapChanges(const ScanLocalizer& localizer, const ros::Time& stamp);
+
   // Latched, published only while subscribed (latched_topic.h).
   LatchedTopic<geometry_msgs::PoseWithCovarianceStamped> pose_pub_, amcl_pose_pub_;
   LatchedTopic<pf_localization::PoseHypotheses> hypotheses_pub_;
   LatchedTopic<diagnostic_msgs::DiagnosticStatus> status_pub_;
+  LatchedTopic<nav_msgs::OccupancyGrid> changes_pub_;
+  ros::Time last_changes_stamp_;
+  std::size_t changes_scans_ = 0;  // the layer's scans when it was last published
   ros::Publisher cloud_pub_, diagnostics_pub_;
   ros::Time last_cloud_stamp_;
   StateChangeLog state_log_;

@@ -18,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "pf_localization/core/map_change_layer.h"
 #include "pf_localization/core/particle_filter.h"
 #include "pf_localization/core/sensor_health.h"
 #include "pf_localization/ros/localizer_config.h"
@@ -104,6 +105,15 @@ class ScanLocalizer {
   std::optional<geometry_msgs::PoseWithCovarianceStamped> estimate(const ros::Time& stamp) const;
   /// The particles, stamped `stamp`, in the global frame.
   geometry_msgs::PoseArray particleCloud(const ros::Time& stamp) const;
+
+  /// Where the world no longer matches the map (core/map_change_layer.h):
+  /// learned from the scans of the updates whose scans agreed with the map
+  /// at the tracked pose and left the filter localized, placed at the
+  /// estimate. Null before a map; a new map starts it anew.
+  const pf::MapChangeLayer* mapChanges() const { return changes_ ? &*changes_ : nullptr; }
+  /// That layer over the map as an OccupancyGrid (MapChangeLayer::occupancy()),
+  /// stamped `stamp`; none before a map.
+  std::optional<nav_msgs::OccupancyGrid> mapChangesMsg(const ros::Time& stamp) const;
   /// At most `max_poses` of them (0: all), a systematic resample by weight
   /// when there are more (toPoseArray in conversions.h).
   geometry_msgs::PoseArray particleCloud(const ros::Time& stamp, std::size_t max_poses) const;
@@ -134,6 +144,8 @@ class ScanLocalizer {
   const tf2::BufferCore* tf_;
   pf::ParticleFilter filter_;
   bool had_map_ = false;
+  nav_msgs::MapMetaData map_info_;                 // of the map in use
+  std::optional<pf::MapChangeLayer> changes_;      // over that map
   std::vector<std::optional<SensorScan>> latest_;  // per sensor
   std::vector<pf::LaserScan> group_;               // the scans of the current update
   pf::CloudScanReducer cloud_reducer_;
