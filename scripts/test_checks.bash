@@ -297,7 +297,7 @@ docs_build() {
   /usr/bin/python3 "$repo/scripts/check_doc_links.py" "$site" "$repo"
 }
 
-# The results tables of README.md and docs/results.md are scripts/results_tables'
+# The results tables of README.md and docs/results.md are scripts/results_tables.py's
 # output from one run of `scripts/benchmark_datasets 0 5000`; pf_bag_runner is
 # deterministic for a seed, so a fresh run must give the same accuracy figures
 # (the CPU column is the machine's, not compared). Recordings of ../shared/data
@@ -305,7 +305,7 @@ docs_build() {
 results_tables_current() {
   local out="$ws/results_tables"
   rm -rf "$out" && mkdir -p "$out"
-  PF_WS="$ws" /usr/bin/python3 "$repo/scripts/results_tables" --check --keep "$out"
+  PF_WS="$ws" /usr/bin/python3 "$repo/scripts/results_tables.py" --check --keep "$out"
 }
 
 # --- Python unit tests (pf_evaluate's metrics, pf_tune, locate) -----------------

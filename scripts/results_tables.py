@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """results_tables: writes the results tables of README.md and docs/results.md from one benchmark run.
 
-usage: scripts/results_tables [--from DIR] [--check] [--keep DIR]
+usage: /usr/bin/python3 scripts/results_tables.py [--from DIR] [--check] [--keep DIR]
 
 Without --from, runs `scripts/benchmark_datasets 0 5000 --no-plots` (the default configuration and
 a 5000-particle budget, seed 1: every recording with a reference under ../shared/data, and the
@@ -186,7 +186,7 @@ def main():
         if compared and not bad:
             print('results_tables: %s: the %s table matches the run (%d rows)' % (rel, name, compared))
     if bad:
-        print('results_tables: run `scripts/results_tables` (or `--from DIR` of a benchmark_datasets 0 5000 run) '
+        print('results_tables: run `/usr/bin/python3 scripts/results_tables.py` (or `--from DIR` of a benchmark_datasets 0 5000 run) '
               'to rewrite them')
     return 1 if bad else 0
 
