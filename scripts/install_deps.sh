@@ -46,6 +46,8 @@ packages=(
   # rviz test (scripts/rviz_click_test.sh): rviz under a virtual X server,
   # driven by xdotool, its window found by xwininfo, screenshots by import
   rviz xvfb xdotool x11-utils imagemagick
+  # the manual (mkdocs.yml, docs/): scripts/test.sh builds it with --strict
+  mkdocs
 )
 
 missing=()

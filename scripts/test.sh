@@ -139,6 +139,7 @@ queue_unit_tier() {  # the unit tests and the source checks
   queue check "the core and the simulator include no ROS header" core_is_ros_free
   queue check "no function in src/ longer than 80 lines" no_long_functions
   queue check "clang-format clean" clang_format_clean
+  queue check "the manual builds (mkdocs --strict), its links and anchors resolve" docs_build
 }
 
 # The low-priority lane: what needs a core for long but no clock.
@@ -161,6 +162,7 @@ background_lane() {
   job check "crowd.bag with updates every 0.05 m or 0.1 rad, 16 seeds: never confidently wrong, 15 tracked as with the defaults" \
     close_updates
   job check "the real recordings (intel_lab, fr079, neato_ac109_1): their precision" real_recordings
+  job check "the results tables of README.md and docs/results.md match a fresh benchmark run" results_tables_current
 }
 
 # The rostests, the longest first when an earlier run left their times.

@@ -9,6 +9,9 @@
 #   catkin_lint_clean install_space make_deb
 # The sources:
 #   core_is_ros_free clang_format_clean no_long_functions
+# The documentation:
+#   docs_build (the manual, strict, its links and anchors)
+#   results_tables_current (README's and docs/results.md's tables against a fresh benchmark run)
 # The Python unit tests: python_unit_tests (writes "PASSED FAILED" to $1).
 
 # --- Replays of the bundled bags with pf_bag_runner (deterministic for a seed) ---
@@ -280,6 +283,29 @@ no_long_functions() {
   local sources
   mapfile -t sources < <(cd "$repo" && git ls-files 'src/*.cc')
   (cd "$repo" && /usr/bin/python3 scripts/long_functions.py --max 80 "${sources[@]}")
+}
+
+# --- The documentation ---------------------------------------------------------
+# The manual (mkdocs.yml, docs/) built with warnings as errors into the
+# workspace, outside the repository; then every internal link and anchor of
+# the built pages and of README.md must resolve (mkdocs 1.4 checks links to
+# pages, not anchors). A few seconds.
+docs_build() {
+  local site="$ws/manual"
+  rm -rf "$site"
+  (cd "$repo" && mkdocs build --strict --quiet -f mkdocs.yml -d "$site") || return 1
+  /usr/bin/python3 "$repo/scripts/check_doc_links.py" "$site" "$repo"
+}
+
+# The results tables of README.md and docs/results.md are scripts/results_tables.py's
+# output from one run of `scripts/benchmark_datasets 0 5000`; pf_bag_runner is
+# deterministic for a seed, so a fresh run must give the same accuracy figures
+# (the CPU column is the machine's, not compared). Recordings of ../shared/data
+# that are absent are not compared. About 15 s on two idle cores.
+results_tables_current() {
+  local out="$ws/results_tables"
+  rm -rf "$out" && mkdir -p "$out"
+  PF_WS="$ws" /usr/bin/python3 "$repo/scripts/results_tables.py" --check --keep "$out"
 }
 
 # --- Python unit tests (pf_evaluate's metrics, pf_tune, locate) -----------------

@@ -45,14 +45,14 @@ TEST(ParameterDocs, TheReconfigureCfgIsTheTables) {
       << "cfg/PfLocalization.cfg is stale" << kRegenerate;
 }
 
-TEST(ParameterDocs, TheReadmesTableIsTheTables) {
-  const std::string readme = readFile("README.md");
+TEST(ParameterDocs, TheManualsTableIsTheTables) {
+  const std::string page = readFile("docs/parameters.md");
   const std::string begin = "<!-- parameters:begin -->\n", end = "<!-- parameters:end -->";
-  const auto b = readme.find(begin), e = readme.find(end);
+  const auto b = page.find(begin), e = page.find(end);
   ASSERT_NE(b, std::string::npos);
   ASSERT_NE(e, std::string::npos);
-  EXPECT_EQ(parameterMarkdown(), readme.substr(b + begin.size(), e - b - begin.size()))
-      << "README.md's parameter table is stale" << kRegenerate;
+  EXPECT_EQ(parameterMarkdown(), page.substr(b + begin.size(), e - b - begin.size()))
+      << "docs/parameters.md's parameter table is stale" << kRegenerate;
 }
 
 // Issue 26 cut the public surface to 50: what an amcl user knows and what a
