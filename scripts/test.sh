@@ -161,6 +161,8 @@ background_lane() {
     corridor_small_budget
   job check "crowd.bag with updates every 0.05 m or 0.1 rad, 16 seeds: never confidently wrong, 15 tracked as with the defaults" \
     close_updates
+  job check "worlds that no longer match their maps, 8 seeds: tracked, never wrong, their changes found" \
+    changed_worlds_check
   job check "the real recordings (intel_lab, fr079, neato_ac109_1): their precision" real_recordings
   job check "the results tables of README.md and docs/results.md match a fresh benchmark run" results_tables_current
 }

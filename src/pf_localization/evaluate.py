@@ -317,6 +317,67 @@ def read_map(yaml_path):
     return grey, [origin[0], origin[0] + w * res, origin[1], origin[1] + h * res]
 
 
+# The map's changes layer (pf_bag_runner --changes, pf_map_changes) and the true change mask
+# (pf_simulator --change-mask) as images: one pixel value per kind of cell.
+CHANGE_ADDED, CHANGE_REMOVED, CHANGE_AS_MAPPED, CHANGE_UNSEEN = 0, 205, 254, 128
+
+
+def read_change_image(yaml_path):
+    """A changes layer or a change mask (map_server pair) -> (h, w) uint8 pixels, row 0 the top."""
+    _need_file(yaml_path, 'changes YAML')
+    import yaml
+    with open(yaml_path) as f:
+        info = yaml.safe_load(f)
+    image = os.path.join(os.path.dirname(os.path.abspath(yaml_path)), str(info.get('image', '')))
+    _need_file(image, 'changes image')
+    return np.rint(read_pnm(image) * 255).astype(np.uint8)
+
+
+def _near(cells, radius=1):
+    """Cells within `radius` cells (8-neighbourhood steps) of a True cell."""
+    out = cells.copy()
+    h, w = cells.shape
+    for dy in range(-radius, radius + 1):
+        for dx in range(-radius, radius + 1):
+            src = cells[max(0, -dy):h - max(0, dy), max(0, -dx):w - max(0, dx)]
+            out[max(0, dy):h - max(0, -dy), max(0, dx):w - max(0, -dx)] |= src
+    return out
+
+
+def change_metrics(layer, mask=None):
+    """How the changes layer compares with the truth. Without a mask: how much of what the lidar saw
+    it marks changed. With the true mask: precision (marked cells within one cell of a true change
+    of their kind: a beam's end point lies in the cell before a face as often as in the face's) and
+    recall (true changes the lidar saw, i.e. that the layer has any evidence of, with a marked cell
+    of their kind within one cell), per kind and overall."""
+    seen = layer != CHANGE_UNSEEN
+    marked = {'added': layer == CHANGE_ADDED, 'removed': layer == CHANGE_REMOVED}
+    n_seen = int(seen.sum())
+    m = {'cells_seen': n_seen, 'cells_added': int(marked['added'].sum()),
+         'cells_removed': int(marked['removed'].sum())}
+    m['changed_share_of_seen'] = (m['cells_added'] + m['cells_removed']) / n_seen if n_seen else 0.0
+    if mask is None:
+        return m
+    if mask.shape != layer.shape:
+        raise EvalError('the changes layer is %dx%d cells, the mask %dx%d: not the same map'
+                        % (layer.shape[1], layer.shape[0], mask.shape[1], mask.shape[0]))
+    truth = {'added': mask == CHANGE_ADDED, 'removed': mask == CHANGE_REMOVED}
+    tp = found = n_marked = n_true = 0
+    for kind in ('added', 'removed'):
+        k_tp = int((marked[kind] & _near(truth[kind])).sum())
+        k_true = truth[kind] & seen
+        k_found = int((k_true & _near(marked[kind])).sum())
+        k_marked, k_n_true = int(marked[kind].sum()), int(k_true.sum())
+        m[kind] = {'precision': k_tp / k_marked if k_marked else None,
+                   'recall': k_found / k_n_true if k_n_true else None,
+                   'true_cells_seen': k_n_true}
+        tp, found, n_marked, n_true = tp + k_tp, found + k_found, n_marked + k_marked, n_true + k_n_true
+    m['precision'] = tp / n_marked if n_marked else None
+    m['recall'] = found / n_true if n_true else None
+    m['true_cells_seen'] = n_true
+    return m
+
+
 # ------------------------------------------------------------------------------------ metrics
 def associate(est, ref_t, max_gap=0.5, interpolate=True):
     """Estimate (x, y, yaw) at each reference time.
@@ -674,6 +735,32 @@ def plot_spread(path, log, t0, title):
     plt.close(fig)
 
 
+def plot_changes(path, the_map, changes, mask, title):
+    """The map with the changes layer over it: added cells red, removed blue; the true mask's
+    changed cells, when given, as a faint outline (orange, cyan) under them."""
+    import matplotlib.pyplot as plt
+    grey, extent = the_map
+    if changes.shape != grey.shape:
+        raise EvalError('the changes layer is %dx%d cells, the map %dx%d: not the same map'
+                        % (changes.shape[1], changes.shape[0], grey.shape[1], grey.shape[0]))
+    rgb = np.repeat(grey[:, :, None], 3, axis=2)
+    rgb[changes == CHANGE_UNSEEN] *= 0.85
+    if mask is not None:
+        rgb[mask == CHANGE_ADDED] = (1.0, 0.75, 0.4)
+        rgb[mask == CHANGE_REMOVED] = (0.6, 0.9, 1.0)
+    rgb[changes == CHANGE_ADDED] = (0.85, 0.1, 0.1)
+    rgb[changes == CHANGE_REMOVED] = (0.1, 0.3, 0.9)
+    fig, ax = plt.subplots(figsize=(8, 8 * grey.shape[0] / max(grey.shape[1], 1) + 0.6))
+    ax.imshow(rgb, extent=extent, origin='upper', interpolation='nearest')
+    ax.set_xlabel('x (m)')
+    ax.set_ylabel('y (m)')
+    ax.set_title(title + ': where the world no longer matches the map (red added, blue removed%s)'
+                 % ('; the truth light' if mask is not None else ''), fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def cpu_axis_top(c, percentile=99.0, headroom=1.5):
     """The top of the CPU time axis: all of c when its largest value is within `headroom` x the
     `percentile`th, else that (a few slow updates, e.g. the first, would squash the rest onto the
@@ -798,6 +885,10 @@ def parse_args(argv):
     p.add_argument('--out', help='report directory (default: TRAJ without extension + _eval)')
     p.add_argument('--cov', help="runner's covariance CSV (pf_bag_runner --covariance)")
     p.add_argument('--hypotheses', help="runner's hypotheses CSV (pf_bag_runner --hypotheses)")
+    p.add_argument('--changes', help="runner's map changes layer (pf_bag_runner --changes), drawn and "
+                   'counted')
+    p.add_argument('--change-mask', help='the true change mask (pf_simulator --change-mask) the changes '
+                   'layer is scored against')
     p.add_argument('--ref-std', type=float, default=0.0,
                    help="the reference's own position std dev (m), added as ref_std^2 I to the covariance")
     p.add_argument('--cov-aligned', action='store_true',
@@ -820,6 +911,10 @@ def run(args):
     parts = read_particles(args.particles) if args.particles else None
     cov = read_covariance(args.cov) if args.cov else None
     hyp = read_hypotheses(args.hypotheses) if args.hypotheses else None
+    if args.change_mask and not args.changes:
+        raise EvalError('--change-mask needs --changes (the layer to score)')
+    changes = read_change_image(args.changes) if args.changes else None
+    mask = read_change_image(args.change_mask) if args.change_mask else None
     if not (np.isfinite(args.ref_std) and args.ref_std >= 0):
         raise EvalError('--ref-std must be a finite number >= 0, got %g' % args.ref_std)
     out = args.out or os.path.splitext(args.traj)[0] + '_eval'
@@ -838,9 +933,12 @@ def run(args):
                                                           args.cov_aligned)
     if hyp is not None:
         m['hypotheses'] = hypotheses_metrics(hyp, ref, args.max_gap, not args.hold)
+    if changes is not None:
+        m['map_changes'] = change_metrics(changes, mask)
     m['inputs'] = {k: os.path.abspath(v) for k, v in (('traj', args.traj), ('bag', args.bag), ('ref', args.ref),
                    ('map', args.map), ('log', args.log), ('particles', args.particles), ('cov', args.cov),
-                   ('hypotheses', args.hypotheses)) if v}
+                   ('hypotheses', args.hypotheses), ('changes', args.changes),
+                   ('change_mask', args.change_mask)) if v}
     plots = []
     if not args.no_plots:
         import matplotlib
@@ -855,6 +953,9 @@ def run(args):
         if cov is not None:
             plot_nees(os.path.join(out, 'nees.png'), m['covariance'], cov_samples, title)
             plots.append('nees.png')
+        if changes is not None and the_map is not None:
+            plot_changes(os.path.join(out, 'changes.png'), the_map, changes, mask, title)
+            plots.append('changes.png')
         if parts is not None:
             m['gif_frames'] = make_particle_gif(os.path.join(out, 'particles.gif'), parts, est, ref, the_map,
                                                 args.gif_seconds, title)
@@ -892,6 +993,8 @@ def describe(m, summary):
         lines.append(describe_covariance(m['covariance']))
     if 'hypotheses' in m:
         lines.append(describe_hypotheses(m['hypotheses']))
+    if 'map_changes' in m:
+        lines.append(describe_changes(m['map_changes']))
     for name, v in m.get('sensors_missing', {}).items():
         lines.append('  sensor missing: %s in %.0f %% of the updates (%s s)' % (
             name, 100 * v['share'], ', '.join('%.1f-%.1f' % tuple(x) for x in v['stretches_s'])))
@@ -910,6 +1013,20 @@ def describe_hypotheses(h):
             % (h['near_m'], pct(h['contain_truth_share']), h['updates_matched'], h['near_m'],
                pct(h.get('near_truth_share')), pct(h['contain_truth_share_with_several']),
                h['updates_with_several'], h['most_hypotheses'], h['mean_hypotheses']))
+
+
+def describe_changes(c):
+    """The text summary's map changes line."""
+    text = ('  map changes:    %.2f %% of the %d cells seen marked changed (%d added, %d removed)'
+            % (100 * c['changed_share_of_seen'], c['cells_seen'], c['cells_added'], c['cells_removed']))
+    if 'recall' in c:
+        fmt = lambda v: '-' if v is None else '%.3f' % v
+        text += ('; against the true mask: precision %s, recall %s of %d changed cells seen '
+                 '(added %s / %s, removed %s / %s; within one cell)'
+                 % (fmt(c['precision']), fmt(c['recall']), c['true_cells_seen'],
+                    fmt(c['added']['precision']), fmt(c['added']['recall']),
+                    fmt(c['removed']['precision']), fmt(c['removed']['recall'])))
+    return text
 
 
 def describe_covariance(c):

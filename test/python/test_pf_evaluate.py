@@ -394,3 +394,67 @@ class AlignedAteTest(unittest.TestCase):
 
 if __name__ == '__main__':
     unittest.main()
+
+
+class ChangeMetricsTest(unittest.TestCase):
+    """The changes layer against the true mask (pixels as pf_bag_runner --changes and
+    pf_simulator --change-mask write them)."""
+
+    @staticmethod
+    def layer():
+        # 20 x 20 cells, all seen; the mask: an added box (rows 2-4, cols 2-6) and a removed
+        # strip (row 12, cols 5-14).
+        mask = np.full((20, 20), pfe.CHANGE_AS_MAPPED, dtype=np.uint8)
+        mask[2:5, 2:7] = pfe.CHANGE_ADDED
+        mask[12, 5:15] = pfe.CHANGE_REMOVED
+        return mask
+
+    def test_a_layer_equal_to_the_mask_is_perfect(self):
+        mask = self.layer()
+        m = pfe.change_metrics(mask.copy(), mask)
+        self.assertEqual(m['precision'], 1.0)
+        self.assertEqual(m['recall'], 1.0)
+        self.assertEqual(m['true_cells_seen'], 15 + 10)
+
+    def test_a_face_marked_one_cell_before_it_counts_and_two_cells_do_not(self):
+        mask = self.layer()
+        layer = np.full_like(mask, pfe.CHANGE_AS_MAPPED)
+        layer[1, 2:7] = pfe.CHANGE_ADDED        # the row above the box: within one cell
+        layer[8, 2:7] = pfe.CHANGE_ADDED        # four rows below it: a false mark
+        m = pfe.change_metrics(layer, mask)
+        self.assertAlmostEqual(m['added']['precision'], 0.5)
+        # Found: the box's first row (within one cell of the marks), 5 of its 15 cells.
+        self.assertAlmostEqual(m['added']['recall'], 5 / 15)
+        self.assertIsNone(m['removed']['precision'])
+        self.assertEqual(m['removed']['recall'], 0.0)
+
+    def test_a_kind_mistaken_is_not_found(self):
+        mask = self.layer()
+        layer = mask.copy()
+        layer[mask == pfe.CHANGE_REMOVED] = pfe.CHANGE_ADDED
+        m = pfe.change_metrics(layer, mask)
+        self.assertAlmostEqual(m['precision'], 15 / 25)
+        self.assertEqual(m['removed']['recall'], 0.0)
+
+    def test_recall_counts_only_the_changes_the_lidar_saw(self):
+        mask = self.layer()
+        layer = np.full_like(mask, pfe.CHANGE_UNSEEN)
+        layer[12, 5:15] = pfe.CHANGE_REMOVED    # the strip seen; the box never
+        m = pfe.change_metrics(layer, mask)
+        self.assertEqual(m['recall'], 1.0)
+        self.assertEqual(m['true_cells_seen'], 10)
+        self.assertEqual(m['cells_seen'], 10)
+        self.assertEqual(m['changed_share_of_seen'], 1.0)
+
+    def test_without_a_mask_only_the_share_marked(self):
+        layer = np.full((10, 10), pfe.CHANGE_AS_MAPPED, dtype=np.uint8)
+        layer[0, 0] = pfe.CHANGE_ADDED
+        layer[5:, :] = pfe.CHANGE_UNSEEN
+        m = pfe.change_metrics(layer)
+        self.assertEqual(m['cells_seen'], 50)
+        self.assertAlmostEqual(m['changed_share_of_seen'], 1 / 50)
+        self.assertNotIn('recall', m)
+
+    def test_another_maps_mask_is_an_error(self):
+        with self.assertRaises(pfe.EvalError):
+            pfe.change_metrics(np.zeros((5, 5), np.uint8), np.zeros((5, 6), np.uint8))
