@@ -49,26 +49,32 @@ MapChangeLayer::MapChangeLayer(const LikelihoodField& field)
       sin_yaw_(std::sin(origin_.yaw)) {
   const OccupancyGrid& grid = field.grid();
   const std::vector<float>& distance = field.distances();
-  map_.resize(grid.data().size());
-  for (std::size_t i = 0; i < map_.size(); ++i) {
+  cells_.resize(grid.data().size());
+  for (std::size_t i = 0; i < cells_.size(); ++i) {
     switch (OccupancyGrid::classify(grid.data()[i])) {
       case CellState::kOccupied:
-        map_[i] = MapCell::kOccupied;
+        cells_[i] = kMapOccupied;
         break;
       case CellState::kUnknown:
-        map_[i] = MapCell::kUnknown;
+        cells_[i] = kMapUnknown;
         break;
       case CellState::kFree:
-        map_[i] = distance[i] <= kBesideObstacle ? MapCell::kBeside : MapCell::kFree;
+        cells_[i] = distance[i] <= kBesideObstacle ? kMapBeside : kMapFree;
         break;
     }
   }
-  counts_.resize(map_.size());
+  counts_.resize(cells_.size());
 }
 
 void MapChangeLayer::clear() {
   std::fill(counts_.begin(), counts_.end(), Counts());
+  for (std::uint8_t& c : cells_) c &= kMapBits;
   scans_ = 0;
+}
+
+bool MapChangeLayer::wants(const Pose2& robot) const {
+  return scans_ == 0 || std::hypot(robot.x - last_.x, robot.y - last_.y) >= kMinStep ||
+         std::abs(normalizeAngle(robot.yaw - last_.yaw)) >= kMinTurn;
 }
 
 void MapChangeLayer::add(const ScanGroup& scans, const Pose2& robot) {
@@ -91,6 +97,7 @@ void MapChangeLayer::add(const ScanGroup& scans, const Pose2& robot) {
     }
   }
   ++scans_;
+  last_ = robot;
 }
 
 void MapChangeLayer::walk(double x, double y, double ux, double uy, double range) {
@@ -104,11 +111,16 @@ void MapChangeLayer::walk(double x, double y, double ux, double uy, double range
   double next_y = uy != 0.0 ? (cy + (step_y > 0 ? 1 : 0) - y) / uy : inf;
   double t = 0.0;
   while (t <= length && cx >= 0 && cy >= 0 && cx < width_ && cy < height_) {
-    const std::size_t i = static_cast<std::size_t>(cy) * width_ + cx;
-    if (map_[i] == MapCell::kOccupied) {
-      count(i, kPass);
-    } else if (map_[i] != MapCell::kUnknown) {
-      count(i, kFree);
+    // Most cells are free, and only their byte is touched.
+    std::uint8_t& cell = cells_[static_cast<std::size_t>(cy) * width_ + cx];
+    const std::uint8_t map = cell & kMapBits;
+    if (map != kMapUnknown) {
+      cell |= kSeen;
+      if (map == kMapOccupied) {
+        count(static_cast<std::size_t>(cy) * width_ + cx, kPass);
+      } else if (cell & kWasHit) {
+        count(static_cast<std::size_t>(cy) * width_ + cx, kFree);
+      }
     }
     if (next_x < next_y) {
       t = next_x;
@@ -127,7 +139,8 @@ void MapChangeLayer::end(double x, double y) {
   const int cx = static_cast<int>(std::floor(x)), cy = static_cast<int>(std::floor(y));
   if (cx < 0 || cy < 0 || cx >= width_ || cy >= height_) return;
   const std::size_t i = static_cast<std::size_t>(cy) * width_ + cx;
-  if (map_[i] == MapCell::kFree) {
+  if ((cells_[i] & kMapBits) == kMapFree) {
+    cells_[i] |= kSeen | kWasHit;
     count(i, kHit);
     return;
   }
@@ -136,16 +149,18 @@ void MapChangeLayer::end(double x, double y) {
   for (int ny = std::max(0, cy - 1); ny <= std::min(height_ - 1, cy + 1); ++ny) {
     for (int nx = std::max(0, cx - 1); nx <= std::min(width_ - 1, cx + 1); ++nx) {
       const std::size_t j = static_cast<std::size_t>(ny) * width_ + nx;
-      if (map_[j] == MapCell::kOccupied) count(j, kEnd);
+      if ((cells_[j] & kMapBits) != kMapOccupied) continue;
+      cells_[j] |= kSeen;
+      count(j, kEnd);
     }
   }
 }
 
 MapChangeLayer::Cell MapChangeLayer::classify(std::size_t i) const {
+  if (!(cells_[i] & kSeen)) return Cell::kUnseen;
   const Counts& c = counts_[i];
   const int hits = c.hits, passes = c.passes;
   const int stopped = hits + c.free, reached = passes + c.ends;
-  if (stopped == 0 && reached == 0) return Cell::kUnseen;
   if (hits >= kMinScans && hits >= kChangedShare * stopped) return Cell::kAdded;
   if (passes >= kMinScans && passes >= kChangedShare * reached) return Cell::kRemoved;
   return Cell::kAsMapped;

@@ -233,9 +233,14 @@ ScanGroup ParticleFilter::maskTransients(const Pose2& odom, const ScanGroup& mea
   return transients_.mask(odom, measured, on_map, &masked_scans_);
 }
 
-ScanGroup ParticleFilter::maskMapChanges(const Pose2& odom, const ScanGroup& scans) {
-  const std::optional<Pose2> robot = trackedPose(odom);
-  if (!robot || !judgesFromTrackedPose(odom)) {
+std::optional<Pose2> ParticleFilter::judgingPose(const Pose2& odom) const {
+  if (!judgesFromTrackedPose(odom)) return std::nullopt;
+  return trackedPose(odom);
+}
+
+ScanGroup ParticleFilter::maskMapChanges(const std::optional<Pose2>& robot,
+                                         const ScanGroup& scans) {
+  if (!robot) {
     changes_.clear();
     return scans;
   }
@@ -263,13 +268,17 @@ bool ParticleFilter::judgesFromTrackedPose(const Pose2& odom) const {
 
 UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& measured) {
   const ScanGroup unmasked = maskTransients(odom, measured);
-  // Judged from the pose tracked since the last update, before the gate
-  // makes this one the last.
-  const ScanGroup scans = maskMapChanges(odom, unmasked);
+  // The pose tracked since the last update, before the gate makes this one
+  // the last.
+  const std::optional<Pose2> judging = judgingPose(odom);
   // The gate judges the odometry by every beam: a scan that stops fitting
   // where it says is what the beams masked for changes of the map would hide.
   GateDecision gate = gate_.decide(odom, unmasked, sensor_.get(), isInitialized(), estimate_.pose,
                                    motion_.faults().suspect(params_.motion), params_);
+  // The beams that see a change of the map, judged only for an update: a
+  // scan between updates moves no particle.
+  const bool between = gate.skip == SkipReason::kNotMoved;
+  const ScanGroup scans = maskMapChanges(gate.runs() ? judging : std::nullopt, unmasked);
   UpdateReport report = gateReport(&gate, particles_.size());
   report.beams_masked = transients_.masked();
   report.beams_changed = changes_.masked();
@@ -277,7 +286,7 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& measured
   report.map_agrees = changes_.agrees();
   report.map_changed_share = changes_.changedShare();
   if (gate.scans) report.beams_dropped -= report.beams_masked;
-  if (gate.skip == SkipReason::kNotMoved) {
+  if (between) {
     report.refinement =
         refinement_.betweenUpdates(sensor_.model(), scans, odom, *gate_.odomAtUpdate(), estimate_,
                                    confidence_.confidence().state, params_);

@@ -238,7 +238,8 @@ void ScanLocalizer::update(pf::LaserScan scan, std::size_t sensor, const ros::Ti
   result->report = filter_.update(*result->odom, group_);
   const pf::UpdateReport& report = result->report;
   if (changes_ && report.updated && report.map_agrees &&
-      filter_.confidence().state != pf::LocalizationState::kLost) {
+      filter_.confidence().state != pf::LocalizationState::kLost &&
+      changes_->wants(filter_.estimate().pose)) {
     changes_->add(group_, filter_.estimate().pose);
   }
   if (latest_.size() > 1) observeHealth(group_.front(), sensor, stamp);

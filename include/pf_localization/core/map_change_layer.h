@@ -37,7 +37,7 @@ class MapChangeLayer {
   };
 
   /// Beams walked per scan at most (every n / kRaysPerScan of a scan of n).
-  static constexpr std::size_t kRaysPerScan = 360;
+  static constexpr std::size_t kRaysPerScan = 180;
   /// m: a beam is walked this far at most; a longer one has no end here.
   static constexpr double kMaxRange = 10.0;
   /// m: the cells this close before a beam's end are not counted as passed
@@ -47,7 +47,7 @@ class MapChangeLayer {
   static constexpr double kBesideObstacle = 0.1;
   /// Scans whose beams reached a cell before it can be called changed (a
   /// scan counts once per cell, however many of its beams reached it).
-  static constexpr int kMinScans = 3;
+  static constexpr int kMinScans = 2;
   /// Share of those that must say it changed: stopped there (added) or went
   /// through (removed).
   static constexpr double kChangedShare = 0.5;
@@ -55,6 +55,14 @@ class MapChangeLayer {
   /// An empty layer of `field`'s map.
   explicit MapChangeLayer(const LikelihoodField& field);
 
+  /// m, rad: a scan is worth adding once the robot moved this far or turned
+  /// this much since the last one added: a scan from the same place says
+  /// again what the last one said, and each costs a walk of every beam.
+  static constexpr double kMinStep = 0.4;
+  static constexpr double kMinTurn = 0.5;
+
+  /// Whether a scan from `robot` is worth adding (kMinStep, kMinTurn).
+  bool wants(const Pose2& robot) const;
   /// Adds what `scans`, placed from the robot pose `robot`, saw.
   void add(const ScanGroup& scans, const Pose2& robot);
   /// Forgets everything seen.
@@ -85,15 +93,20 @@ class MapChangeLayer {
  private:
   // Scans, each counted once per cell and kind.
   struct Counts {
-    std::uint16_t hits = 0;    // a beam ended here, the map free and clear around
-    std::uint16_t free = 0;    // a beam passed, the map free here
+    std::uint16_t hits = 0;  // a beam ended here, the map free and clear around
+    // A beam passed, the map free here, since the first hit (what passed
+    // before says nothing of an object that came later).
+    std::uint16_t free = 0;
     std::uint16_t passes = 0;  // a beam passed, the map occupied here
     std::uint16_t ends = 0;    // a beam ended on this mapped obstacle
     std::uint16_t scan = 0;    // the last scan that counted here (scans_, wrapping)
     std::uint8_t counted = 0;  // of that scan: a bit per kind already counted
   };
   enum Kind : std::uint8_t { kHit = 1, kFree = 2, kPass = 4, kEnd = 8 };
-  enum class MapCell : std::uint8_t { kFree, kBeside, kOccupied, kUnknown };
+  // Each cell's byte: what the map has there (the low two bits), whether a
+  // beam reached it, and whether one ever ended there short of the map.
+  enum MapCell : std::uint8_t { kMapFree, kMapBeside, kMapOccupied, kMapUnknown, kMapBits = 3 };
+  enum Flag : std::uint8_t { kSeen = 4, kWasHit = 8 };
 
   Cell classify(std::size_t i) const;
   // Counts `kind` in cell i, once per scan.
@@ -107,9 +120,10 @@ class MapChangeLayer {
   double inv_resolution_;
   Pose2 origin_;
   double cos_yaw_, sin_yaw_;
-  std::vector<MapCell> map_;
+  std::vector<std::uint8_t> cells_;  // MapCell | Flag
   std::vector<Counts> counts_;
   std::size_t scans_ = 0;
+  Pose2 last_;  // the robot pose of the last scan added
 };
 
 }  // namespace pf

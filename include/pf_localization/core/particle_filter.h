@@ -178,9 +178,13 @@ class ParticleFilter {
   // The scans with the beams that see something that moved in while the
   // robot stood masked (transient_beams.h), judged from the last estimate.
   ScanGroup maskTransients(const Pose2& odom, const ScanGroup& measured);
-  // The scans with the beams that see a change of the map masked, while the
-  // tracked pose explains the rest (map_change_mask.h).
-  ScanGroup maskMapChanges(const Pose2& odom, const ScanGroup& scans);
+  // The tracked pose at `odom` when it is known well enough to judge beams
+  // from (judgesFromTrackedPose).
+  std::optional<Pose2> judgingPose(const Pose2& odom) const;
+  // The scans with the beams that see a change of the map from `robot`
+  // masked, while that pose explains the rest (map_change_mask.h); none:
+  // nothing judged.
+  ScanGroup maskMapChanges(const std::optional<Pose2>& robot, const ScanGroup& scans);
   // Whether the tracked pose at `odom` is known well enough to judge beams
   // from: one place, told apart, not lost, a short step of odometry since.
   bool judgesFromTrackedPose(const Pose2& odom) const;
