@@ -12,17 +12,17 @@
 #include <limits>
 #include <memory>
 
-#include "pf_localization/core/beam_model.h"
-#include "pf_localization/core/cloud_scan.h"
-#include "pf_localization/core/confidence.h"
-#include "pf_localization/core/likelihood_field_model.h"
-#include "pf_localization/core/look_alikes.h"
-#include "pf_localization/core/odometry_motion_model.h"
-#include "pf_localization/core/particle_filter.h"
-#include "pf_localization/core/pose_estimator.h"
-#include "pf_localization/core/resampler.h"
-#include "pf_localization/core/scan_refiner.h"
-#include "pf_localization/core/weighting.h"
+#include "pf_localization/core/estimate/confidence.h"
+#include "pf_localization/core/estimate/pose_estimator.h"
+#include "pf_localization/core/estimate/scan_refiner.h"
+#include "pf_localization/core/filter/particle_filter.h"
+#include "pf_localization/core/filter/resampler.h"
+#include "pf_localization/core/filter/weighting.h"
+#include "pf_localization/core/motion/odometry_motion_model.h"
+#include "pf_localization/core/recovery/look_alikes.h"
+#include "pf_localization/core/sensor/beam_model.h"
+#include "pf_localization/core/sensor/cloud_scan.h"
+#include "pf_localization/core/sensor/likelihood_field_model.h"
 
 namespace {
 

@@ -51,7 +51,7 @@
 
 #include <vector>
 
-#include "pf_localization/core/occupancy_grid.h"
+#include "pf_localization/core/map/occupancy_grid.h"
 #include "pf_localization/sim/building_map.h"
 #include "pf_localization/sim/scene_3d.h"
 
