@@ -48,7 +48,7 @@
 #include "pf_localization/ros/input/scan_drop.h"
 #include "pf_localization/ros/input/scan_inputs.h"
 #include "pf_localization/ros/localizer/inline_callback_queue.h"
-#include "pf_localization/ros/localizer/limited_warn.h"
+#include "pf_localization/ros/localizer/limited_log.h"
 #include "pf_localization/ros/localizer/live_localizer.h"
 #include "pf_localization/ros/output/map_to_odom_republisher.h"
 #include "pf_localization/ros/params/parameter_docs.h"

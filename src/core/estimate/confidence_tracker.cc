@@ -5,8 +5,8 @@
 #include <string>
 
 #include "pf_localization/core/estimate/hypotheses.h"
-#include "pf_localization/core/estimate/scan_refiner.h"
-#include "pf_localization/core/recovery/new_view.h"
+#include "pf_localization/core/estimate/scan_matcher.h"
+#include "pf_localization/core/filter/view_share.h"
 
 namespace pf {
 

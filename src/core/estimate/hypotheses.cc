@@ -5,7 +5,7 @@
 #include <utility>
 #include <vector>
 
-#include "pf_localization/core/recovery/look_alikes.h"
+#include "pf_localization/core/recovery/look_alike_places.h"
 
 namespace pf {
 

@@ -8,9 +8,9 @@
 #include <utility>
 
 #include "pf_localization/core/estimate/hypotheses.h"
-#include "pf_localization/core/filter/tempering.h"
-#include "pf_localization/core/recovery/random_free_pose.h"
-#include "pf_localization/core/util/prefault.h"
+#include "pf_localization/core/filter/weighting.h"
+#include "pf_localization/core/recovery/recovery.h"
+#include "pf_localization/core/util/scratch_storage.h"
 
 namespace pf {
 

@@ -6,7 +6,7 @@
 #include <string>
 #include <thread>
 
-#include "pf_localization/core/util/parameter_check.h"
+#include "pf_localization/core/util/parameter_table.h"
 
 namespace pf {
 namespace {

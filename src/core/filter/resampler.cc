@@ -5,9 +5,8 @@
 #include <stdexcept>
 
 #include "pf_localization/core/filter/particle_blocks.h"
-#include "pf_localization/core/util/bin_index.h"
 #include "pf_localization/core/util/bin_table.h"
-#include "pf_localization/core/util/thread_scratch.h"
+#include "pf_localization/core/util/scratch_storage.h"
 
 namespace pf {
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <utility>
 
-#include "pf_localization/core/recovery/new_view.h"
+#include "pf_localization/core/filter/view_share.h"
 
 namespace pf {
 namespace {
@@ -119,6 +119,28 @@ std::optional<std::vector<PreparedScan>> UpdateGate::fitDropped(
   const double fit = hitFraction(model, prepared, predicted, params.update_fit_distance);
   if (fit >= fit_at_update_ - params.update_fit_drop) return std::nullopt;
   return prepared;
+}
+
+const char* toString(SkipReason reason) {
+  switch (reason) {
+    case SkipReason::kNone:
+      return "updated";
+    case SkipReason::kNoMap:
+      return "no map yet";
+    case SkipReason::kNotInitialized:
+      return "the filter is not initialised";
+    case SkipReason::kOdometryNotFinite:
+      return "the odometry pose is not finite";
+    case SkipReason::kBadScan:
+      return "bad scan";
+    case SkipReason::kOdometryJumped:
+      return "odometry jumped";
+    case SkipReason::kNotMoved:
+      return "not moved enough since the last update";
+    case SkipReason::kNoValidBeam:
+      return "no valid beam in the scan";
+  }
+  return "unknown skip reason";
 }
 
 }  // namespace pf

@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "pf_localization/core/filter/particle_blocks.h"
-#include "pf_localization/core/util/prefault.h"
+#include "pf_localization/core/util/scratch_storage.h"
 
 namespace pf {
 namespace {

@@ -5,10 +5,10 @@
 #include <stdexcept>
 #include <string>
 
-#include "pf_localization/core/recovery/new_view.h"
+#include "pf_localization/core/filter/view_share.h"
 #include "pf_localization/core/util/fast_math.h"
-#include "pf_localization/core/util/parameter_check.h"
-#include "pf_localization/core/util/thread_scratch.h"
+#include "pf_localization/core/util/parameter_table.h"
+#include "pf_localization/core/util/scratch_storage.h"
 
 namespace pf {
 namespace {

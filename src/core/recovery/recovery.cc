@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <utility>
+#include <vector>
 
 #include "pf_localization/core/filter/resampler.h"
-#include "pf_localization/core/recovery/new_view.h"
-#include "pf_localization/core/recovery/random_free_pose.h"
-#include "pf_localization/core/util/prefault.h"
+#include "pf_localization/core/filter/view_share.h"
+#include "pf_localization/core/util/scratch_storage.h"
 
 namespace pf {
 
@@ -73,7 +73,7 @@ void ExpansionResetting::spread(const RecoveryParams& params, std::size_t n, Ran
 void LookAlikeMove::contribute(const RecoveryContext& context, const RecoveryParams& /*params*/,
                                RecoveryPlan* plan) {
   // Whenever a look-alike has fitted clearly better for kBetterUpdates in a
-  // row (look_alikes.h): that streak is what tells a place from an object
+  // row (look_alike_places.h): that streak is what tells a place from an object
   // that is not on the map. Asking as well for a fit below the usual one
   // held the move back for seconds where the fit sinks slowly, as the view
   // that tells two aisles apart comes in (docs/design.md).
@@ -183,6 +183,16 @@ void Recovery::reserve(std::size_t n) {
   for (std::vector<double>* v : {&spare_.x, &spare_.y, &spare_.yaw, &spare_.weight}) {
     prefault(v, n);
   }
+}
+
+Pose2 randomFreePose(const OccupancyGrid& grid, Random* random) {
+  const std::vector<int>& free = grid.freeCells();
+  const int cell = free[random->index(free.size())];
+  const CellIndex c{cell % grid.width(), cell / grid.width()};
+  // Anywhere inside the cell, not only its centre.
+  const Pose2 local{(c.x + random->uniform()) * grid.resolution(),
+                    (c.y + random->uniform()) * grid.resolution(), random->uniform(-M_PI, M_PI)};
+  return compose(grid.origin(), local);
 }
 
 }  // namespace pf

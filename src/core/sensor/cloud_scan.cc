@@ -7,8 +7,8 @@
 #include <utility>
 #include <vector>
 
-#include "pf_localization/core/util/fast_atan2.h"
-#include "pf_localization/core/util/parameter_check.h"
+#include "pf_localization/core/util/fast_math.h"
+#include "pf_localization/core/util/parameter_table.h"
 
 namespace pf {
 namespace {

@@ -12,9 +12,8 @@
 
 #include "pf_localization/core/filter/particle_blocks.h"
 #include "pf_localization/core/util/fast_math.h"
-#include "pf_localization/core/util/parameter_check.h"
 #include "pf_localization/core/util/parameter_table.h"
-#include "pf_localization/core/util/thread_scratch.h"
+#include "pf_localization/core/util/scratch_storage.h"
 
 namespace pf {
 

@@ -5,7 +5,7 @@
 #include <cstring>
 #include <vector>
 
-#include "pf_localization/core/util/thread_scratch.h"
+#include "pf_localization/core/util/scratch_storage.h"
 
 namespace pf {
 namespace {

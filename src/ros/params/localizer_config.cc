@@ -10,7 +10,6 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "pf_localization/core/util/parameter_check.h"
 #include "pf_localization/core/util/parameter_table.h"
 #include "pf_localization/ros/params/amcl_params.h"
 
@@ -447,7 +446,7 @@ void finishReading(LocalizerConfig* c) {
 // Parameters under a new name: a configuration that still sets the old one
 // is told which (nullptr: not renamed).
 const char* renamedTo(const std::string& name) {
-  // Issue 30: the whole update on several threads, not only the scoring.
+  // The whole update runs on several threads now, not only the scoring.
   if (name == "sensor_threads") return "threads";
   return nullptr;
 }
@@ -603,7 +602,7 @@ class ParamReader {
     if (!retired.empty()) {
       notes_->infos.push_back(retired +
                               ": no longer parameters (constants of the filter's algorithms "
-                              "since issue 26, docs/design.md): ignored");
+                              "(docs/design.md)): ignored");
     }
     if (!unknown.empty()) {
       notes_->warnings.push_back(

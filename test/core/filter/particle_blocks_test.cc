@@ -15,7 +15,7 @@
 #include <thread>
 #include <vector>
 
-#include "pf_localization/core/estimate/pose_estimator.h"
+#include "pf_localization/core/estimate/cluster_estimate.h"
 #include "pf_localization/core/filter/particle_filter.h"
 #include "pf_localization/core/filter/resampler.h"
 #include "support/rooms.h"

@@ -8,7 +8,7 @@
 #include <memory>
 
 #include "core/small_world.h"
-#include "pf_localization/core/recovery/new_view.h"
+#include "pf_localization/core/filter/view_share.h"
 #include "pf_localization/core/sensor/likelihood_field_model.h"
 
 namespace pf {

@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "core/expect_pose.h"
-#include "pf_localization/core/recovery/new_view.h"
+#include "pf_localization/core/filter/view_share.h"
 
 namespace pf {
 namespace {
@@ -360,7 +360,7 @@ TEST(ApplyLongStep, RefusesAStepThatIsNotPositive) {
   EXPECT_THROW(OdometryMotionModel(OdometryMotionParams{}, {1.0, -1.0}), std::invalid_argument);
 }
 
-// Updates closer together than a view (new_view.h): five updates of a fifth
+// Updates closer together than a view (view_share.h): five updates of a fifth
 // of a view each spread the particles as one update a view apart does;
 // with the textbook's squares they spread them by a fifth of its variance.
 TEST(ApplyPartialView, FiveFifthsOfAViewAddUpToOneWholeUpdatesNoise) {

@@ -10,7 +10,7 @@
 
 #include "core/small_world.h"
 #include "pf_localization/core/filter/particle_filter.h"
-#include "pf_localization/core/recovery/random_free_pose.h"
+#include "pf_localization/core/recovery/recovery.h"
 #include "pf_localization/core/sensor/likelihood_field_model.h"
 #include "pf_localization/core/util/random.h"
 #include "support/rooms.h"

@@ -8,7 +8,6 @@
 #include <numeric>
 
 #include "core/small_world.h"
-#include "pf_localization/core/recovery/random_free_pose.h"
 
 namespace pf {
 namespace {
@@ -119,7 +118,7 @@ TEST(Recovery, TheAveragesStartAtTheFirstFitAndFollowAtTheirRates) {
   EXPECT_DOUBLE_EQ(0, recovery.lowFitViews());
 }
 
-// Updates closer together than a view (new_view.h) each count their share
+// Updates closer together than a view (view_share.h) each count their share
 // of it: the patience, the injected share, the averages' rates and the
 // spread are per view, so that a view's worth of them does what one update
 // a view apart does.

@@ -10,7 +10,7 @@
 
 #include "core/small_world.h"
 #include "pf_localization/core/filter/resampler.h"
-#include "pf_localization/core/filter/tempering.h"
+#include "pf_localization/core/filter/weighting.h"
 #include "pf_localization/core/sensor/likelihood_field_model.h"
 
 namespace pf {

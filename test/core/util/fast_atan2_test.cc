@@ -1,8 +1,8 @@
-#include "pf_localization/core/util/fast_atan2.h"
-
 #include <gtest/gtest.h>
 
 #include <cmath>
+
+#include "pf_localization/core/util/fast_math.h"
 
 namespace pf {
 namespace {

@@ -1,6 +1,6 @@
-// The pieces of pf_node's overload handling that need no ROS master (issue
-// 15): the one-scan hand-over, the latency percentiles, the particle cap of
-// max_update_time, the bounded particle cloud and the rate-limited log.
+// The pieces of pf_node's overload handling that need no ROS master: the one-scan hand-over, the
+// latency percentiles, the particle cap of max_update_time, the bounded particle cloud and the
+// rate-limited log.
 #include <gtest/gtest.h>
 
 #include <boost/make_shared.hpp>
@@ -10,8 +10,8 @@
 #include "pf_localization/ros/input/conversions.h"
 #include "pf_localization/ros/input/latest_scan_slot.h"
 #include "pf_localization/ros/localizer/limited_log.h"
-#include "pf_localization/ros/localizer/update_time_governor.h"
-#include "pf_localization/ros/localizer/update_timing.h"
+#include "pf_localization/ros/localizer/output_latency.h"
+#include "pf_localization/ros/localizer/particle_cap_governor.h"
 
 namespace pf_ros {
 namespace {

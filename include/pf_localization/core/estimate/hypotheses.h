@@ -3,29 +3,26 @@
 // robot could be in one of several look-alike places instead of driving on
 // the heaviest guess.
 //
-// A hypothesis is a cluster of the estimate (pose_estimator.h) that is
+// A hypothesis is a cluster of the estimate (cluster_estimate.h) that is
 //  - the heaviest, or
 //  - a rival by the rule assessConfidence counts rivals with (isRival: at
 //    least ConfidenceParams::rival_weight_ratio as heavy as the heaviest),
 //    so that "uncertain: N rival hypotheses" always comes with those N
 //    listed beside the heaviest, or
 //  - a holder of at least kMinHypothesisShare of the cloud's weight.
-// The last is not the rival count's rule, and cannot be without changing
-// the filter (the rival count steers tempering and the published
-// covariance). It is needed: on bags/global.bag the cloud settled in twin
-// room B, the wrong one, with 86-91 % of the weight for 7 updates, while the
-// true room A kept 9-13 %: 0.09-0.15 of the heaviest, no rival, yet the true
-// place. The published verdict follows the list instead
+// The last is wider than the rival count's rule (which steers tempering and
+// the published covariance): a true place can hold a tenth of the weight
+// while a twin holds the rest. The published verdict follows the list
 // (ConfidenceTracker::holdWhileAmbiguous): never "localized" while a second
-// place is listed.
+// place is listed. See docs/design.md, "Look-alike places".
 #pragma once
 
 #include <Eigen/Core>
 #include <cstddef>
 #include <vector>
 
-#include "pf_localization/core/estimate/pose_estimator.h"
-#include "pf_localization/core/recovery/look_alikes.h"
+#include "pf_localization/core/estimate/cluster_estimate.h"
+#include "pf_localization/core/recovery/look_alike_places.h"
 #include "pf_localization/core/util/pose2.h"
 
 namespace pf {
@@ -71,7 +68,7 @@ Hypotheses hypothesesOf(const PoseEstimate& estimate, double rival_weight_ratio,
                         std::size_t max_listed = kMaxListedHypotheses);
 
 /// Lists after the cloud's hypotheses the look-alike `places` the scan fits
-/// as well as the estimate (look_alikes.h) that the cloud does not hold (no
+/// as well as the estimate (look_alike_places.h) that the cloud does not hold (no
 /// hypothesis within LookAlikes::kMinShift), best fit first: weight 0, no
 /// particles, the heaviest hypothesis's covariance (a shift or half turn
 /// leaves an x-y covariance as it is). A place within kMinShift of a better

@@ -1,4 +1,4 @@
-// Whether a scan runs a filter update, and why not: the input checks (map,
+// Whether a scan runs a filter update, and why not (SkipReason): the input checks (map,
 // initialisation, finite odometry, a well-formed scan with a valid beam), the
 // odometry-fault check, and the motion thresholds. It keeps the odometry
 // pose of the last update, which the motion update starts from.
@@ -20,13 +20,30 @@
 #include <string>
 
 #include "pf_localization/core/filter/particle_filter_params.h"
-#include "pf_localization/core/filter/skip_reason.h"
+#include "pf_localization/core/filter/update_gate.h"
 #include "pf_localization/core/sensor/laser_scan.h"
 #include "pf_localization/core/sensor/scan_group.h"
 #include "pf_localization/core/sensor/sensor_model.h"
 #include "pf_localization/core/util/pose2.h"
 
 namespace pf {
+
+// Why ParticleFilter::update did not run a filter update: the typed outcome
+// that callers branch and rate-limit their logs on, with the specifics of
+// each case in UpdateReport::skip_detail.
+enum class SkipReason {
+  kNone,               // the update ran
+  kNoMap,              // no map installed yet
+  kNotInitialized,     // no particles: neither initializeGaussian nor initializeUniform ran
+  kOdometryNotFinite,  // the odometry pose has a NaN or an infinity
+  kBadScan,            // the scan is malformed (validateScan): the detail says how
+  kOdometryJumped,     // further than odom_jump_limit since the last update: an odometry fault
+  kNotMoved,           // below update_min_d and update_min_a, and the scan still fits
+  kNoValidBeam,        // no beam of the scan is usable
+};
+
+/// A few words for `reason`, e.g. "not moved enough since the last update".
+const char* toString(SkipReason reason);
 
 /// The longest step one update makes while the scans come often enough for
 /// the gate (odometry_motion_model.h): twice update_min_d and update_min_a.
@@ -45,7 +62,7 @@ struct GateDecision {
   std::optional<Pose2> from;
   double step = 0.0;         // m of odometry travelled since the last update
   bool fit_dropped = false;  // runs before the thresholds: the scan stopped fitting
-  // The share of a new view the update brings (new_view.h): of its motion
+  // The share of a new view the update brings (view_share.h): of its motion
   // since the last update; 1 for the first, for a requested one and when the
   // fit dropped (the scan changed, whatever the odometry says); while the
   // odometry is suspect, at least leastUpdateShare of the thresholds.

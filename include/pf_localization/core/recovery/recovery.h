@@ -9,7 +9,7 @@
 //   trigger_ratio times the long-term one injects that dip's share; unless
 //   lost, only after the fit stayed low for more than `patience` updates
 //   (patience_localized while localized). Updates closer together than a
-//   view (new_view.h) count their share of it, inject that share of the dip,
+//   view (view_share.h) count their share of it, inject that share of the dip,
 //   and move the averages by it.
 // - LostShareInjection: a compact cloud that is lost searches at once with
 //   lost_share of max_particles.
@@ -18,7 +18,7 @@
 //   fitting below expansion_ratio times the long-term average spreads the
 //   survivors of the resampling.
 // - LookAlikeMove: where the scan fits look-alikes of the estimate clearly
-//   better (look_alikes.h), each gets a copy of the survivors carried there
+//   better (look_alike_places.h), each gets a copy of the survivors carried there
 //   by the map's motion, keeping the cloud's shape: the twin a robot was
 //   kidnapped into, or the one a global search missed, is tried at once.
 // Injected particles weigh kidnap_prior together (a mixture proposal: Thrun,
@@ -30,10 +30,11 @@
 #include <utility>
 #include <vector>
 
-#include "pf_localization/core/estimate/confidence.h"
+#include "pf_localization/core/estimate/confidence_verdict.h"
 #include "pf_localization/core/filter/particle_filter_params.h"
 #include "pf_localization/core/filter/particle_set.h"
 #include "pf_localization/core/map/occupancy_grid.h"
+#include "pf_localization/core/util/pose2.h"
 #include "pf_localization/core/util/random.h"
 
 namespace pf {
@@ -47,7 +48,7 @@ struct RecoveryContext {
   LocalizationState state = LocalizationState::kLost;  // this scan's verdict
   std::size_t particles = 0;                           // in the cloud now
   std::size_t max_particles = 0;                       // the budget (kld.max_particles)
-  double view = 1.0;                      // the share of a new view this scan brings (new_view.h)
+  double view = 1.0;                      // the share of a new view this scan brings (view_share.h)
   bool has_free_space = false;            // the map has free cells to draw random particles from
   std::vector<Pose2> better_look_alikes;  // map motions to look-alikes the scan fits clearly better
 };
@@ -76,7 +77,7 @@ class AugmentedMclInjection final : public RecoveryStrategy {
   void contribute(const RecoveryContext& context, const RecoveryParams& params,
                   RecoveryPlan* plan) override;
   void restart() override { low_fit_views_ = 0.0; }
-  /// The new views (new_view.h) the consecutive updates so far with the
+  /// The new views (view_share.h) the consecutive updates so far with the
   /// short-term average below the trigger brought; with the default
   /// thresholds, their count.
   double lowFitViews() const { return low_fit_views_; }
@@ -134,7 +135,7 @@ class Recovery {
   /// Takes this scan's mean beam likelihood into the averages (alpha_slow,
   /// alpha_fast; alpha_slow 0 keeps them at 0, which disables recovery), at
   /// their rates times `view`, the share of a new view the scan brings
-  /// (new_view.h): the averages, the patience, the injected share and the
+  /// (view_share.h): the averages, the patience, the injected share and the
   /// spread of the next plan() are per view, not per update.
   void observe(double mean_beam_likelihood, const RecoveryParams& params, double view = 1.0);
   /// The plan for this update, from the last observe() and this scan's
@@ -172,5 +173,13 @@ class Recovery {
   LookAlikeMove look_alike_move_;
   ParticleSet spare_;  // the resampler's output, swapped with the cloud
 };
+
+// A pose drawn uniformly over a map's free space: the particles of a global
+// localization and the random guesses recovery injects (Thrun et al.,
+// "Probabilistic Robotics", table 8.3).
+/// A free cell of `grid` chosen uniformly, a point uniformly inside it and a
+/// uniform yaw in [-pi, pi), in the map frame, drawn from `random` in that
+/// order. Precondition: grid.freeCells() is not empty.
+Pose2 randomFreePose(const OccupancyGrid& grid, Random* random);
 
 }  // namespace pf

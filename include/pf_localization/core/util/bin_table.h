@@ -1,4 +1,5 @@
-// Dense ids for the occupied bins of an (x, y, yaw) histogram.
+// Dense ids for the occupied bins of an (x, y, yaw) histogram, and the bin
+// of a coordinate (binIndex).
 //
 // The clustering and KLD-sampling bin every particle on every update. A
 // node-based hash map allocates once per new bin, so a wide cloud (global
@@ -7,6 +8,7 @@
 // between updates: after the widest cloud it has seen, it allocates nothing.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -96,5 +98,18 @@ class BinTable {
   std::size_t mask_ = 0;
   std::size_t size_ = 0;
 };
+
+// The histogram bin of a coordinate, safe for any double.
+//
+// Converting a double outside the integer range (or NaN) to an integer is
+// undefined behaviour, and particles can end up anywhere. Bins are clamped to +-2^52, far beyond
+// any real map, and NaN goes to bin 0.
+inline int64_t binIndex(double value, double bin_size) {
+  constexpr double kLimit = 4503599627370496.0;  // 2^52
+  const double bin = std::floor(value / bin_size);
+  if (!(bin > -kLimit)) return std::isnan(bin) ? 0 : -static_cast<int64_t>(kLimit);
+  if (!(bin < kLimit)) return static_cast<int64_t>(kLimit);
+  return static_cast<int64_t>(bin);
+}
 
 }  // namespace pf

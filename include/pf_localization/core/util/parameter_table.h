@@ -14,6 +14,7 @@
 
 #include <functional>
 #include <limits>
+#include <stdexcept>
 #include <string>
 #include <variant>
 #include <vector>
@@ -196,6 +197,16 @@ void checkRanges(const ParameterTable<Options>& table, const Options& options) {
         },
         p.field);
   }
+}
+
+// A check that a parameter table's range cannot say alone (one value against
+// another, a sum), worded as the tables word theirs: std::invalid_argument
+// with "invalid parameter NAME = VALUE: must be RANGE",
+// which pf_node prints as it is when it refuses to start.
+/// Throws std::invalid_argument naming `name`, `value` and the valid `range` unless `ok`.
+inline void requireParameter(bool ok, const std::string& name, const std::string& range,
+                             double value) {
+  if (!ok) throw std::invalid_argument(invalidParameterMessage(name, formatNumber(value), range));
 }
 
 }  // namespace pf

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "pf_localization/core/filter/particle_filter.h"
-#include "pf_localization/core/sensor/sensor_health.h"
+#include "pf_localization/core/sensor/sensor_status.h"
 #include "pf_localization/ros/params/localizer_config.h"
 
 namespace pf_ros {

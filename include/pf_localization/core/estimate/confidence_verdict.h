@@ -24,7 +24,7 @@
 #include <Eigen/Core>
 #include <string>
 
-#include "pf_localization/core/estimate/pose_estimator.h"
+#include "pf_localization/core/estimate/cluster_estimate.h"
 
 namespace pf {
 

@@ -15,7 +15,7 @@
 namespace pf {
 
 /// s without a scan after which a sensor is silent: ten periods of a 5 Hz
-/// lidar, and issue 29's bound on naming a missing sensor.
+/// lidar, and the bound on naming a missing sensor.
 constexpr double kSilentAfter = 2.0;
 /// Below this share of readings among its beams a sensor is blocked. A
 /// Neato loses 40 % of its beams to dropouts and blind sectors; a covered

@@ -1,7 +1,7 @@
 // LookAlikes: the map's symmetries (shifts between twin rooms, the half turn
 // of a bare hall, none in a scatter of obstacles), what a scan says of them,
 // and a filter carried into a twin room finding itself there.
-#include "pf_localization/core/recovery/look_alikes.h"
+#include "pf_localization/core/recovery/look_alike_places.h"
 
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-#include "pf_localization/ros/localizer/update_timing.h"
+#include "pf_localization/ros/localizer/output_latency.h"
 
 #include <algorithm>
 #include <cmath>

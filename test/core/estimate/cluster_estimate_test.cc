@@ -1,4 +1,4 @@
-#include "pf_localization/core/estimate/pose_estimator.h"
+#include "pf_localization/core/estimate/cluster_estimate.h"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,6 @@
 #include <vector>
 
 #include "core/expect_pose.h"
-#include "pf_localization/core/util/bin_index.h"
 #include "pf_localization/core/util/bin_table.h"
 
 namespace pf {

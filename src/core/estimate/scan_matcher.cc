@@ -1,4 +1,4 @@
-#include "pf_localization/core/estimate/scan_refiner.h"
+#include "pf_localization/core/estimate/scan_matcher.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -9,7 +9,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "pf_localization/core/util/parameter_check.h"
+#include "pf_localization/core/util/parameter_table.h"
 
 namespace pf {
 namespace {

@@ -1,4 +1,4 @@
-#include "pf_localization/core/estimate/pose_estimator.h"
+#include "pf_localization/core/estimate/cluster_estimate.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,10 +8,9 @@
 #endif
 
 #include "pf_localization/core/filter/particle_blocks.h"
-#include "pf_localization/core/util/bin_index.h"
 #include "pf_localization/core/util/bin_table.h"
 #include "pf_localization/core/util/fast_math.h"
-#include "pf_localization/core/util/thread_scratch.h"
+#include "pf_localization/core/util/scratch_storage.h"
 
 namespace pf {
 namespace {

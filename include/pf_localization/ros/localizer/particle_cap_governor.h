@@ -1,17 +1,16 @@
-// max_update_time: "use what the CPU allows" instead of a guessed
-// max_particles (issue 15). After each update it learns the wall time one
+// The particle cap behind max_update_time: "use what the CPU allows" instead
+// of a guessed max_particles. After each update it learns the wall time one
 // particle costs on this computer, as it is loaded now, and caps the particle
 // count so that an update fits in the budget; KLD-sampling still chooses the
 // count below the cap. The cost taken is a high quantile of the recent
-// updates' (the budget is meant for the p95 of the update time, and on a
-// busy computer the p95 is twice the median). A slower computer, or another
-// process taking the CPU, lowers the cap at once; when the CPU is free again
-// it rises as the slow updates leave the window.
+// updates' (the budget is meant for the p95 of the update time). A slower or
+// busier computer lowers the cap at once; it rises again as the slow updates
+// leave the window.
 #pragma once
 
 #include <cstddef>
 
-#include "pf_localization/ros/localizer/update_timing.h"
+#include "pf_localization/ros/localizer/output_latency.h"
 
 namespace pf_ros {
 

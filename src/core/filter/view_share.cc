@@ -1,4 +1,4 @@
-#include "pf_localization/core/recovery/new_view.h"
+#include "pf_localization/core/filter/view_share.h"
 
 #include <algorithm>
 

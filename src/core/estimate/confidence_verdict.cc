@@ -1,4 +1,4 @@
-#include "pf_localization/core/estimate/confidence.h"
+#include "pf_localization/core/estimate/confidence_verdict.h"
 
 #include <cmath>
 #include <iomanip>
@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "pf_localization/core/estimate/hypotheses.h"
-#include "pf_localization/core/util/parameter_check.h"
+#include "pf_localization/core/util/parameter_table.h"
 
 namespace pf {
 

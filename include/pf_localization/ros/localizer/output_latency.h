@@ -2,8 +2,8 @@
 // scan's arrival to the publication of its map -> odom, the scan's age on
 // arrival, the wall time of the update itself, and the scans dropped because
 // a newer one arrived while they waited (latest_scan_slot.h). These go to the
-// diagnostics after every update (issue 15), so that a user sees an
-// overloaded computer there before tf users downstream notice.
+// diagnostics after every update, where an overloaded computer shows before
+// tf users downstream notice.
 #pragma once
 
 #include <diagnostic_msgs/DiagnosticStatus.h>

@@ -1,4 +1,4 @@
-#include "pf_localization/core/recovery/look_alikes.h"
+#include "pf_localization/core/recovery/look_alike_places.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "pf_localization/core/estimate/scan_refiner.h"
+#include "pf_localization/core/estimate/scan_matcher.h"
 
 #include <gtest/gtest.h>
 
