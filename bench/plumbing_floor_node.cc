@@ -6,7 +6,7 @@
 // filter and nothing else. Run on a bag in place of pf_node, its CPU time is
 // the floor under pf_node's: on a virtual machine, where a system call costs
 // microseconds, receiving and sending messages through roscpp is most of a
-// light localizer's CPU (docs/performance.md, "Stop 25"). scripts/live_cpu.sh runs
+// light localizer's CPU (docs/performance.md). scripts/live_cpu.sh runs
 // both on the same bag, in turn.
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <ros/ros.h>

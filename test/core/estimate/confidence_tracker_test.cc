@@ -97,7 +97,7 @@ TEST_F(ConfidenceTrackerTest, AFitBelowTheTriggerForLongerThanPatienceDemotes) {
   EXPECT_NE(std::string::npos, tracker_.confidence().reason.find("for 6 views"));
 }
 
-// Patience counts views (new_view.h): updates a fifth of a view apart
+// Patience counts views (view_share.h): updates a fifth of a view apart
 // demote only after as much motion as whole-view updates do.
 TEST_F(ConfidenceTrackerTest, PatienceCountsViewsNotUpdates) {
   assessLocalized();

@@ -1,4 +1,4 @@
-// ParticleFilter with refine_estimate: the scan fit of scan_refiner.h feeds
+// ParticleFilter with refine_estimate: the scan fit of scan_matcher.h feeds
 // the published estimate and map -> odom (scan_refiner_test.cc tests the fit
 // itself). In a file of its own, in small_world.h's room, so that it stays
 // apart from the filter's other tests.
@@ -93,7 +93,7 @@ TEST(ParticleFilterRefinement, ScansBetweenUpdatesAreFittedAndStandingStillIsNot
 }
 
 TEST(ParticleFilterRefinement, StandingStillThePublishedPoseHolds) {
-  // Issue 28: standing still, the published pose moves less than 5 mm (std
+  // Standing still, the published pose moves less than 5 mm (std
   // dev) from scan to scan. With the defaults, noisy scans (2 cm, a Neato's)
   // and encoders that twitch by a tenth of a millimetre.
   const OccupancyGrid grid = small_world::room();

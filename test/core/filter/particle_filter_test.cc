@@ -402,7 +402,7 @@ ParticleFilterParams recoveryParams() {
 }
 
 // An update on `scan` with the odometry at rest that counts a whole new view
-// (new_view.h), as the recovery tests' robot is carried without odometry:
+// (view_share.h), as the recovery tests' robot is carried without odometry:
 // a requested update (amcl's request_nomotion_update) does. Without the
 // request, a scan taken where the odometry has not moved brings no new view.
 UpdateReport viewUpdate(ParticleFilter* filter, const LaserScan& scan) {

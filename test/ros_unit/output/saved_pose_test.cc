@@ -1,4 +1,4 @@
-// The pose saved on the parameter server and its map (issue 27): the map's
+// The pose saved on the parameter server and its map: the map's
 // signature, ~saved_pose_map's value, whether a configured pose is a saved
 // one, and what the first map decides about it.
 #include "pf_localization/ros/output/saved_pose.h"

@@ -190,8 +190,8 @@ TEST(AmclParams, UnknownNamesAreListedInOneWarning) {
   EXPECT_EQ(notes.warnings[0].find("max_particles"), std::string::npos) << notes.warnings[0];
 }
 
-// Settings that were parameters before they became constants of the filter
-// (issue 26): a configuration that still sets one is told so, not warned of a
+// Settings that were parameters before they became constants of the filter:
+// a configuration that still sets one is told so, not warned of a
 // misspelling, and the constant stands.
 TEST(AmclParams, RetiredParametersAreNamedAndLeftAlone) {
   ConfigNotes notes;
@@ -206,7 +206,7 @@ TEST(AmclParams, RetiredParametersAreNamedAndLeftAlone) {
   EXPECT_TRUE(anyContains(notes.infos, "no longer parameters"));
 }
 
-// sensor_threads became threads (issue 30): the old name is answered with
+// sensor_threads became threads: the old name is answered with
 // the new one, not as a misspelling.
 TEST(AmclParams, ARenamedParameterNamesItsNewName) {
   ConfigNotes notes;
@@ -217,7 +217,7 @@ TEST(AmclParams, ARenamedParameterNamesItsNewName) {
   EXPECT_EQ(std::string::npos, notes.warnings[0].find("unknown")) << notes.warnings[0];
 }
 
-// Issue 15's parameter: read, and refused with the start-up message.
+// max_update_time: read, and refused with the start-up message.
 TEST(AmclParams, MaxUpdateTimeIsReadAndValidated) {
   ConfigNotes notes;
   LocalizerConfig c = readConfig(*yaml("max_update_time: 0.02\n"), nullptr, &notes);

@@ -55,8 +55,8 @@ TEST(ParameterDocs, TheReadmesTableIsTheTables) {
       << "README.md's parameter table is stale" << kRegenerate;
 }
 
-// Issue 26 cut the public surface to 50: what an amcl user knows and what a
-// robot or a building needs. Issue 29's sensors add theirs: the scan topics,
+// The public surface is kept small: what an amcl user knows and what a
+// robot or a building needs (50), and the sensors' own: the scan topics,
 // and for point clouds their topics and height band.
 constexpr std::size_t kMaxParameters = 55;
 

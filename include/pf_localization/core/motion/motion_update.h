@@ -27,7 +27,7 @@ class MotionUpdate {
   /// Moves every particle by the noisy odometry motion from `from` to `to`,
   /// the tracker's share of them assuming a fault (and flagged so), on up
   /// to `threads` threads (the same result for any count); the noise of an
-  /// update that brings a share `view_share` of a new view (new_view.h).
+  /// update that brings a share `view_share` of a new view (view_share.h).
   void apply(const Pose2& from, const Pose2& to, ParticleSet* particles, Random* random,
              int threads = 1, double view_share = 1.0) {
     model_.apply(from, to, faults_.sampledFraction(), particles, random, faults_.flags(), threads,

@@ -66,7 +66,7 @@ class OdometryFaultTracker {
   /// (`weights` normalised, in the order of the flags) against the share
   /// they were given, clamped; summed on up to `threads` threads (the same
   /// result for any count). After an update that brings a share
-  /// `view_share` of a new view (new_view.h), whose weights carry that
+  /// `view_share` of a new view (view_share.h), whose weights carry that
   /// share of a scan's evidence, the evidence ratio is taken to the power
   /// 1 / view_share and the memory to the power view_share: a view's worth
   /// of such updates moves the share as one update a view apart does.

@@ -2,53 +2,30 @@
 // reports, with noise that grows with the motion.
 //
 // Differential drive: "sample_motion_model_odometry" of Thrun, Burgard & Fox,
-// "Probabilistic Robotics" (2005), table 5.6. The odometry step is split into
-// a rotation rot1 towards the direction of travel, a translation trans and a
-// final rotation rot2; each is perturbed with a standard deviation of
+// "Probabilistic Robotics" (2005), table 5.6. The step is split into a
+// rotation rot1 towards the direction of travel, a translation trans and a
+// final rotation rot2, each perturbed with a standard deviation of
 //   rot:   sqrt(alpha1 * rot^2 + alpha2 * trans^2)
 //   trans: sqrt(alpha3 * trans^2 + alpha4 * (rot1^2 + rot2^2))
-// Two refinements over the textbook: a robot that drives backwards has
-// rot1 close to pi, which must not be mistaken for a large rotation, so the
-// rotation noise uses the smaller of |rot1| and |pi - rot1|; and for tiny
-// translations the direction of travel is meaningless, so rot1 is taken as 0.
-//
-// One filter update's step: the alphas describe the noise of the step one
-// update makes, as in amcl, whose updates come every update_min_d of travel.
-// A longer step (scans far apart) stands for several updates, and its
-// variance adds up as theirs would, linearly in its length, instead of with
-// its square: each v^2 above becomes v * min(v, one update's v). Left
-// quadratic, a long step's direction of travel is so noisy that the
-// particles fall short of the odometry on average, and along a corridor the
-// cloud falls behind the robot (docs/design.md, "A long step's noise").
-//
-// Omnidirectional: the step is a translation in the robot frame (forward and
-// strafe) plus a rotation, with amcl's omni convention for the alphas:
+// except that driving backwards (rot1 near pi) counts as min(|rot1|,
+// |pi - rot1|) of rotation, and rot1 is 0 for tiny translations.
+// Omnidirectional (amcl's omni convention): a translation (forward, strafe)
+// plus a rotation,
 //   trans:  sqrt(alpha3 * trans^2 + alpha1 * rot^2)
 //   rot:    sqrt(alpha4 * rot^2 + alpha2 * trans^2)
 //   strafe: sqrt(alpha1 * rot^2 + alpha5 * trans^2)
 //
-// Odometry faults: the Gaussian above assumes that the wheels report the
-// motion up to a few per cent. Real odometry sometimes does not, in two ways
-// that a Gaussian cannot cover: it reports motion the robot did not make
-// (wheels spinning on a threshold, a stalled or held robot), and it reports
-// the wrong direction (encoders that count ticks without their sign, so a
-// reversing robot is logged as driving forwards: the CARMEN logs do this in
-// 5 % of their steps on fr079). A Gaussian then puts no particle where the
-// robot is, and the filter drifts away while every scan still fits roughly.
-// So the model is a mixture (Thrun, Burgard & Fox, section 6.3.1, applied to
-// motion: a reliable and an unreliable component): a share fault_fraction of
-// the particles take, half of them, the reversed translation (with the same
-// noise) and the other half no translation (uniform within +-fault_margin).
-// The scans decide which particles were right; when the odometry was, the
-// faulty ones die at the next resampling. Faults come in runs (a robot
-// reverses for a while), so the filter sets the next step's share from this
-// scan's evidence for a fault, between fault_fraction and fault_fraction_max
-// (OdometryFaultTracker): a small share while the odometry is right, many
-// particles in the fault while it lasts, and none while the scan cannot pin
-// the position along the direction of travel. A uniform spread
-// over every translation in between was tried: in long corridors, where the scans say little about
-// the position along them, it smeared the estimate along the corridor (Intel lab) more than the two
-// discrete faults do.
+// The alphas describe one filter update's step, as in amcl: a longer step
+// stands for several updates, its variance linear in its length (each v^2
+// above becomes v * min(v, one update's v)).
+//
+// Odometry faults: a mixture of a reliable and an unreliable component
+// (Thrun, Burgard & Fox, section 6.3.1, applied to motion). A share of the
+// particles (fault_fraction .. fault_fraction_max, set per step by
+// OdometryFaultTracker) takes, half of them, the reversed translation and,
+// the other half, no translation (uniform within +-fault_margin); the scans
+// decide which were right. Why: docs/design.md, "A long step's noise" and
+// "Odometry faults are observed, not assumed".
 #pragma once
 
 #include <cstdint>
@@ -130,7 +107,7 @@ class OdometryMotionModel {
   /// threads: each block of particles draws from its own stream
   /// (particle_blocks.h), so the result is the same for any thread count.
   /// In an update that brings a share `view_share` < 1 of a new view
-  /// (new_view.h), each component's variance below a view's size is linear
+  /// (view_share.h), each component's variance below a view's size is linear
   /// in it, and the stalled particles' spread is fault_margin times the share.
   void apply(const Pose2& from, const Pose2& to, double fault_fraction, ParticleSet* particles,
              Random* random, std::vector<uint8_t>* faulty, int threads = 1,

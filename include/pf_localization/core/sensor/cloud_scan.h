@@ -26,13 +26,9 @@
 // without a point reads NaN, "no reading" (laser_scan.h): the band may
 // have removed what was there, so it does not say the direction is free.
 //
-// The nearest point alone is the first obstacle, but also the one whose
-// range noise is most negative; the mean of that surface's points is not
-// (point_cloud_test.cc, CloudBag, compares with a 2D lidar at the same place).
-//
-// The bearing is measured by fastAtan2 (fast_atan2.h): with std::atan2 a
-// 28 800-point sweep whose points all lie in the band took 523 us instead
-// of 282 (BM_CloudToScan/1), the default band's 173 instead of 106.
+// (The mean, not the nearest point: the nearest is also the one whose range
+// noise is most negative.) The bearing is measured by fastAtan2
+// (fast_math.h). See docs/design.md, "A point cloud becomes a scan".
 #pragma once
 
 #include <Eigen/Core>

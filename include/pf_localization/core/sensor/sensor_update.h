@@ -59,7 +59,7 @@ class SensorUpdate {
   /// The same two, weighing by `model` instead of the update's own (a
   /// smoothed copy of it: global_search.h). The second takes the scans'
   /// likelihood to the power `evidence_share`, the share of a new view the
-  /// update brings (new_view.h; 0: the weights stay as they are); the mean
+  /// update brings (view_share.h; 0: the weights stay as they are); the mean
   /// beam likelihood is the scans' own.
   Weighing weigh(const SensorModel& model, const PreparedScan& scan, double min_ess_fraction,
                  double likelihood_exponent, ParticleSet* particles, int threads = 1);

@@ -4,9 +4,8 @@
 // only as a nav_msgs/Odometry topic get it into the tf buffer from there.
 // The topic waits a moment (kGrace s of its own stamps) for /tf to show
 // odometry before it is taken as the source. Which source is in use is
-// announced once, and again when it changes (issue 27: a robot with only
-// /odom tracked fine, and nothing said where its odometry came from). Not
-// thread-safe: pf_node calls it from its main spinner only.
+// announced once, and again when it changes. Not thread-safe: pf_node calls it from its main
+// spinner only.
 #pragma once
 
 #include <geometry_msgs/TransformStamped.h>

@@ -1,12 +1,9 @@
 // A roscpp callback queue that runs each callback at once, on the thread that
 // queues it, instead of waking a spinner to run it.
 //
-// Why: roscpp reads every message on its poll thread and hands it to a
-// spinner through a callback queue, so each message wakes two threads. On a
-// virtual machine a wake-up costs tens of microseconds of kernel time, and
-// pf_node receives about 80 /tf messages a second from a Neato bag played at
-// 2x: the hand-offs cost about a fifth of the node's CPU
-// (docs/performance.md, "Wake-ups: tf and scans on the poll thread"). The tf
+// roscpp reads every message on its poll thread and hands it to a spinner
+// through a callback queue, so each message wakes two threads (the cost:
+// docs/performance.md, "Wake-ups: tf and scans on the poll thread"). The tf
 // listener and the scan's tf message filter (whose callbacks only store a
 // transform or leave a scan for the filter thread: short, thread-safe, never
 // blocking on the filter) run here, so a message costs one wake-up.

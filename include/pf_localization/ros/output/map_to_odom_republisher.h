@@ -2,27 +2,19 @@
 // whenever 1.5 periods (1 / tf_publish_rate s) pass without one on the wall
 // clock, one period under simulated time, so that tf users never wait more
 // than two periods (see kWallClockPeriods in the .cc). Neither a filter update
-// (80 ms for 500 000 particles) nor anything else on the node's spinner
-// delays it (under load a ros::Timer on the one spinner waited behind the
-// filter, and tf users downstream saw 8 s gaps). It only ever touches the
+// nor anything else on the node's spinner delays it: it only ever touches the
 // latest transform handed to it, under its own mutex, never the filter.
 //
 // What times the republishing depends on the clock:
 // - on the wall clock, a thread of its own that sleeps on a timer (timerfd)
 //   until a publication is due. Each publication after an update re-arms
 //   the timer, without waking the thread, so that while updates come often
-//   enough it never wakes. (Not a ros::Timer
-//   on a callback queue of its own: two thread hops per tick, roscpp's timer
-//   thread then the queue's spinner, each a chance to be descheduled on a
-//   loaded computer; nor a condition variable's timed wait: the thread
-//   would wake at every period to find the publication put off);
+//   enough it never wakes;
 // - under simulated time, /clock itself: no sleep can be timed on a clock
 //   that only /clock moves, so start() subscribes to it on the handle it is
 //   given (pf_node's poll thread), and the /clock message at which a
 //   publication is due publishes it, on the thread that brought it. No
-//   thread polls the clock (a roscpp timer, or a thread of this kind, would
-//   wake every millisecond of wall time to look: docs/performance.md, "The
-//   fixed cost").
+//   thread polls the clock (docs/performance.md, "The fixed cost").
 #pragma once
 
 #include <geometry_msgs/TransformStamped.h>

@@ -7,7 +7,7 @@
 // itself. At start-up a configured initial pose that ~saved_pose_map
 // records is a saved one, and it is only used on a first map with the same
 // signature that has the pose in a free cell; otherwise global localization
-// (issue 27: a roscore that had run another bag gave a pose on another map).
+// (a roscore that had run another bag may hold a pose on another map).
 #pragma once
 
 #include <nav_msgs/OccupancyGrid.h>
