@@ -6,7 +6,7 @@
 // filter and nothing else. Run on a bag in place of pf_node, its CPU time is
 // the floor under pf_node's: on a virtual machine, where a system call costs
 // microseconds, receiving and sending messages through roscpp is most of a
-// light localizer's CPU (docs/performance.md, "Stop 25"). scripts/live_cpu.sh runs
+// light localizer's CPU (docs/performance.md). scripts/live_cpu.sh runs
 // both on the same bag, in turn.
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <ros/ros.h>
@@ -15,7 +15,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
-#include "pf_localization/ros/inline_callback_queue.h"
+#include "pf_localization/ros/localizer/inline_callback_queue.h"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "pf_node");

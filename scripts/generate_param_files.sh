@@ -2,7 +2,7 @@
 # Writes the files generated from the parameter table (ros/localizer_config.cc
 # and the core's option tables): config/pf.yaml, cfg/PfLocalization.cfg and the
 # manual's parameter table (docs/parameters.md, between its "parameters:begin" and
-# "parameters:end" markers). Run it after changing a parameter; test/ros_unit/parameter_docs_test.cc
+# "parameters:end" markers). Run it after changing a parameter; test/ros_unit/params/parameter_docs_test.cc
 # fails while any of them differs from the table.
 #   bash scripts/generate_param_files.sh
 set -euo pipefail

@@ -167,7 +167,7 @@ PY
 # of the 16 tracked as with the defaults (RMSE within 0.03 m, max within
 # 0.15 m; seed 2 jumps and comes back, "uncertain" meanwhile). While the
 # filter's evidence, motion noise, fault tracking and recovery counted
-# updates instead of views (new_view.h), every seed jumped 9-16 m to a place
+# updates instead of views (view_share.h), every seed jumped 9-16 m to a place
 # that fits the scans people hide (ATE 3.6-5.9 m); while the scans of a
 # suspect odometry counted whole views, 5 of the 16 did (383 updates
 # confidently wrong). About 20 s.

@@ -29,8 +29,8 @@
 #include <iostream>
 #include <string>
 
-#include "pf_localization/core/map_loader.h"
-#include "pf_localization/ros/conversions.h"
+#include "pf_localization/core/map/map_loader.h"
+#include "pf_localization/ros/input/conversions.h"
 
 namespace {
 

@@ -33,11 +33,11 @@
 #include <string>
 #include <vector>
 
-#include "pf_localization/core/map_loader.h"
-#include "pf_localization/ros/conversions.h"
-#include "pf_localization/ros/localizer_config.h"
-#include "pf_localization/ros/scan_localizer.h"
-#include "pf_localization/ros/update_timing.h"
+#include "pf_localization/core/map/map_loader.h"
+#include "pf_localization/ros/input/conversions.h"
+#include "pf_localization/ros/localizer/output_latency.h"
+#include "pf_localization/ros/localizer/scan_localizer.h"
+#include "pf_localization/ros/params/localizer_config.h"
 
 namespace {
 

@@ -10,7 +10,7 @@
 #include <iostream>
 #include <string>
 
-#include "pf_localization/core/map_loader.h"
+#include "pf_localization/core/map/map_loader.h"
 #include "pf_localization/sim/building_map.h"
 #include "pf_localization/sim/warehouse_map.h"
 

@@ -42,18 +42,18 @@
 #include <utility>
 #include <vector>
 
-#include "pf_localization/ros/inline_callback_queue.h"
-#include "pf_localization/ros/latest_scan_slot.h"
-#include "pf_localization/ros/limited_warn.h"
-#include "pf_localization/ros/live_localizer.h"
-#include "pf_localization/ros/map_to_odom_republisher.h"
-#include "pf_localization/ros/odometry_source.h"
-#include "pf_localization/ros/parameter_docs.h"
-#include "pf_localization/ros/pose_transform.h"
-#include "pf_localization/ros/reconfigure_server.h"
-#include "pf_localization/ros/scan_drop.h"
-#include "pf_localization/ros/scan_inputs.h"
-#include "pf_localization/ros/startup_config.h"
+#include "pf_localization/ros/input/latest_scan_slot.h"
+#include "pf_localization/ros/input/odometry_source.h"
+#include "pf_localization/ros/input/pose_transform.h"
+#include "pf_localization/ros/input/scan_drop.h"
+#include "pf_localization/ros/input/scan_inputs.h"
+#include "pf_localization/ros/localizer/inline_callback_queue.h"
+#include "pf_localization/ros/localizer/limited_log.h"
+#include "pf_localization/ros/localizer/live_localizer.h"
+#include "pf_localization/ros/output/map_to_odom_republisher.h"
+#include "pf_localization/ros/params/parameter_docs.h"
+#include "pf_localization/ros/params/reconfigure_server.h"
+#include "pf_localization/ros/params/startup_config.h"
 
 namespace pf_ros {
 namespace {

@@ -3,7 +3,7 @@
 #include <iostream>
 #include <string>
 
-#include "pf_localization/ros/parameter_docs.h"
+#include "pf_localization/ros/params/parameter_docs.h"
 
 int main(int argc, char** argv) {
   const std::string what = argc == 2 ? argv[1] : "";

@@ -73,8 +73,8 @@
 #include <utility>
 #include <vector>
 
-#include "pf_localization/core/map_loader.h"
-#include "pf_localization/ros/conversions.h"
+#include "pf_localization/core/map/map_loader.h"
+#include "pf_localization/ros/input/conversions.h"
 #include "pf_localization/sim/amr_rig.h"
 #include "pf_localization/sim/building_clutter.h"
 #include "pf_localization/sim/diff_drive_robot.h"

@@ -82,7 +82,7 @@ BUNDLED = {
     # only, as sim_sparse.
     'sim_corridor': dict(dir='{repo}', bag='bags/corridor.bag', map='maps/corridor.yaml', pose=(2.5, 3.95, 0.0),
                          ref=('--bag', 'bags/corridor.bag'), eval_args=('--max-gap', '0.1')),
-    # Issue 30: a 118 x 78 m warehouse of ten twin aisles (bags/README.md).
+    # A 118 x 78 m warehouse of ten twin aisles (bags/README.md).
     'sim_warehouse': dict(dir='{repo}', bag='bags/warehouse_tracking.bag', map='maps/warehouse.yaml',
                           pose=(5.0, 6.0, 1.5707963), ref=('--bag', 'bags/warehouse_tracking.bag')),
     'sim_warehouse_global': dict(dir='{repo}', bag='bags/warehouse_global.bag', map='maps/warehouse.yaml',

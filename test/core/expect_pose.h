@@ -4,7 +4,7 @@
 
 #include <gtest/gtest.h>
 
-#include "pf_localization/core/pose2.h"
+#include "pf_localization/core/util/pose2.h"
 
 namespace pf {
 

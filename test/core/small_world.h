@@ -3,7 +3,7 @@
 // robot is at.
 #pragma once
 
-#include "pf_localization/core/particle_filter_params.h"
+#include "pf_localization/core/filter/particle_filter_params.h"
 #include "support/rooms.h"
 #include "support/scan_simulator.h"
 

@@ -21,10 +21,10 @@
 #include <vector>
 
 #include "fuzz_input.h"
-#include "pf_localization/core/laser_scan.h"
-#include "pf_localization/core/likelihood_field_model.h"
-#include "pf_localization/core/occupancy_grid.h"
-#include "pf_localization/core/particle_filter.h"
+#include "pf_localization/core/filter/particle_filter.h"
+#include "pf_localization/core/map/occupancy_grid.h"
+#include "pf_localization/core/sensor/laser_scan.h"
+#include "pf_localization/core/sensor/likelihood_field_model.h"
 
 namespace {
 

@@ -23,7 +23,7 @@
 #include <string>
 
 #include "fuzz_input.h"
-#include "pf_localization/core/map_loader.h"
+#include "pf_localization/core/map/map_loader.h"
 
 namespace {
 

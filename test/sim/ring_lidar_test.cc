@@ -7,7 +7,7 @@
 #include <limits>
 #include <vector>
 
-#include "pf_localization/core/map_loader.h"
+#include "pf_localization/core/map/map_loader.h"
 #include "pf_localization/sim/amr_rig.h"
 #include "pf_localization/sim/building_clutter.h"
 #include "pf_localization/sim/building_map.h"

@@ -2,7 +2,7 @@
 // simulator's maps.
 #pragma once
 
-#include "pf_localization/core/occupancy_grid.h"
+#include "pf_localization/core/map/occupancy_grid.h"
 
 namespace pf::test {
 

@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "pf_localization/core/particle_filter.h"
+#include "pf_localization/core/filter/particle_filter.h"
 #include "support/scan_simulator.h"
 
 namespace pf::test {

@@ -4,7 +4,7 @@
 
 #include <vector>
 
-#include "pf_localization/core/occupancy_grid.h"
+#include "pf_localization/core/map/occupancy_grid.h"
 
 namespace pf::test {
 

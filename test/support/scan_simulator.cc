@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-#include "pf_localization/core/scan_deskew.h"
+#include "pf_localization/core/motion/scan_deskew.h"
 
 namespace pf::test {
 

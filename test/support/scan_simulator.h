@@ -7,9 +7,9 @@
 #include <cstdint>
 #include <limits>
 
-#include "pf_localization/core/laser_scan.h"
-#include "pf_localization/core/occupancy_grid.h"
-#include "pf_localization/core/random.h"
+#include "pf_localization/core/map/occupancy_grid.h"
+#include "pf_localization/core/sensor/laser_scan.h"
+#include "pf_localization/core/util/random.h"
 #include "pf_localization/sim/ray_caster.h"
 
 namespace pf::test {

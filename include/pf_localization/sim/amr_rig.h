@@ -18,7 +18,7 @@
 // (12.5 Hz from 30 ms, 10 Hz from 60 ms: one is on odd 10 ms ticks, the
 // other on even ones).
 //
-// The warehouse rig (issue 30) keeps the body and carries one safety lidar
+// The warehouse rig keeps the body and carries one safety lidar
 // of longer range, centred on the front edge, as a warehouse AMR that only
 // drives forwards does: 0.2 m up, 541 beams at 0.5 degrees from -135 to +135
 // degrees, 0.05-25 m, 10 Hz (or a log's sparser period). Its 270 degrees

@@ -30,7 +30,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "pf_localization/core/occupancy_grid.h"
+#include "pf_localization/core/map/occupancy_grid.h"
 
 namespace pf::sim {
 

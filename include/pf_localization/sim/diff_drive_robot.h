@@ -18,7 +18,7 @@
 // rotations.
 #pragma once
 
-#include "pf_localization/core/pose2.h"
+#include "pf_localization/core/util/pose2.h"
 #include "pf_localization/sim/sim_random.h"
 
 namespace pf::sim {

@@ -36,7 +36,7 @@
 #include <string>
 #include <vector>
 
-#include "pf_localization/core/occupancy_grid.h"
+#include "pf_localization/core/map/occupancy_grid.h"
 #include "pf_localization/sim/building_map.h"
 
 namespace pf::sim {

@@ -27,8 +27,8 @@
 #include <string>
 #include <vector>
 
-#include "pf_localization/core/occupancy_grid.h"
-#include "pf_localization/core/pose2.h"
+#include "pf_localization/core/map/occupancy_grid.h"
+#include "pf_localization/core/util/pose2.h"
 #include "pf_localization/sim/diff_drive_robot.h"
 #include "pf_localization/sim/sim_random.h"
 

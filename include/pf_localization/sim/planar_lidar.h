@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "pf_localization/core/pose2.h"
+#include "pf_localization/core/util/pose2.h"
 #include "pf_localization/sim/path_script.h"
 #include "pf_localization/sim/ray_caster.h"
 #include "pf_localization/sim/scan_schedule.h"

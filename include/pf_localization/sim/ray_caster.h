@@ -30,7 +30,7 @@
 #include <utility>
 #include <vector>
 
-#include "pf_localization/core/occupancy_grid.h"
+#include "pf_localization/core/map/occupancy_grid.h"
 #include "pf_localization/sim/sim_random.h"
 
 namespace pf::sim {

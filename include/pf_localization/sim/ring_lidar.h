@@ -23,7 +23,7 @@
 #include <string>
 #include <vector>
 
-#include "pf_localization/core/pose2.h"
+#include "pf_localization/core/util/pose2.h"
 #include "pf_localization/sim/scan_schedule.h"
 #include "pf_localization/sim/scene_3d.h"
 #include "pf_localization/sim/sim_random.h"

@@ -20,7 +20,7 @@
 #include <limits>
 #include <vector>
 
-#include "pf_localization/core/occupancy_grid.h"
+#include "pf_localization/core/map/occupancy_grid.h"
 #include "pf_localization/sim/path_script.h"
 #include "pf_localization/sim/ray_caster.h"
 

@@ -1,4 +1,4 @@
-// The warehouse map (issue 30, "warehouse scale"): a 118 x 78 m hall of
+// The warehouse map: a 118 x 78 m hall of
 // pallet racks, drawn by code like the building (building_map.h) so that it
 // can be regenerated bit for bit (pf_make_map writes maps/warehouse.pgm and
 // .yaml: 2400 x 1600 cells of 0.05 m, extent x -1..119, y -1..79).
@@ -51,7 +51,7 @@
 
 #include <vector>
 
-#include "pf_localization/core/occupancy_grid.h"
+#include "pf_localization/core/map/occupancy_grid.h"
 #include "pf_localization/sim/building_map.h"
 #include "pf_localization/sim/scene_3d.h"
 

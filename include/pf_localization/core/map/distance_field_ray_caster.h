@@ -1,0 +1,69 @@
+// Ray casting on an occupancy grid, sped up by the map's distance transform.
+//
+// The beam model needs, for every particle and beam, the range at which the
+// beam would hit the map: millions of rays per update. Walking every cell a
+// ray crosses (Amanatides & Woo, "A Fast Voxel Traversal Algorithm for Ray
+// Tracing", Eurographics 1987) costs one step per cell, 80 steps for a 4 m
+// beam on a 0.05 m map. Sphere tracing (Hart, "Sphere tracing: a geometric
+// method for the antialiased ray tracing of implicit surfaces", The Visual
+// Computer 12, 1996) on the exact Euclidean distance transform of the
+// obstacles skips the empty space instead: from a cell whose centre lies D
+// cells from the nearest occupied cell's centre, no occupied cell can be
+// entered within D - sqrt(2) cells along any ray (both ends may be sqrt(2)/2
+// off their cell's centre), so the ray jumps D - 1.5 cells at once. Near
+// obstacles (D <= 1.5) it falls back to the cell walk, so the first occupied
+// cell is found exactly and the range is where the ray enters it, as the
+// simulator's ray caster measures it (not rounded to cell centres).
+//
+// The skip distances are computed once per map, uncapped, into a table with
+// a one-cell border that stands for "outside the map". Unknown cells are
+// transparent, as in the likelihood field (nothing mapped is there to
+// reflect); a ray that leaves the map, or reaches max_range first, returns
+// max_range.
+#pragma once
+
+#include <vector>
+
+#include "pf_localization/core/map/likelihood_field.h"
+#include "pf_localization/core/map/occupancy_grid.h"
+#include "pf_localization/core/util/pose2.h"
+
+namespace pf {
+
+class DistanceFieldRayCaster {
+ public:
+  explicit DistanceFieldRayCaster(const OccupancyGrid& grid);
+  /// The same from a likelihood field's distances, without a transform of
+  /// its own: capped at the field's max_distance, they only shorten the jumps
+  /// through open space, and every range is the same.
+  explicit DistanceFieldRayCaster(const LikelihoodField& field);
+
+  /// The range in metres from (x, y) along `angle` (world frame) to the first
+  /// occupied cell, or max_range when there is none within max_range on the map.
+  double cast(double x, double y, double angle, double max_range) const;
+
+  /// The same from a point and direction already in the grid's frame, in cells
+  /// (max_range too): the form the beam model's inner loop uses.
+  double castInCells(double cx, double cy, double dx, double dy, double max_range) const;
+
+  double resolution() const { return resolution_; }
+  const Pose2& origin() const { return origin_; }
+
+ private:
+  // The skip table from each cell's distance in cells to the nearest occupied
+  // cell's centre (`cells(x, y)`).
+  template <typename Cells>
+  void fill(const OccupancyGrid& grid, Cells cells);
+
+  // Per cell of the bordered table: kOccupied, kOutside, or the distance in
+  // cells the ray may jump from anywhere in the cell (0: walk to the next cell).
+  static constexpr float kOccupied = -1.0f;
+  static constexpr float kOutside = -2.0f;
+  std::vector<float> skip_;
+  int stride_ = 0;
+  int rows_ = 0;
+  double resolution_ = 0.0;
+  Pose2 origin_;
+};
+
+}  // namespace pf

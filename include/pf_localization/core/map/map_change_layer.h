@@ -1,0 +1,129 @@
+// The cells where the world no longer matches its map, learned over time
+// from what the lidars saw.
+//
+// Each scan added from a pose the filter trusts is walked cell by cell
+// along some of its beams (Amanatides & Woo's grid traversal, "A fast voxel
+// traversal algorithm for ray tracing", Eurographics 1987): a beam that ends
+// in a cell the map has free, clear of its obstacles, counts a hit there; a
+// cell the beam crosses well before its end counts a pass, free or through
+// a mapped obstacle; a beam that ends on a mapped obstacle counts an end on
+// it. A cell is added (an obstacle the map lacks) when most beams that
+// reached it stopped there, and removed (a mapped obstacle that is gone)
+// when most beams that reached it went through: the counting of occupancy
+// mapping (Moravec & Elfes, ICRA 1985) kept beside the map, as the temporary
+// maps of Meyer-Delius et al. (IROS 2010) do, instead of merged into it.
+// People walking through are hit for a moment and passed for the rest of the
+// run, so they do not stay. See docs/design.md, "A map out of date is not a
+// wrong pose".
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "pf_localization/core/map/likelihood_field.h"
+#include "pf_localization/core/sensor/scan_group.h"
+#include "pf_localization/core/util/pose2.h"
+
+namespace pf {
+
+class MapChangeLayer {
+ public:
+  enum class Cell : std::uint8_t {
+    kUnseen,    // no beam reached it
+    kAsMapped,  // seen, and as the map has it
+    kAdded,     // occupied in the world, free on the map
+    kRemoved,   // occupied on the map, free in the world
+  };
+
+  /// Beams walked per scan at most (every n / kRaysPerScan of a scan of n).
+  static constexpr std::size_t kRaysPerScan = 180;
+  /// m: a beam is walked this far at most; a longer one has no end here.
+  static constexpr double kMaxRange = 10.0;
+  /// m: the cells this close before a beam's end are not counted as passed
+  /// (the end point's own error, a blurred wall).
+  static constexpr double kEndMargin = 0.3;
+  /// m: an end point this close to a mapped obstacle ends on it, not short.
+  static constexpr double kBesideObstacle = 0.1;
+  /// Scans whose beams reached a cell before it can be called changed (a
+  /// scan counts once per cell, however many of its beams reached it).
+  static constexpr int kMinScans = 2;
+  /// Share of those that must say it changed: stopped there (added) or went
+  /// through (removed).
+  static constexpr double kChangedShare = 0.5;
+
+  /// An empty layer of `field`'s map.
+  explicit MapChangeLayer(const LikelihoodField& field);
+
+  /// m, rad: a scan is worth adding once the robot moved this far or turned
+  /// this much since the last one added: a scan from the same place says
+  /// again what the last one said, and each costs a walk of every beam.
+  static constexpr double kMinStep = 0.4;
+  static constexpr double kMinTurn = 0.5;
+
+  /// Whether a scan from `robot` is worth adding (kMinStep, kMinTurn).
+  bool wants(const Pose2& robot) const;
+  /// Adds what `scans`, placed from the robot pose `robot`, saw.
+  void add(const ScanGroup& scans, const Pose2& robot);
+  /// Forgets everything seen.
+  void clear();
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  Cell cell(int x, int y) const { return classify(y * width_ + x); }
+
+  struct Summary {
+    std::size_t seen = 0, added = 0, removed = 0;
+    double changedShare() const {
+      return seen == 0 ? 0.0 : static_cast<double>(added + removed) / static_cast<double>(seen);
+    }
+  };
+  Summary summary() const;
+
+  /// Every cell as a nav_msgs/OccupancyGrid value, row-major from the
+  /// lower-left cell: -1 unseen, 0 seen as mapped, 100 added, 50 removed.
+  std::vector<std::int8_t> occupancy() const;
+  /// Every cell as an image's pixel (saveImage, map_loader.h), in the true
+  /// change mask's convention (pf_simulator --change-mask): 0 added, 205
+  /// removed, 254 seen as mapped; and 128 unseen.
+  std::vector<std::uint8_t> pixels() const;
+  /// Scans added so far.
+  std::size_t scans() const { return scans_; }
+
+ private:
+  // Scans, each counted once per cell and kind.
+  struct Counts {
+    std::uint16_t hits = 0;  // a beam ended here, the map free and clear around
+    // A beam passed, the map free here, since the first hit (what passed
+    // before says nothing of an object that came later).
+    std::uint16_t free = 0;
+    std::uint16_t passes = 0;  // a beam passed, the map occupied here
+    std::uint16_t ends = 0;    // a beam ended on this mapped obstacle
+    std::uint16_t scan = 0;    // the last scan that counted here (scans_, wrapping)
+    std::uint8_t counted = 0;  // of that scan: a bit per kind already counted
+  };
+  enum Kind : std::uint8_t { kHit = 1, kFree = 2, kPass = 4, kEnd = 8 };
+  // Each cell's byte: what the map has there (the low two bits), whether a
+  // beam reached it, and whether one ever ended there short of the map.
+  enum MapCell : std::uint8_t { kMapFree, kMapBeside, kMapOccupied, kMapUnknown, kMapBits = 3 };
+  enum Flag : std::uint8_t { kSeen = 4, kWasHit = 8 };
+
+  Cell classify(std::size_t i) const;
+  // Counts `kind` in cell i, once per scan.
+  void count(std::size_t i, Kind kind);
+  // One beam from (x, y) along (ux, uy), in cells of the grid's frame.
+  void walk(double x, double y, double ux, double uy, double range);
+  // The end point of a beam, in cells of the grid's frame.
+  void end(double x, double y);
+
+  int width_, height_;
+  double inv_resolution_;
+  Pose2 origin_;
+  double cos_yaw_, sin_yaw_;
+  std::vector<std::uint8_t> cells_;  // MapCell | Flag
+  std::vector<Counts> counts_;
+  std::size_t scans_ = 0;
+  Pose2 last_;  // the robot pose of the last scan added
+};
+
+}  // namespace pf

@@ -1,0 +1,60 @@
+// Rate limiting of repeated log lines (bad input, dropped scans): one line
+// per kind and period tells the user without drowning the log, and counts
+// what it held back, so that nothing is dropped silently. LimitedLog decides
+// when a line is due; LimitedWarn writes pf_node's warnings through one. Wall time, so the
+// limit also holds while a bag is paused or replayed fast. Thread-safe:
+// pf_node's scan worker and its spinner both log through one.
+#pragma once
+
+#include <map>
+#include <mutex>
+#include <string>
+
+namespace pf_ros {
+
+class LimitedLog {
+ public:
+  /// `period`: s between two lines of the same kind.
+  explicit LimitedLog(double period) : period_(period) {}
+
+  /// Whether a message of this kind is due at wall time `now_s` (s, any
+  /// epoch); if so, `suppressed` is how many of its kind were held back since
+  /// the last one logged.
+  bool due(const std::string& key, double now_s, int* suppressed = nullptr);
+  /// The same at the current wall time.
+  bool due(const std::string& key, int* suppressed = nullptr);
+
+ private:
+  struct Entry {
+    double last = 0.0;
+    bool logged = false;
+    int suppressed = 0;
+  };
+  const double period_;
+  std::mutex mutex_;
+  std::map<std::string, Entry> entries_;
+};
+
+// pf_node's rate-limited warnings (bad input, dropped scans): at most one
+// line per kind of problem and period (LimitedLog), saying how many like it
+// were held back since the last one. Thread-safe, as LimitedLog is.
+class LimitedWarn {
+ public:
+  /// `prefix`: the start of every line ("pf_node"); `period`: s between two
+  /// lines of the same kind.
+  LimitedWarn(std::string prefix, double period) : prefix_(std::move(prefix)), log_(period) {}
+
+  /// Logs `text` at WARN when a line of kind `key` is due.
+  void warn(const std::string& key, const std::string& text);
+  /// Whether a line of kind `key` is due (for lines at another level).
+  bool due(const std::string& key) { return log_.due(key); }
+
+  /// The line warn() logs: `text`, and how many were held back, if any.
+  static std::string line(const std::string& text, int suppressed);
+
+ private:
+  const std::string prefix_;
+  LimitedLog log_;
+};
+
+}  // namespace pf_ros

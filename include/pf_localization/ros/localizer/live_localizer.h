@@ -1,0 +1,102 @@
+// The filter side of pf_node: the ScanLocalizer and everything that changes
+// with it. A scan's update and what follows it (map -> odom to the
+// republisher, the pose to the saver, the estimate and the diagnostics),
+// maps, initial poses and the services, the live parameters with
+// max_update_time's particle cap, time jumping back (TimeJumpDetector:
+// tf and the filter start over) and the check of a pose saved by an earlier
+// run on the first map (saved_pose.h).
+//
+// Threads (README.md, "Under overload"): every method but saver() and
+// haveMap() must be called with pf_node's filter mutex held; the filter
+// thread holds it for a whole update, the main spinner's callbacks that
+// touch the filter wait for it. What runs at a steady rate never does: the
+// republisher and the saver get their data under small locks of their own.
+#pragma once
+
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <nav_msgs/OccupancyGrid.h>
+#include <ros/ros.h>
+#include <tf2_ros/buffer.h>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "pf_localization/ros/input/latest_scan_slot.h"
+#include "pf_localization/ros/input/time_jump_detector.h"
+#include "pf_localization/ros/localizer/limited_log.h"
+#include "pf_localization/ros/localizer/output_latency.h"
+#include "pf_localization/ros/localizer/particle_cap_governor.h"
+#include "pf_localization/ros/localizer/scan_localizer.h"
+#include "pf_localization/ros/output/estimate_publisher.h"
+#include "pf_localization/ros/output/map_to_odom_republisher.h"
+#include "pf_localization/ros/output/saved_pose.h"
+#include "pf_localization/ros/params/reconfigure_server.h"
+
+namespace pf_ros {
+
+class LiveLocalizer {
+ public:
+  /// `saved`: config.initial_pose was saved by an earlier run (isSavedPose()).
+  /// `tf`, `republisher` and `warn` must outlive it; the topics are
+  /// advertised on `nh`. Logs the initial pose it will start from.
+  LiveLocalizer(const LocalizerConfig& config, std::optional<SavedPoseMap> saved,
+                tf2_ros::Buffer* tf, MapToOdomRepublisher* republisher, LimitedWarn* warn,
+                ros::NodeHandle& nh);
+
+  /// A new map (map topic or set_map). False when it was refused (logged).
+  bool installMap(const nav_msgs::OccupancyGrid& map);
+  /// Whether a map was installed. Changed only by installMap(), which pf_node
+  /// calls from its main spinner; read there without the mutex.
+  bool haveMap() const { return have_map_; }
+
+  /// Re-initialises at `pose`, in the global frame. False when refused (warned).
+  bool setInitialPose(const geometry_msgs::PoseWithCovarianceStamped& pose);
+  bool startGlobalLocalization();
+  void requestNoMotionUpdate() { localizer_.filter().requestNoMotionUpdate(); }
+
+  /// The live parameters from ReconfigureServer: the filter's at its next
+  /// update, the republisher's and max_update_time now. Empty, or the error.
+  std::string reconfigure(const LocalizerConfig& next);
+
+  /// One scan from the filter thread: the update and everything after it.
+  /// `slot` (its scans dropped) and `reconfigure` (its generation): for the
+  /// diagnostics, as they are after the update.
+  void processScan(const PendingScan& pending, const LatestScanSlot& slot,
+                   const ReconfigureServer& reconfigure);
+
+  /// When `stamp` lies more than `tolerance` s before the latest scan used:
+  /// clears tf, restarts the filter and returns true.
+  bool timeJumpedBack(const ros::Time& stamp, double tolerance = TimeJumpDetector::kScanTolerance);
+  /// Clears tf again when it still holds transforms of the scan's chain from
+  /// before time jumped back (latestChainStamp()).
+  void clearStaleBuffer(const std::string& laser_frame);
+
+  /// What to save, under its own lock: may be used without the mutex.
+  const PoseSaver& saver() const { return saver_; }
+
+ private:
+  void logInitialPose() const;
+  void checkSavedPose(const std::string& map_signature);
+  bool fromBeforeTheJump(const ros::Time& stamp);
+  void applyParticleCap(std::size_t cap);
+  void filterChanged(const ros::Time& scan_stamp);
+
+  const LocalizerConfig config_;  // as read at start-up: the live values are localizer_'s
+  tf2_ros::Buffer* tf_;
+  MapToOdomRepublisher* republisher_;
+  LimitedWarn* warn_;
+  ScanLocalizer localizer_;
+  UpdateTimeGovernor governor_;
+  UpdateTiming timing_;
+  EstimatePublisher output_;
+  TimeJumpDetector jumps_;
+  PoseSaver saver_;
+  bool have_map_ = false;
+  std::optional<SavedPoseMap> saved_pose_;  // until the first map checks it
+  bool saved_pose_ignored_ = false;         // it was, and global localization started
+  bool pose_before_map_ = false;            // an initial pose replaced it before any map
+  std::optional<pf::Pose2> last_odom_;      // odom -> base at the latest scan used
+};
+
+}  // namespace pf_ros

@@ -1,0 +1,129 @@
+// map -> odom on /tf: published after every filter update, and again
+// whenever 1.5 periods (1 / tf_publish_rate s) pass without one on the wall
+// clock, one period under simulated time, so that tf users never wait more
+// than two periods (see kWallClockPeriods in the .cc). Neither a filter update
+// nor anything else on the node's spinner delays it: it only ever touches the
+// latest transform handed to it, under its own mutex, never the filter.
+//
+// What times the republishing depends on the clock:
+// - on the wall clock, a thread of its own that sleeps on a timer (timerfd)
+//   until a publication is due. Each publication after an update re-arms
+//   the timer, without waking the thread, so that while updates come often
+//   enough it never wakes;
+// - under simulated time, /clock itself: no sleep can be timed on a clock
+//   that only /clock moves, so start() subscribes to it on the handle it is
+//   given (pf_node's poll thread), and the /clock message at which a
+//   publication is due publishes it, on the thread that brought it. No
+//   thread polls the clock (docs/performance.md, "The fixed cost").
+#pragma once
+
+#include <geometry_msgs/TransformStamped.h>
+#include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
+#include <tf2_ros/transform_broadcaster.h>
+
+#include <functional>
+#include <mutex>
+#include <optional>
+#include <thread>
+
+namespace pf_ros {
+
+/// When map -> odom is due again: one period after the latest publication,
+/// timed or after an update, rather than on a fixed beat. Every message costs
+/// the node and each subscriber about ten system calls, and tf users still
+/// get one at least once a period.
+class RepublishSchedule {
+ public:
+  /// Whether a timed publication is due at `now`. The first call is, and so
+  /// is any call after time went back (a bag restarted).
+  bool due(const ros::Time& now, const ros::Duration& period);
+  /// Something was published at `now`: the next is due one period later.
+  void published(const ros::Time& now, const ros::Duration& period) { next_ = now + period; }
+  /// Forget the past: due at once.
+  void reset() { next_ = ros::Time(); }
+  /// When the next is due (zero: at once).
+  const ros::Time& next() const { return next_; }
+
+ private:
+  ros::Time next_;
+};
+
+struct MapToOdomRepublisherOptions {
+  double rate = 20.0;                // Hz of republishing (tf_publish_rate); > 0
+  double transform_tolerance = 0.1;  // s each stamp is post-dated by, so tf users never extrapolate
+  bool enabled = true;               // false (tf_broadcast false): nothing is ever published
+};
+
+class MapToOdomRepublisher {
+ public:
+  /// Called with the clock's time before each timed publication, on the
+  /// thread that times it (see above), without any lock held (pf_node checks
+  /// there whether simulated time jumped back).
+  using TickHook = std::function<void(const ros::Time& now)>;
+
+  explicit MapToOdomRepublisher(const MapToOdomRepublisherOptions& options, TickHook hook = {});
+
+  /// Starts the timed republishing (once; the hook may be called from then
+  /// on): under simulated time by subscribing to /clock on `clock_nh` (its
+  /// callback queue runs onClock()), on the wall clock by starting the thread.
+  void start(ros::NodeHandle clock_nh);
+  ~MapToOdomRepublisher();
+  MapToOdomRepublisher(const MapToOdomRepublisher&) = delete;
+  MapToOdomRepublisher& operator=(const MapToOdomRepublisher&) = delete;
+
+  /// The new map -> odom (its stamp is ignored; nullopt: nothing to publish
+  /// until the next set()), after the scan stamped `scan_stamp` (zero: none):
+  /// published at once, stamped max(now, scan_stamp) + transform_tolerance,
+  /// or just after the previous stamp when that is not later (tf2 refuses a
+  /// repeated stamp); the next timed publication is then due one delay later.
+  /// Returns whether it was published.
+  bool set(const std::optional<geometry_msgs::TransformStamped>& map_to_odom,
+           const ros::Time& scan_stamp);
+
+  /// Time jumped back: forgets the transform, the scan stamp and the last
+  /// stamp published, so that the new timeline's stamps are accepted.
+  void reset();
+
+  void setRate(double hz);
+  void setTransformTolerance(double seconds);
+
+  /// Number of map -> odom messages published since start.
+  std::size_t published() const;
+
+  /// Simulated time moved to `now` (/clock): the timed publication when one
+  /// is due. Never waits: while set() publishes (which puts the next timed
+  /// publication off anyway) the next /clock looks again.
+  void onClock(const ros::Time& now);
+
+ private:
+  // The wall clock's thread: sleeps on the timer until a timed publication
+  // is due.
+  void run();
+  // The wall clock's timer fires in `seconds` (no timer: nothing); mutex_
+  // held, or the thread not started.
+  void armLocked(double seconds);
+  // How long after the latest publication the next timed one is due: 1.5
+  // periods on the wall clock, one under simulated time (see the .cc).
+  ros::Duration delayLocked() const;
+  // The timed publication at `now`, when due; `lock` holds mutex_ (and is
+  // released around the hook).
+  void tick(const ros::Time& now, std::unique_lock<std::mutex>* lock);
+  // Publishes the stored transform stamped `stamp`; mutex_ held.
+  bool publishLocked(ros::Time stamp);
+
+  MapToOdomRepublisherOptions options_;
+  TickHook hook_;
+  tf2_ros::TransformBroadcaster broadcaster_;
+  mutable std::mutex mutex_;
+  int timer_fd_ = -1;  // the wall clock's timer (timerfd); -1 under simulated time
+  bool stop_ = false;
+  std::optional<geometry_msgs::TransformStamped> transform_;
+  ros::Time scan_stamp_, last_stamp_;
+  RepublishSchedule schedule_;
+  std::size_t published_ = 0;
+  ros::Subscriber clock_sub_;
+  std::thread thread_;
+};
+
+}  // namespace pf_ros

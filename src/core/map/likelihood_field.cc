@@ -1,0 +1,69 @@
+#include "pf_localization/core/map/likelihood_field.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "pf_localization/core/map/distance_transform.h"
+
+namespace pf {
+
+LikelihoodField::LikelihoodField(const OccupancyGrid& grid, double max_distance)
+    : grid_(grid), max_distance_(max_distance) {
+  if (!(max_distance > 0.0) || !std::isfinite(max_distance)) {
+    throw std::invalid_argument("likelihood field: max_distance must be positive and finite, got " +
+                                std::to_string(max_distance));
+  }
+  std::vector<bool> occupied(grid.data().size());
+  for (std::size_t i = 0; i < occupied.size(); ++i) {
+    occupied[i] = OccupancyGrid::classify(grid.data()[i]) == CellState::kOccupied;
+  }
+  // Squared cells, turned into metres in place.
+  distances_ = squaredDistanceTransform(occupied, grid.width(), grid.height());
+  const float cap = static_cast<float>(max_distance);
+  const float res = static_cast<float>(grid.resolution());
+  for (float& d : distances_) d = std::min(std::sqrt(d) * res, cap);  // sqrt(inf) = inf -> cap
+  // Inside an obstacle, how far past its surface: the distance to the nearest
+  // cell that is not occupied, less the surface cell's own and kFreeDepth. A
+  // map whose obstacles are all that thin (a real map's walls) needs no second
+  // transform: its surface distances are its distances.
+  if (!hasDeepCells(occupied, grid.width(), grid.height())) return;
+  std::vector<bool> open(occupied.size());
+  for (std::size_t i = 0; i < open.size(); ++i) open[i] = !occupied[i];
+  const std::vector<float> depth = squaredDistanceTransform(open, grid.width(), grid.height());
+  surface_distances_ = distances_;
+  for (std::size_t i = 0; i < open.size(); ++i) {
+    if (occupied[i]) {
+      surface_distances_[i] =
+          std::min(std::max(std::sqrt(depth[i]) - 1.0f - kFreeDepth, 0.0f) * res, cap);
+    }
+  }
+}
+
+bool LikelihoodField::hasDeepCells(const std::vector<bool>& occupied, int width, int height) {
+  // Deeper than 1 + kFreeDepth cells: every cell within that radius occupied
+  // or off the map (off the map is no free cell to measure to either).
+  const int r = static_cast<int>(1.0f + kFreeDepth);
+  const auto open = [&](int x, int y) {
+    return x >= 0 && y >= 0 && x < width && y < height &&
+           !occupied[static_cast<std::size_t>(y) * width + x];
+  };
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      bool deep = true;
+      for (int dy = -r; dy <= r && deep; ++dy) {
+        for (int dx = -r; dx <= r && deep; ++dx) {
+          if (dx * dx + dy * dy <= r * r) deep = !open(x + dx, y + dy);
+        }
+      }
+      if (deep) return true;
+    }
+  }
+  return false;
+}
+
+double LikelihoodField::distance(const CellIndex& c) const {
+  return grid_.contains(c) ? distances_[grid_.linearIndex(c)] : max_distance_;
+}
+
+}  // namespace pf

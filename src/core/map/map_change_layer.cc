@@ -1,0 +1,226 @@
+#include "pf_localization/core/map/map_change_layer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "pf_localization/core/motion/scan_deskew.h"
+
+namespace pf {
+namespace {
+
+void bump(std::uint16_t* n) {
+  if (*n < std::numeric_limits<std::uint16_t>::max()) ++*n;
+}
+
+}  // namespace
+
+void MapChangeLayer::count(std::size_t i, Kind kind) {
+  Counts& c = counts_[i];
+  const auto scan = static_cast<std::uint16_t>(scans_);
+  if (c.scan != scan) {
+    c.scan = scan;
+    c.counted = 0;
+  }
+  if (c.counted & kind) return;
+  c.counted |= kind;
+  switch (kind) {
+    case kHit:
+      bump(&c.hits);
+      break;
+    case kFree:
+      bump(&c.free);
+      break;
+    case kPass:
+      bump(&c.passes);
+      break;
+    case kEnd:
+      bump(&c.ends);
+      break;
+  }
+}
+
+MapChangeLayer::MapChangeLayer(const LikelihoodField& field)
+    : width_(field.grid().width()),
+      height_(field.grid().height()),
+      inv_resolution_(1.0 / field.grid().resolution()),
+      origin_(field.grid().origin()),
+      cos_yaw_(std::cos(origin_.yaw)),
+      sin_yaw_(std::sin(origin_.yaw)) {
+  const OccupancyGrid& grid = field.grid();
+  const std::vector<float>& distance = field.distances();
+  cells_.resize(grid.data().size());
+  for (std::size_t i = 0; i < cells_.size(); ++i) {
+    switch (OccupancyGrid::classify(grid.data()[i])) {
+      case CellState::kOccupied:
+        cells_[i] = kMapOccupied;
+        break;
+      case CellState::kUnknown:
+        cells_[i] = kMapUnknown;
+        break;
+      case CellState::kFree:
+        cells_[i] = distance[i] <= kBesideObstacle ? kMapBeside : kMapFree;
+        break;
+    }
+  }
+  counts_.resize(cells_.size());
+}
+
+void MapChangeLayer::clear() {
+  std::fill(counts_.begin(), counts_.end(), Counts());
+  for (std::uint8_t& c : cells_) c &= kMapBits;
+  scans_ = 0;
+}
+
+bool MapChangeLayer::wants(const Pose2& robot) const {
+  return scans_ == 0 || std::hypot(robot.x - last_.x, robot.y - last_.y) >= kMinStep ||
+         std::abs(normalizeAngle(robot.yaw - last_.yaw)) >= kMinTurn;
+}
+
+void MapChangeLayer::add(const ScanGroup& scans, const Pose2& robot) {
+  for (const LaserScan& scan : scans) {
+    const std::size_t n = scan.ranges.size();
+    const Pose2 base = compose(robot, scan.robot_offset);
+    const bool skewed = !scan.sweep.isStill();
+    const std::size_t stride = std::max<std::size_t>(1, n / kRaysPerScan);
+    Pose2 sensor = compose(base, scan.sensor_pose);
+    for (std::size_t i = 0; i < n; i += stride) {
+      if (!isReading(scan.ranges[i], scan.range_min, scan.range_max)) continue;
+      if (skewed) sensor = compose(base, sensorPoseAtBeam(scan.sensor_pose, scan.sweep, i));
+      const double angle =
+          sensor.yaw - origin_.yaw + scan.angle_min + static_cast<double>(i) * scan.angle_increment;
+      // The sensor in cells of the grid's frame.
+      const double dx = sensor.x - origin_.x, dy = sensor.y - origin_.y;
+      const double x = (cos_yaw_ * dx + sin_yaw_ * dy) * inv_resolution_;
+      const double y = (-sin_yaw_ * dx + cos_yaw_ * dy) * inv_resolution_;
+      walk(x, y, std::cos(angle), std::sin(angle), scan.ranges[i]);
+    }
+  }
+  ++scans_;
+  last_ = robot;
+}
+
+void MapChangeLayer::walk(double x, double y, double ux, double uy, double range) {
+  const double length = (std::min(range, kMaxRange) - kEndMargin) * inv_resolution_;
+  int cx = static_cast<int>(std::floor(x)), cy = static_cast<int>(std::floor(y));
+  const int step_x = ux >= 0.0 ? 1 : -1, step_y = uy >= 0.0 ? 1 : -1;
+  const double inf = std::numeric_limits<double>::infinity();
+  const double delta_x = ux != 0.0 ? std::abs(1.0 / ux) : inf;
+  const double delta_y = uy != 0.0 ? std::abs(1.0 / uy) : inf;
+  double next_x = ux != 0.0 ? (cx + (step_x > 0 ? 1 : 0) - x) / ux : inf;
+  double next_y = uy != 0.0 ? (cy + (step_y > 0 ? 1 : 0) - y) / uy : inf;
+  double t = 0.0;
+  while (t <= length && cx >= 0 && cy >= 0 && cx < width_ && cy < height_) {
+    // Most cells are free, and only their byte is touched.
+    std::uint8_t& cell = cells_[static_cast<std::size_t>(cy) * width_ + cx];
+    const std::uint8_t map = cell & kMapBits;
+    if (map != kMapUnknown) {
+      cell |= kSeen;
+      if (map == kMapOccupied) {
+        count(static_cast<std::size_t>(cy) * width_ + cx, kPass);
+      } else if (cell & kWasHit) {
+        count(static_cast<std::size_t>(cy) * width_ + cx, kFree);
+      }
+    }
+    if (next_x < next_y) {
+      t = next_x;
+      next_x += delta_x;
+      cx += step_x;
+    } else {
+      t = next_y;
+      next_y += delta_y;
+      cy += step_y;
+    }
+  }
+  if (range <= kMaxRange) end(x + ux * range * inv_resolution_, y + uy * range * inv_resolution_);
+}
+
+void MapChangeLayer::end(double x, double y) {
+  const int cx = static_cast<int>(std::floor(x)), cy = static_cast<int>(std::floor(y));
+  if (cx < 0 || cy < 0 || cx >= width_ || cy >= height_) return;
+  const std::size_t i = static_cast<std::size_t>(cy) * width_ + cx;
+  if ((cells_[i] & kMapBits) == kMapFree) {
+    cells_[i] |= kSeen | kWasHit;
+    count(i, kHit);
+    return;
+  }
+  // On (or beside) the map's obstacle: an end for each mapped obstacle cell
+  // around the end point.
+  for (int ny = std::max(0, cy - 1); ny <= std::min(height_ - 1, cy + 1); ++ny) {
+    for (int nx = std::max(0, cx - 1); nx <= std::min(width_ - 1, cx + 1); ++nx) {
+      const std::size_t j = static_cast<std::size_t>(ny) * width_ + nx;
+      if ((cells_[j] & kMapBits) != kMapOccupied) continue;
+      cells_[j] |= kSeen;
+      count(j, kEnd);
+    }
+  }
+}
+
+MapChangeLayer::Cell MapChangeLayer::classify(std::size_t i) const {
+  if (!(cells_[i] & kSeen)) return Cell::kUnseen;
+  const Counts& c = counts_[i];
+  const int hits = c.hits, passes = c.passes;
+  const int stopped = hits + c.free, reached = passes + c.ends;
+  if (hits >= kMinScans && hits >= kChangedShare * stopped) return Cell::kAdded;
+  if (passes >= kMinScans && passes >= kChangedShare * reached) return Cell::kRemoved;
+  return Cell::kAsMapped;
+}
+
+MapChangeLayer::Summary MapChangeLayer::summary() const {
+  Summary s;
+  for (std::size_t i = 0; i < counts_.size(); ++i) {
+    switch (classify(i)) {
+      case Cell::kUnseen:
+        continue;
+      case Cell::kAdded:
+        ++s.added;
+        break;
+      case Cell::kRemoved:
+        ++s.removed;
+        break;
+      case Cell::kAsMapped:
+        break;
+    }
+    ++s.seen;
+  }
+  return s;
+}
+
+namespace {
+
+template <typename T>
+std::vector<T> valuesOf(const MapChangeLayer& layer, T unseen, T as_mapped, T added, T removed) {
+  std::vector<T> out(static_cast<std::size_t>(layer.width()) * layer.height());
+  for (int y = 0; y < layer.height(); ++y) {
+    for (int x = 0; x < layer.width(); ++x) {
+      T& v = out[static_cast<std::size_t>(y) * layer.width() + x];
+      switch (layer.cell(x, y)) {
+        case MapChangeLayer::Cell::kUnseen:
+          v = unseen;
+          break;
+        case MapChangeLayer::Cell::kAsMapped:
+          v = as_mapped;
+          break;
+        case MapChangeLayer::Cell::kAdded:
+          v = added;
+          break;
+        case MapChangeLayer::Cell::kRemoved:
+          v = removed;
+          break;
+      }
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::vector<std::int8_t> MapChangeLayer::occupancy() const {
+  return valuesOf<std::int8_t>(*this, -1, 0, 100, 50);
+}
+
+std::vector<std::uint8_t> MapChangeLayer::pixels() const {
+  return valuesOf<std::uint8_t>(*this, 128, 254, 0, 205);
+}
+
+}  // namespace pf

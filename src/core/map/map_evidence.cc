@@ -1,0 +1,124 @@
+#include "pf_localization/core/map/map_evidence.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pf {
+
+EvidenceCounts& EvidenceCounts::operator+=(const EvidenceCounts& o) {
+  on_map += o.on_map;
+  short_of_map += o.short_of_map;
+  through_onto_map += o.through_onto_map;
+  through_into_open += o.through_into_open;
+  off_map += o.off_map;
+  return *this;
+}
+
+namespace {
+
+void add(BeamEvidence e, EvidenceCounts* c) {
+  switch (e) {
+    case BeamEvidence::kOnMap:
+      ++c->on_map;
+      break;
+    case BeamEvidence::kShortOfMap:
+      ++c->short_of_map;
+      break;
+    case BeamEvidence::kThroughOntoMap:
+      ++c->through_onto_map;
+      break;
+    case BeamEvidence::kThroughIntoOpen:
+      ++c->through_into_open;
+      break;
+    case BeamEvidence::kOffMap:
+      ++c->off_map;
+      break;
+    case BeamEvidence::kNoReading:
+      break;
+  }
+}
+
+}  // namespace
+
+MapEvidence::MapEvidence(const LikelihoodField& field)
+    : field_(&field),
+      caster_(field),
+      origin_(field.grid().origin()),
+      cos_yaw_(std::cos(origin_.yaw)),
+      sin_yaw_(std::sin(origin_.yaw)),
+      inv_resolution_(1.0 / field.grid().resolution()) {}
+
+BeamEvidence MapEvidence::judge(double sx, double sy, double angle, double range) const {
+  return judgeRay(sx, sy, std::cos(angle), std::sin(angle), range);
+}
+
+BeamEvidence MapEvidence::judgeRay(double sx, double sy, double ux, double uy, double range) const {
+  const OccupancyGrid& grid = field_->grid();
+  // An end point just past the map's edge (a wall drawn on it, a little pose
+  // error) is judged where the beam leaves the map.
+  // Far beams say little of changes and cost the most to cast: on the map.
+  if (range > kMaxJudgedRange) return BeamEvidence::kOnMap;
+  constexpr int kEdgeSteps = 6;
+  double inside = range;
+  for (int k = 1; !grid.contains(grid.worldToCell(sx + inside * ux, sy + inside * uy)); ++k) {
+    if (k > kEdgeSteps) return BeamEvidence::kOffMap;
+    inside = range - kThroughMargin * k / kEdgeSteps;
+  }
+  const double d = field_->distanceAt(sx + inside * ux, sy + inside * uy);
+  // Where the map would stop the beam: its first obstacle along the ray, up to
+  // just past the measured end (cast in the grid's frame, in cells).
+  const double dx = sx - origin_.x, dy = sy - origin_.y;
+  const double expected = caster_.castInCells((cos_yaw_ * dx + sin_yaw_ * dy) * inv_resolution_,
+                                              (-sin_yaw_ * dx + cos_yaw_ * dy) * inv_resolution_,
+                                              cos_yaw_ * ux + sin_yaw_ * uy,
+                                              -sin_yaw_ * ux + cos_yaw_ * uy, range + kShortMargin);
+  if (expected < range - kThroughMargin) {
+    return d <= kOnMapDistance ? BeamEvidence::kThroughOntoMap : BeamEvidence::kThroughIntoOpen;
+  }
+  if (expected >= range + kShortMargin && d > kBesideObstacle) return BeamEvidence::kShortOfMap;
+  return BeamEvidence::kOnMap;
+}
+
+EvidenceCounts MapEvidence::judge(const LaserScan& scan, const Pose2& robot,
+                                  std::vector<BeamEvidence>* out) const {
+  EvidenceCounts counts;
+  const std::size_t n = scan.ranges.size();
+  out->assign(n, BeamEvidence::kNoReading);
+  const Pose2 base = compose(robot, scan.robot_offset);
+  const bool skewed = !scan.sweep.isStill();
+  // A beam's neighbours within the stride see what it sees, near enough.
+  const std::size_t stride = std::max<std::size_t>(1, n / kJudgedBeams);
+  Pose2 sensor = compose(base, scan.sensor_pose);
+  for (std::size_t first = 0; first < n; first += stride) {
+    const std::size_t end = std::min(n, first + stride);
+    std::size_t i = first;
+    while (i < end && !isReading(scan.ranges[i], scan.range_min, scan.range_max)) ++i;
+    if (i == end) continue;
+    if (skewed) sensor = compose(base, sensorPoseAtBeam(scan.sensor_pose, scan.sweep, i));
+    const BeamEvidence e =
+        judge(sensor.x, sensor.y,
+              sensor.yaw + scan.angle_min + static_cast<double>(i) * scan.angle_increment,
+              scan.ranges[i]);
+    add(e, &counts);
+    for (std::size_t j = i; j < end; ++j) {
+      if (isReading(scan.ranges[j], scan.range_min, scan.range_max)) (*out)[j] = e;
+    }
+  }
+  return counts;
+}
+
+EvidenceCounts MapEvidence::count(const std::vector<PreparedScan>& scans,
+                                  const Pose2& robot) const {
+  EvidenceCounts counts;
+  for (const PreparedScan& s : scans) {
+    const Pose2 sensor = compose(robot, {s.sensor_x, s.sensor_y, 0.0});
+    for (std::size_t b = 0; b < s.size(); ++b) {
+      const Pose2 end = compose(robot, {s.x[b], s.y[b], 0.0});
+      const double dx = end.x - sensor.x, dy = end.y - sensor.y;
+      add(judge(sensor.x, sensor.y, std::atan2(dy, dx), std::hypot(dx, dy)), &counts);
+    }
+  }
+  return counts;
+}
+
+}  // namespace pf

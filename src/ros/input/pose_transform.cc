@@ -1,0 +1,38 @@
+#include "pf_localization/ros/input/pose_transform.h"
+
+#include <Eigen/Core>
+#include <cmath>
+
+#include "pf_localization/ros/input/conversions.h"
+
+namespace pf_ros {
+
+geometry_msgs::PoseWithCovarianceStamped inParentFrame(
+    const geometry_msgs::PoseWithCovarianceStamped& pose,
+    const geometry_msgs::TransformStamped& frame) {
+  geometry_msgs::PoseWithCovarianceStamped out = pose;
+  const pf::Pose2 f = toPose2(frame.transform);
+  out.pose.pose = toPoseMsg(pf::compose(f, toPose2(pose.pose.pose)));
+  Eigen::Matrix3d rot = Eigen::Matrix3d::Identity();
+  rot.topLeftCorner<2, 2>() << std::cos(f.yaw), -std::sin(f.yaw), std::sin(f.yaw), std::cos(f.yaw);
+  out.pose.covariance =
+      toRosCovariance(rot * fromRosCovariance(pose.pose.covariance) * rot.transpose());
+  return out;
+}
+
+std::optional<geometry_msgs::PoseWithCovarianceStamped> poseInFrame(
+    const tf2_ros::Buffer& tf, const geometry_msgs::PoseWithCovarianceStamped& pose,
+    const std::string& frame, const ros::Duration& timeout, std::string* error) {
+  geometry_msgs::TransformStamped t;
+  try {
+    t = tf.lookupTransform(frame, pose.header.frame_id, ros::Time(0), timeout);
+  } catch (const tf2::TransformException& e) {
+    *error = e.what();
+    return std::nullopt;
+  }
+  geometry_msgs::PoseWithCovarianceStamped out = inParentFrame(pose, t);
+  out.header.frame_id = frame;
+  return out;
+}
+
+}  // namespace pf_ros

@@ -1,0 +1,42 @@
+#include "pf_localization/ros/input/scan_drop.h"
+
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+
+namespace pf_ros {
+namespace {
+
+std::string failureText(tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+  switch (reason) {
+    case tf2_ros::filter_failure_reasons::OutTheBack:
+      return "its stamp is older than the tf buffer";
+    case tf2_ros::filter_failure_reasons::EmptyFrameID:
+      return "its frame_id is empty";
+    default:
+      return "no transform arrived for its stamp before the queue filled up";
+  }
+}
+
+}  // namespace
+
+std::string scanDropMessage(const std_msgs::Header& header,
+                            tf2_ros::filter_failure_reasons::FilterFailureReason reason,
+                            const std::string& base_frame, const std::string& odom_frame) {
+  return "scan dropped: " + failureText(reason) + ". It needs tf from '" + header.frame_id +
+         "' to '" + base_frame + "' (the sensor's mounting) and '" + base_frame + "' to '" +
+         odom_frame + "' (odometry) at t=" + std::to_string(header.stamp.toSec()) +
+         "; check that both are published";
+}
+
+void lowerThreadPriority(int increment) {
+  const id_t tid = static_cast<id_t>(::syscall(SYS_gettid));
+  errno = 0;
+  const int nice = ::getpriority(PRIO_PROCESS, tid);
+  if (errno == 0) ::setpriority(PRIO_PROCESS, tid, std::min(19, nice + increment));
+}
+
+}  // namespace pf_ros

@@ -1,0 +1,223 @@
+#include "pf_localization/ros/localizer/live_localizer.h"
+
+#include <algorithm>
+#include <utility>
+
+#include "pf_localization/ros/input/conversions.h"
+
+namespace pf_ros {
+
+LiveLocalizer::LiveLocalizer(const LocalizerConfig& config, std::optional<SavedPoseMap> saved,
+                             tf2_ros::Buffer* tf, MapToOdomRepublisher* republisher,
+                             LimitedWarn* warn, ros::NodeHandle& nh)
+    : config_(config),
+      tf_(tf),
+      republisher_(republisher),
+      warn_(warn),
+      localizer_(config, tf),
+      governor_(UpdateTimeGovernorOptions{config.max_update_time}),
+      output_(nh),
+      saved_pose_(std::move(saved)) {
+  logInitialPose();
+}
+
+void LiveLocalizer::logInitialPose() const {
+  if (!config_.initial_pose) {
+    ROS_INFO("pf_node: no initial pose given: global localization once a map arrives");
+    return;
+  }
+  const pf::Pose2& p = *config_.initial_pose;
+  ROS_INFO("pf_node: initial pose (%.3f, %.3f, %.3f) in %s%s; waiting for a map", p.x, p.y, p.yaw,
+           config_.global_frame.c_str(),
+           saved_pose_ ? ", saved by an earlier run: used only on the map it was saved on" : "");
+}
+
+bool LiveLocalizer::installMap(const nav_msgs::OccupancyGrid& map) {
+  const bool first = !have_map_;
+  const std::string error = localizer_.setMap(map);
+  if (!error.empty()) {
+    ROS_ERROR("pf_node: %s", error.c_str());
+    return false;
+  }
+  have_map_ = true;
+  if (config_.save_pose_rate > 0.0 || (first && saved_pose_)) {
+    const std::string signature = mapSignature(map);
+    saver_.setMap(signature);
+    if (first && saved_pose_) checkSavedPose(signature);
+  }
+  ROS_INFO("pf_node: map %u x %u cells at %.3f m; %zu particles", map.info.width, map.info.height,
+           map.info.resolution, localizer_.filter().particles().size());
+  output_.publishEstimate(localizer_, map.header.stamp, true);
+  filterChanged(ros::Time());
+  return true;
+}
+
+// On the first map, when the configured initial pose was saved by an
+// earlier run: it stays only on the map it was saved on, in free space;
+// otherwise global localization, now and on a restart.
+void LiveLocalizer::checkSavedPose(const std::string& map_signature) {
+  const SavedPoseDecision d = decideSavedPose(*saved_pose_, *config_.initial_pose, map_signature,
+                                              *localizer_.filter().map());
+  saved_pose_.reset();
+  if (d.resume) {
+    ROS_INFO("pf_node: %s", d.message.c_str());
+    return;
+  }
+  ROS_WARN("pf_node: %s", d.message.c_str());
+  saved_pose_ignored_ = true;
+  // An initial pose that came before the map is what the filter started from.
+  if (pose_before_map_) return;
+  const std::string error = localizer_.startGlobalLocalization();
+  if (!error.empty()) ROS_WARN("pf_node: %s", error.c_str());
+}
+
+bool LiveLocalizer::setInitialPose(const geometry_msgs::PoseWithCovarianceStamped& pose) {
+  const std::string error = localizer_.setInitialPose(pose);
+  if (!error.empty()) {
+    warn_->warn("initialpose", error);
+    return false;
+  }
+  if (!have_map_) pose_before_map_ = true;
+  const pf::Pose2 p = toPose2(pose.pose.pose);
+  ROS_INFO("pf_node: re-initialised at (%.3f, %.3f, %.3f) in %s", p.x, p.y, p.yaw,
+           config_.global_frame.c_str());
+  output_.publishEstimate(localizer_, pose.header.stamp, true);
+  filterChanged(ros::Time());
+  return true;
+}
+
+bool LiveLocalizer::startGlobalLocalization() {
+  const std::string error = localizer_.startGlobalLocalization();
+  if (!error.empty()) {
+    ROS_WARN("pf_node: %s", error.c_str());
+    return false;
+  }
+  ROS_INFO("pf_node: global localization: %zu particles over the free space",
+           localizer_.filter().particles().size());
+  output_.publishEstimate(localizer_, ros::Time::now(), true);
+  filterChanged(ros::Time());
+  return true;
+}
+
+std::string LiveLocalizer::reconfigure(const LocalizerConfig& next) {
+  const std::string error = localizer_.reconfigure(next);
+  if (!error.empty()) return error;
+  republisher_->setRate(next.tf_publish_rate);
+  republisher_->setTransformTolerance(next.transform_tolerance);
+  governor_.setMaxUpdateTime(next.max_update_time);
+  applyParticleCap(governor_.cap());
+  return "";
+}
+
+// max_update_time's cap on the particle count, under the configured
+// max_particles (0: none, the configured bounds alone).
+void LiveLocalizer::applyParticleCap(std::size_t cap) {
+  pf::ParticleFilterParams p = localizer_.config().filter;
+  if (cap > 0 && cap < static_cast<std::size_t>(p.kld.max_particles)) {
+    p.kld.max_particles = static_cast<int>(cap);
+    p.kld.min_particles = std::min(p.kld.min_particles, p.kld.max_particles);
+  }
+  const pf::KldParams& now = localizer_.filter().params().kld;
+  if (now.max_particles == p.kld.max_particles && now.min_particles == p.kld.min_particles) return;
+  localizer_.filter().setParams(p);
+}
+
+void LiveLocalizer::processScan(const PendingScan& pending, const LatestScanSlot& slot,
+                                const ReconfigureServer& reconfigure) {
+  const std_msgs::Header& header = pending.header();
+  if (fromBeforeTheJump(header.stamp)) return;
+  if (timeJumpedBack(header.stamp)) return;
+  const ros::WallTime start = ros::WallTime::now();
+  const ScanResult result = pending.scan ? localizer_.processScan(*pending.scan, pending.sensor)
+                                         : localizer_.processCloud(*pending.cloud, pending.sensor);
+  const double update_s = (ros::WallTime::now() - start).toSec();
+  if (result.error != ScanError::kNone) {
+    warn_->warn(toString(result.error), errorMessage(result));
+    return;
+  }
+  if (!result.warning.empty()) warn_->warn("scan inconsistent", result.warning);
+  const pf::UpdateReport& r = result.report;
+  const ros::Time& stamp = header.stamp;
+  last_odom_ = result.odom;
+  jumps_.scanUsed(stamp);
+  // map -> odom first: tf users wait for it, nobody waits for the rest.
+  filterChanged(stamp);
+  if (r.updated) {
+    timing_.addUpdate((ros::WallTime::now() - pending.arrival_wall).toSec(),
+                      (pending.arrival_clock - stamp).toSec(), update_s);
+    if (governor_.enabled()) applyParticleCap(governor_.addUpdate(r.particles, update_s));
+    output_.publishEstimate(localizer_, stamp, false);
+    output_.publishConfidence(localizer_, stamp, r, reconfigure.generation(), timing_,
+                              slot.dropped(), governor_.cap());
+    ROS_DEBUG("pf_node: update with %d beams, %zu particles, ESS %.0f%s in %.1f ms", r.beams_used,
+              r.particles, r.ess, r.resampled ? ", resampled" : "", update_s * 1e3);
+  } else if (r.skip_reason != pf::SkipReason::kNotMoved) {
+    warn_->warn(pf::toString(r.skip_reason), "scan not used: " + pf::skipMessage(r));
+  }
+}
+
+// tf data and the filter's odometry reference belong to the old timeline,
+// so both start over, as tf itself does on such a jump: from the initial
+// pose, or with global localization.
+bool LiveLocalizer::timeJumpedBack(const ros::Time& stamp, double tolerance) {
+  const auto back = jumps_.jumpBack(stamp, tolerance);
+  if (!back) return false;
+  const bool from_pose = config_.initial_pose && !saved_pose_ignored_;
+  ROS_WARN(
+      "pf_node: time jumped back by %.1f s (a bag restarted?): clearing tf and restarting "
+      "the filter %s",
+      *back, from_pose ? "from the initial pose" : "with global localization");
+  tf_->clear();
+  last_odom_.reset();
+  std::string error = localizer_.restart();
+  // restart() goes back to the configured pose, which was a saved one not to use.
+  if (error.empty() && !from_pose && config_.initial_pose) {
+    error = localizer_.startGlobalLocalization();
+  }
+  if (!error.empty()) ROS_WARN("pf_node: %s", error.c_str());
+  jumps_.reset();
+  republisher_->reset();
+  filterChanged(ros::Time());
+  return true;
+}
+
+namespace {
+// ros::Time::now(), asked only under simulated time, where it matters.
+ros::Time simClockNow() { return ros::Time::isSimTime() ? ros::Time::now() : ros::Time(); }
+}  // namespace
+
+// When a bag starts over, messages of the old timeline are still queued in
+// pf_node's subscriptions and tf's: they arrive after the jump back, stamped
+// ahead of the clock. A scan among them would restart the filter a second
+// time, at the wrong place; they are dropped instead.
+bool LiveLocalizer::fromBeforeTheJump(const ros::Time& stamp) {
+  const auto ahead = aheadOfSimClock(stamp, simClockNow(), ros::Time::isSimTime());
+  if (!ahead) return false;
+  warn_->warn("scan ahead of clock",
+              "scan ignored: stamped " + std::to_string(*ahead) +
+                  " s ahead of /clock, so it is from before time jumped back");
+  return true;
+}
+
+void LiveLocalizer::clearStaleBuffer(const std::string& laser_frame) {
+  const ros::Time latest =
+      latestChainStamp(*tf_, config_.odom_frame, config_.base_frame, laser_frame);
+  const auto ahead = aheadOfSimClock(latest, simClockNow(), ros::Time::isSimTime());
+  if (!ahead) return;
+  warn_->warn("stale tf",
+              "clearing tf again: it still held transforms from before time jumped back (" +
+                  std::to_string(*ahead) + " s ahead of /clock)");
+  tf_->clear();
+}
+
+// After anything that moved the filter: map -> odom goes to the republisher
+// and the pose to the saver, neither of which may wait for the filter (an
+// update can hold it for longer than a scan period: a saver on the main
+// spinner that waited would hold back the scans and odometry queued behind it).
+void LiveLocalizer::filterChanged(const ros::Time& scan_stamp) {
+  republisher_->set(localizer_.mapToOdom(ros::Time()), scan_stamp);
+  if (config_.save_pose_rate <= 0.0) return;  // nothing is ever saved
+  saver_.set(poseToSave(localizer_, last_odom_));
+}
+
+}  // namespace pf_ros

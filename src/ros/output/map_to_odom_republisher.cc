@@ -1,0 +1,170 @@
+#include "pf_localization/ros/output/map_to_odom_republisher.h"
+
+#include <pthread.h>
+#include <sys/timerfd.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdint>
+#include <utility>
+
+namespace pf_ros {
+namespace {
+
+// s: the shortest the timer is armed for (0 would disarm it).
+constexpr double kMinWait = 1e-6;
+
+// Periods without a publication after which map -> odom is republished on
+// the wall clock. tf users are promised no gap over two periods: an update
+// within one and a half makes the timed copy needless (scans at 14 Hz and
+// more: most of them), and the half period left covers the latency of a
+// loaded computer. Under simulated time every delay of the wall clock is
+// multiplied by the bag's rate and the clock moves in steps, so the timed
+// copy comes after one period, as the whole margin is needed there.
+constexpr double kWallClockPeriods = 1.5;
+
+}  // namespace
+
+bool RepublishSchedule::due(const ros::Time& now, const ros::Duration& period) {
+  if (next_.isZero() || now + period < next_) next_ = now;
+  return now >= next_;
+}
+
+MapToOdomRepublisher::MapToOdomRepublisher(const MapToOdomRepublisherOptions& options,
+                                           TickHook hook)
+    : options_(options), hook_(std::move(hook)) {}
+
+void MapToOdomRepublisher::start(ros::NodeHandle clock_nh) {
+  if (thread_.joinable() || clock_sub_) return;
+  if (ros::Time::isSimTime()) {
+    clock_sub_ = clock_nh.subscribe<rosgraph_msgs::Clock>(
+        "/clock", 1, [this](const rosgraph_msgs::ClockConstPtr& msg) { onClock(msg->clock); });
+  } else {
+    timer_fd_ = ::timerfd_create(CLOCK_MONOTONIC, TFD_CLOEXEC);
+    if (timer_fd_ < 0) {
+      ROS_ERROR("pf_node: no timer for republishing map -> odom (timerfd_create: errno %d)", errno);
+      return;
+    }
+    armLocked(kMinWait);  // the first publication is due at once
+    thread_ = std::thread([this] { run(); });
+  }
+}
+
+MapToOdomRepublisher::~MapToOdomRepublisher() {
+  clock_sub_.shutdown();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    stop_ = true;
+    armLocked(kMinWait);  // wakes the thread
+  }
+  if (thread_.joinable()) thread_.join();
+  if (timer_fd_ >= 0) ::close(timer_fd_);
+}
+
+bool MapToOdomRepublisher::set(const std::optional<geometry_msgs::TransformStamped>& map_to_odom,
+                               const ros::Time& scan_stamp) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  transform_ = map_to_odom;
+  if (!scan_stamp.isZero()) scan_stamp_ = std::max(scan_stamp_, scan_stamp);
+  const ros::Time now = ros::Time::now();
+  ros::Time stamp = std::max(now, scan_stamp_) + ros::Duration(options_.transform_tolerance);
+  // A correction must reach tf now even when the clock has not moved since
+  // the last timed publication.
+  if (!last_stamp_.isZero() && stamp <= last_stamp_) stamp = last_stamp_ + ros::Duration(1e-3);
+  if (!publishLocked(stamp)) return false;
+  if (!now.isZero()) {
+    schedule_.published(now, delayLocked());
+    armLocked(delayLocked().toSec());  // puts the thread's wake-up off, without waking it
+  }
+  return true;
+}
+
+void MapToOdomRepublisher::reset() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  transform_.reset();
+  scan_stamp_ = ros::Time();
+  last_stamp_ = ros::Time();
+  schedule_.reset();
+}
+
+void MapToOdomRepublisher::setRate(double hz) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  options_.rate = hz;
+  armLocked(kMinWait);  // the thread times the next publication by the new rate
+}
+
+void MapToOdomRepublisher::setTransformTolerance(double seconds) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  options_.transform_tolerance = seconds;
+}
+
+std::size_t MapToOdomRepublisher::published() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return published_;
+}
+
+void MapToOdomRepublisher::onClock(const ros::Time& now) {
+  std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
+  if (lock.owns_lock() && !stop_) tick(now, &lock);
+}
+
+void MapToOdomRepublisher::run() {
+  pthread_setname_np(pthread_self(), "pf_map_odom");
+  for (;;) {
+    std::uint64_t expirations = 0;
+    if (::read(timer_fd_, &expirations, sizeof expirations) < 0 && errno != EINTR) {
+      ROS_ERROR("pf_node: the map -> odom timer failed (errno %d): republishing stops", errno);
+      return;
+    }
+    std::unique_lock<std::mutex> lock(mutex_);
+    if (stop_) return;
+    tick(ros::Time::now(), &lock);
+    if (stop_) return;
+    // Until the next is due; set() moves that later without waking the thread.
+    armLocked(std::max((schedule_.next() - ros::Time::now()).toSec(), kMinWait));
+  }
+}
+
+ros::Duration MapToOdomRepublisher::delayLocked() const {
+  return ros::Duration((timer_fd_ >= 0 ? kWallClockPeriods : 1.0) / options_.rate);
+}
+
+void MapToOdomRepublisher::armLocked(double seconds) {
+  if (timer_fd_ < 0) return;
+  itimerspec spec{};
+  const auto ns = static_cast<std::int64_t>(std::max(seconds, kMinWait) * 1e9);
+  spec.it_value.tv_sec = static_cast<time_t>(ns / 1000000000);
+  spec.it_value.tv_nsec = static_cast<decltype(spec.it_value.tv_nsec)>(ns % 1000000000);
+  ::timerfd_settime(timer_fd_, 0, &spec, nullptr);
+}
+
+void MapToOdomRepublisher::tick(const ros::Time& now, std::unique_lock<std::mutex>* lock) {
+  const ros::Duration period = delayLocked();
+  // Zero: simulated time has not started.
+  if (now.isZero() || !schedule_.due(now, period)) return;
+  // The tick counts as a publication even when it has nothing new to send
+  // (no map -> odom yet, or no later stamp): otherwise it would stay due.
+  schedule_.published(now, period);
+  if (hook_) {
+    lock->unlock();
+    hook_(now);
+    lock->lock();
+    if (stop_) return;
+  }
+  const ros::Time stamp = std::max(now, scan_stamp_) + ros::Duration(options_.transform_tolerance);
+  // Between updates, only a later stamp is news (and tf2 refuses a repeated one).
+  if (stamp > last_stamp_) publishLocked(stamp);
+}
+
+bool MapToOdomRepublisher::publishLocked(ros::Time stamp) {
+  if (!options_.enabled || !transform_) return false;
+  geometry_msgs::TransformStamped t = *transform_;
+  t.header.stamp = stamp;
+  broadcaster_.sendTransform(t);
+  last_stamp_ = stamp;
+  ++published_;
+  return true;
+}
+
+}  // namespace pf_ros

@@ -1,0 +1,94 @@
+#include "pf_localization/core/map/bicubic_distance_field.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <vector>
+
+namespace pf {
+namespace {
+
+// 10 x 5 cells of 0.1 m whose column 0 is a wall: the distance at column i
+// is 0.1 i, a linear ramp in x, the same in every row.
+OccupancyGrid wallOnTheLeft(const Pose2& origin = {}) {
+  std::vector<int8_t> data(50, 0);
+  for (int y = 0; y < 5; ++y) data[y * 10] = 100;
+  return OccupancyGrid(10, 5, 0.1, origin, data);
+}
+
+TEST(BicubicDistanceField, PassesThroughTheCellCentres) {
+  // One obstacle at cell (2, 2) of a 5 x 5 grid of 0.1 m cells.
+  std::vector<int8_t> data(25, 0);
+  data[2 * 5 + 2] = 100;
+  const LikelihoodField field(OccupancyGrid(5, 5, 0.1, {}, data), 2.0);
+  const BicubicDistanceField smooth(field);
+  for (int y = 0; y < 5; ++y) {
+    for (int x = 0; x < 5; ++x) {
+      const FieldSample s = smooth.sample((x + 0.5) * 0.1, (y + 0.5) * 0.1);
+      EXPECT_NEAR(field.distance({x, y}), s.distance, 1e-6) << x << "," << y;
+    }
+  }
+  // The obstacle's centre is a minimum: zero, and flat by symmetry.
+  const FieldSample centre = smooth.sample(0.25, 0.25);
+  EXPECT_NEAR(0.0, centre.distance, 1e-12);
+  EXPECT_NEAR(0.0, centre.dx, 1e-12);
+  EXPECT_NEAR(0.0, centre.dy, 1e-12);
+}
+
+TEST(BicubicDistanceField, ReproducesTheRampBesideAWall) {
+  const LikelihoodField field(wallOnTheLeft(), 2.0);
+  const BicubicDistanceField smooth(field);
+  // x = 0.43 m is 3.8 cells from the wall's centre: the stencil (columns 2
+  // to 5, rows 1 to 4) lies on the ramp, which the cubic reproduces exactly.
+  const FieldSample s = smooth.sample(0.43, 0.27);
+  EXPECT_NEAR(0.38, s.distance, 1e-6);
+  EXPECT_NEAR(1.0, s.dx, 1e-6);
+  EXPECT_NEAR(0.0, s.dy, 1e-6);
+}
+
+TEST(BicubicDistanceField, FollowsARotatedOrigin) {
+  // The same grid turned a quarter left about (1, 0): the ramp runs along +y.
+  const LikelihoodField field(wallOnTheLeft({1.0, 0.0, M_PI / 2}), 2.0);
+  const BicubicDistanceField smooth(field);
+  // Grid point (0.43, 0.27) is world (1 - 0.27, 0.43).
+  const FieldSample s = smooth.sample(0.73, 0.43);
+  EXPECT_NEAR(0.38, s.distance, 1e-6);
+  EXPECT_NEAR(0.0, s.dx, 1e-6);
+  EXPECT_NEAR(1.0, s.dy, 1e-6);
+}
+
+TEST(BicubicDistanceField, GradientIsTheDerivativeOfTheValue) {
+  // Near a corner of two walls, where the field bends.
+  std::vector<int8_t> data(36, 0);
+  for (int i = 0; i < 6; ++i) data[i] = data[i * 6] = 100;
+  const LikelihoodField field(OccupancyGrid(6, 6, 0.1, {0.2, -0.1, 0.3}, data), 2.0);
+  const BicubicDistanceField smooth(field);
+  const double h = 1e-6;
+  for (const auto& p : {std::pair<double, double>{0.41, 0.17}, {0.33, 0.08}, {0.55, 0.29}}) {
+    const FieldSample s = smooth.sample(p.first, p.second);
+    const double dx = (smooth.sample(p.first + h, p.second).distance -
+                       smooth.sample(p.first - h, p.second).distance) /
+                      (2 * h);
+    const double dy = (smooth.sample(p.first, p.second + h).distance -
+                       smooth.sample(p.first, p.second - h).distance) /
+                      (2 * h);
+    EXPECT_NEAR(dx, s.dx, 1e-6);
+    EXPECT_NEAR(dy, s.dy, 1e-6);
+  }
+}
+
+TEST(BicubicDistanceField, FarOffTheMapIsMaxDistanceAndFlat) {
+  const LikelihoodField field(wallOnTheLeft(), 1.5);
+  const BicubicDistanceField smooth(field);
+  for (const double x : {-50.0, 50.0, std::numeric_limits<double>::quiet_NaN(),
+                         std::numeric_limits<double>::infinity()}) {
+    const FieldSample s = smooth.sample(x, 0.2);
+    EXPECT_EQ(1.5, s.distance);
+    EXPECT_EQ(0.0, s.dx);
+    EXPECT_EQ(0.0, s.dy);
+  }
+}
+
+}  // namespace
+}  // namespace pf

@@ -1,0 +1,135 @@
+#include "pf_localization/core/map/distance_transform.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+namespace pf {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// Row-major from the lower-left cell, like the grids: index = y * width + x.
+std::vector<bool> sources(int width, int height, const std::vector<std::pair<int, int>>& cells) {
+  std::vector<bool> is_source(static_cast<std::size_t>(width) * height, false);
+  for (const auto& c : cells) is_source[c.second * width + c.first] = true;
+  return is_source;
+}
+
+std::vector<float> bruteForce(const std::vector<bool>& is_source, int width, int height) {
+  std::vector<float> out(is_source.size(), kInf);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      for (int sy = 0; sy < height; ++sy) {
+        for (int sx = 0; sx < width; ++sx) {
+          if (!is_source[sy * width + sx]) continue;
+          const float d = static_cast<float>((x - sx) * (x - sx) + (y - sy) * (y - sy));
+          out[y * width + x] = std::min(out[y * width + x], d);
+        }
+      }
+    }
+  }
+  return out;
+}
+
+TEST(SquaredDistanceTransform, OneSource) {
+  // 5 x 4, source at (1, 1): (x - 1)^2 + (y - 1)^2.
+  const std::vector<float> expected = {
+      2, 1, 2, 5, 10,  // y = 0
+      1, 0, 1, 4, 9,   // y = 1
+      2, 1, 2, 5, 10,  // y = 2
+      5, 4, 5, 8, 13,  // y = 3
+  };
+  EXPECT_EQ(expected, squaredDistanceTransform(sources(5, 4, {{1, 1}}), 5, 4));
+}
+
+TEST(SquaredDistanceTransform, TwoSourcesTakeTheNearer) {
+  // 5 x 4, sources at (0, 0) and (4, 3): min(x^2 + y^2, (x - 4)^2 + (y - 3)^2).
+  // E.g. (3, 0): min(9, 1 + 9) = 9; (2, 2): min(8, 4 + 1) = 5; (1, 3): min(10, 9) = 9.
+  const std::vector<float> expected = {
+      0, 1, 4, 9, 9,  // y = 0
+      1, 2, 5, 5, 4,  // y = 1
+      4, 5, 5, 2, 1,  // y = 2
+      9, 9, 4, 1, 0,  // y = 3
+  };
+  EXPECT_EQ(expected, squaredDistanceTransform(sources(5, 4, {{0, 0}, {4, 3}}), 5, 4));
+}
+
+TEST(SquaredDistanceTransform, NoSourceIsInfiniteEverywhere) {
+  const std::vector<float> d = squaredDistanceTransform(sources(5, 4, {}), 5, 4);
+  ASSERT_EQ(20u, d.size());
+  for (float v : d) EXPECT_EQ(kInf, v);
+}
+
+TEST(SquaredDistanceTransform, AllSourcesIsZeroEverywhere) {
+  const std::vector<float> d = squaredDistanceTransform(std::vector<bool>(20, true), 5, 4);
+  EXPECT_EQ(std::vector<float>(20, 0.0f), d);
+}
+
+TEST(SquaredDistanceTransform, SingleRowAndSingleColumn) {
+  // 6 x 1, source at x = 4: (x - 4)^2.
+  EXPECT_EQ((std::vector<float>{16, 9, 4, 1, 0, 1}),
+            squaredDistanceTransform(sources(6, 1, {{4, 0}}), 6, 1));
+  // 1 x 6, source at y = 1.
+  EXPECT_EQ((std::vector<float>{1, 0, 1, 4, 9, 16}),
+            squaredDistanceTransform(sources(1, 6, {{0, 1}}), 1, 6));
+  EXPECT_EQ((std::vector<float>{0}), squaredDistanceTransform({true}, 1, 1));
+  EXPECT_EQ((std::vector<float>{kInf}), squaredDistanceTransform({false}, 1, 1));
+}
+
+TEST(SquaredDistanceTransform, SourceOnlyInOneColumnReachesTheWholeGrid) {
+  // Columns without any source must still get distances through the row pass.
+  // 4 x 3, source at (3, 2): (x - 3)^2 + (y - 2)^2.
+  const std::vector<float> expected = {
+      13, 8, 5, 4,  // y = 0
+      10, 5, 2, 1,  // y = 1
+      9,  4, 1, 0,  // y = 2
+  };
+  EXPECT_EQ(expected, squaredDistanceTransform(sources(4, 3, {{3, 2}}), 4, 3));
+}
+
+TEST(SquaredDistanceTransform, EmptyGridsGiveNothing) {
+  EXPECT_TRUE(squaredDistanceTransform({}, 0, 0).empty());
+  EXPECT_TRUE(squaredDistanceTransform({}, 5, 0).empty());
+  EXPECT_TRUE(squaredDistanceTransform({}, 0, 5).empty());
+}
+
+TEST(SquaredDistanceTransform, MatchesBruteForceOnRandomGrids) {
+  std::mt19937 rng(1234);
+  const int width = 30, height = 20;
+  // Dense, sparse, and a single source: the last two give large distances
+  // next to cells the passes treat as "no source".
+  for (double density : {0.3, 0.1, 0.02, 0.003}) {
+    std::bernoulli_distribution is_source(density);
+    for (int trial = 0; trial < 5; ++trial) {
+      std::vector<bool> grid(width * height);
+      for (std::size_t i = 0; i < grid.size(); ++i) grid[i] = is_source(rng);
+      const std::vector<float> expected = bruteForce(grid, width, height);
+      const std::vector<float> actual = squaredDistanceTransform(grid, width, height);
+      ASSERT_EQ(expected.size(), actual.size());
+      for (std::size_t i = 0; i < expected.size(); ++i) {
+        ASSERT_EQ(expected[i], actual[i])
+            << "cell (" << i % width << ", " << i / width << "), density " << density;
+      }
+    }
+  }
+}
+
+TEST(SquaredDistanceTransform, FarCornersOfALargerGridAreExact) {
+  // 400 x 300 with one source in a corner: the far corner is 399^2 + 299^2.
+  const int width = 400, height = 300;
+  const std::vector<float> d =
+      squaredDistanceTransform(sources(width, height, {{0, 0}}), width, height);
+  EXPECT_EQ(0.0f, d[0]);
+  EXPECT_EQ(399.0f * 399.0f + 299.0f * 299.0f, d.back());
+  EXPECT_EQ(399.0f * 399.0f, d[width - 1]);
+  EXPECT_EQ(299.0f * 299.0f, d[(height - 1) * width]);
+  EXPECT_EQ(123.0f * 123.0f + 77.0f * 77.0f, d[77 * width + 123]);
+}
+
+}  // namespace
+}  // namespace pf

@@ -1,0 +1,125 @@
+// The layer of where the world no longer matches its map
+// (map_change_layer.h): a room whose map lacks one box and has another that
+// is gone, scanned from a few poses.
+#include "pf_localization/core/map/map_change_layer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "pf_localization/core/map/map_loader.h"
+#include "support/rooms.h"
+#include "support/scan_simulator.h"
+
+namespace pf {
+namespace {
+
+using test::Box;
+using test::room;
+using test::simulateScan;
+
+const Box kAdded{4.0, 1.7, 4.6, 2.3};    // in the world, not on the map
+const Box kRemoved{1.2, 2.6, 1.8, 3.2};  // on the map, not in the world
+
+OccupancyGrid world() { return room(6.0, 4.0, 0.05, {kAdded}); }
+OccupancyGrid mapOf() { return room(6.0, 4.0, 0.05, {kRemoved}); }
+
+// A 360-beam scan of `seen` from `p`, as a Neato's.
+LaserScan scan360(const OccupancyGrid& seen, const Pose2& p) {
+  test::ScanSpec spec;
+  spec.beams = 360;
+  spec.angle_increment = 2.0 * M_PI / 360;
+  return simulateScan(seen, p, spec);
+}
+
+// The robot's poses: round the room's middle, where it sees both boxes.
+std::vector<Pose2> tour() {
+  return {{3.0, 2.0, 0.0}, {2.6, 1.2, 0.5}, {2.0, 1.0, 1.6}, {3.2, 2.8, -2.0}, {2.5, 2.2, 3.0}};
+}
+
+// The cells of `box` and one cell round it in state `c`: a beam's end
+// point lies in the cell before a face as often as in the face's.
+int cellsIn(const MapChangeLayer& layer, const OccupancyGrid& grid, const Box& box,
+            MapChangeLayer::Cell c) {
+  const double r = grid.resolution();
+  const CellIndex lo = grid.worldToCell(box.x0 - r, box.y0 - r),
+                  hi = grid.worldToCell(box.x1 + r, box.y1 + r);
+  int n = 0;
+  for (int y = lo.y; y <= hi.y; ++y) {
+    for (int x = lo.x; x <= hi.x; ++x) n += layer.cell(x, y) == c;
+  }
+  return n;
+}
+
+// The layer after the tour, each pose scanned `times` times.
+MapChangeLayer toured(const OccupancyGrid& map, const OccupancyGrid& seen, int times) {
+  const LikelihoodField field(map, 2.0);
+  MapChangeLayer layer(field);
+  for (int k = 0; k < times; ++k) {
+    for (const Pose2& p : tour()) layer.add(scan360(seen, p), p);
+  }
+  return layer;
+}
+
+TEST(MapChangeLayer, AWorldAsMappedHasNoChange) {
+  const MapChangeLayer layer = toured(mapOf(), mapOf(), 3);
+  const MapChangeLayer::Summary s = layer.summary();
+  EXPECT_GT(s.seen, 3000u);
+  EXPECT_EQ(0u, s.added);
+  EXPECT_EQ(0u, s.removed);
+  EXPECT_EQ(15u, layer.scans());
+}
+
+TEST(MapChangeLayer, FindsWhatTheMapLacksAndWhatIsGone) {
+  const OccupancyGrid map = mapOf();
+  const MapChangeLayer layer = toured(map, world(), 3);
+  // The added box's faces towards the tour are hit: a 0.6 m face is 12 cells.
+  EXPECT_GE(cellsIn(layer, map, kAdded, MapChangeLayer::Cell::kAdded), 20);
+  // The gone box is seen through: most of its 13 x 13 cells.
+  EXPECT_GE(cellsIn(layer, map, kRemoved, MapChangeLayer::Cell::kRemoved), 100);
+  // Nothing else: every changed cell is one of the boxes'.
+  const MapChangeLayer::Summary s = layer.summary();
+  EXPECT_EQ(s.added,
+            static_cast<std::size_t>(cellsIn(layer, map, kAdded, MapChangeLayer::Cell::kAdded)));
+  EXPECT_EQ(s.removed, static_cast<std::size_t>(
+                           cellsIn(layer, map, kRemoved, MapChangeLayer::Cell::kRemoved)));
+}
+
+TEST(MapChangeLayer, OneGlimpseIsNotAChange) {
+  // One scan is fewer than kMinScans, however many of its beams hit a cell...
+  const OccupancyGrid map = mapOf();
+  const LikelihoodField field(map, 2.0);
+  MapChangeLayer layer(field);
+  const Pose2 p = tour().front();
+  layer.add(scan360(world(), p), p);
+  EXPECT_EQ(0u, layer.summary().added);
+  // ...and something that stood there for a while and left is passed for
+  // longer than it was hit: a person, not a change of the building.
+  for (int k = 0; k < 4; ++k) layer.add(scan360(world(), p), p);
+  EXPECT_GT(layer.summary().added, 0u);
+  for (int k = 0; k < 10; ++k) layer.add(scan360(map, p), p);
+  EXPECT_EQ(0u, layer.summary().added);
+}
+
+TEST(MapChangeLayer, WritesTheMasksConvention) {
+  const OccupancyGrid map = mapOf();
+  const MapChangeLayer layer = toured(map, world(), 3);
+  const std::vector<std::uint8_t> pixels = layer.pixels();
+  const std::vector<std::int8_t> values = layer.occupancy();
+  ASSERT_EQ(map.data().size(), pixels.size());
+  ASSERT_EQ(map.data().size(), values.size());
+  std::size_t added = 0, removed = 0;
+  for (std::size_t i = 0; i < pixels.size(); ++i) {
+    added += pixels[i] == 0;
+    removed += pixels[i] == 205;
+    EXPECT_EQ(pixels[i] == 128, values[i] == -1);
+    EXPECT_EQ(pixels[i] == 0, values[i] == 100);
+  }
+  EXPECT_EQ(layer.summary().added, added);
+  EXPECT_EQ(layer.summary().removed, removed);
+  EXPECT_THROW(saveImage(map, std::vector<std::uint8_t>(3), "/tmp/x.yaml"), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pf
