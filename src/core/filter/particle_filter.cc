@@ -275,10 +275,10 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& measured
   // where it says is what the beams masked for changes of the map would hide.
   GateDecision gate = gate_.decide(odom, unmasked, sensor_.get(), isInitialized(), estimate_.pose,
                                    motion_.faults().suspect(params_.motion), params_);
-  // The beams that see a change of the map, judged only for an update: a
-  // scan between updates moves no particle.
+  // The beams that see a change of the map, judged for the fit between
+  // updates too: it moves the tracked pose the next update judges from.
   const bool between = gate.skip == SkipReason::kNotMoved;
-  const ScanGroup scans = maskMapChanges(gate.runs() ? judging : std::nullopt, unmasked);
+  const ScanGroup scans = maskMapChanges(judging, unmasked);
   UpdateReport report = gateReport(&gate, particles_.size());
   report.beams_masked = transients_.masked();
   report.beams_changed = changes_.masked();
