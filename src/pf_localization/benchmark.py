@@ -17,7 +17,7 @@ onto the reference), median and max error, the share of the run more than 0.5 m 
 covariance's honesty after the first 10 s (share of reference poses inside its 95 % ellipse, with
 the reference's own noise added; mean NEES, 2 if honest), yaw RMSE, convergence time, CPU time per
 update and wall time per run. With --workers N (a Dask LocalCluster of N worker processes) or --scheduler (a running Dask
-cluster: README.md, "Tuning the parameters: pf_tune") every run is a Dask task, as in pf_tune; the
+cluster: docs/tuning.md) every run is a Dask task, as in pf_tune; the
 table is the same, but CPU and wall times then include the contention of parallel runs. Each run's files (trajectory, update log, covariance, runner output, evaluation report) go to
 OUT/<dataset>_<particles>/; the table is also written to OUT/results.csv and OUT/results.md. Exit
 status 0 if every run succeeded, 1 if not (a missing data folder is not a failure: it is reported,

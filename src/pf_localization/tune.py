@@ -14,7 +14,7 @@ How it works
   ten bags keeps ten workers busy) and scores each run; the trial's value is the mean over the bags
   (lower is better). Without --scheduler a dask.distributed LocalCluster with --workers worker
   processes (default: one per core) is started and closed by the tool; with --scheduler the same
-  tasks go to an existing cluster (README.md, "Tuning the parameters: pf_tune").
+  tasks go to an existing cluster (docs/tuning.md).
 
 Objectives (chosen automatically unless --objective says otherwise, and printed)
   reference  every bag has /ground_truth, or --reference gives a TUM file per bag:

@@ -93,11 +93,11 @@ std::string py(const std::string& s) {
 
 const char* kYamlHeader =
     "# pf_localization parameters: every parameter of pf_node and pf_bag_runner, at its\n"
-    "# default. GENERATED from the parameter table (ros/localizer_config.cc and the core's\n"
+    "# default. GENERATED from the parameter table (ros/params/localizer_config.cc and the core's\n"
     "# options) by scripts/generate_param_files.sh; a unit test checks that it matches.\n"
     "# Loaded into pf_node's private namespace by launch/localization.launch and read by\n"
     "# `pf_bag_runner --params`. Each comment: [unit] valid values (live: can change while\n"
-    "# pf_node runs; amcl: amcl's parameter too) description. README.md, \"Parameters\".\n";
+    "# pf_node runs; amcl: amcl's parameter too) description. docs/parameters.md.\n";
 
 }  // namespace
 

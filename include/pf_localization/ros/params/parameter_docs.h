@@ -1,6 +1,6 @@
 // The files a user reads about the parameters, written from the one table
 // (localizerParameters()): config/pf.yaml, cfg/PfLocalization.cfg, the
-// README's table and `pf_node --help`. scripts/generate_param_files.sh writes
+// manual's table (docs/parameters.md) and `pf_node --help`. scripts/generate_param_files.sh writes
 // the committed files with pf_param_docs; a unit test fails when one of them
 // differs from what the table says, so they cannot drift.
 #pragma once
@@ -18,7 +18,7 @@ std::string configYaml();
 /// their sliders, plus amcl's kld_z and restore_defaults.
 std::string reconfigureCfg();
 
-/// The README's table: name, default, unit, range, live, amcl, description.
+/// The manual's table (docs/parameters.md): name, default, unit, range, live, amcl, description.
 std::string parameterMarkdown();
 
 /// `pf_node --help`: usage, then one line per parameter.
