@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""A bounded CPU hog for the rostests (issue 15): busy loops on ~processes
+"""A bounded CPU hog for the rostests: busy loops on ~processes
 processes (default: every core) for ~duration seconds of wall time (default
 60), started after ~delay s, then it exits. Run as an ordinary <node>: it
 takes the CPU from pf_node the way another process on a robot computer

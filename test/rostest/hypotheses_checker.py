@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""rostest checker for pf_hypotheses (issue 30): while the robot is in a room
+"""rostest checker for pf_hypotheses: while the robot is in a room
 identical to another, pf_node must publish both places; once it has left
 and says it is localized, one.
 

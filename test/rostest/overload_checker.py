@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""rostest checker for pf_node under overload (issue 15).
+"""rostest checker for pf_node under overload.
 
 Watches, while the bag plays (from the first to the last /ground_truth):
   - map -> odom on /tf: the largest gap between two consecutive stamps

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""rostest checker for a sensor that stops (issue 29): pf_node's pf_status
+"""rostest checker for a sensor that stops: pf_node's pf_status
 must name it as missing within max_delay [s] of it going, and not before,
 and must stop naming it within max_delay of it coming back.
 
