@@ -62,6 +62,7 @@
 #include <sensor_msgs/PointField.h>
 #include <tf2_msgs/TFMessage.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -519,8 +520,32 @@ double clearanceRadius(RigKind rig) {
   return rig == RigKind::kNeato ? kNeatoRadius : pf::sim::kAmrRadius;
 }
 
+// The cells under the rig's own objects that the map lacks (the warehouse
+// rig's pallets), added to `changed`'s mask: the lidar sees them as it sees
+// the changes. Returns how many.
+int addRigObjects(RigKind rig, pf::sim::ChangedWorld* changed) {
+  if (rig != RigKind::kWarehouse) return 0;
+  const pf::OccupancyGrid& world = changed->world;
+  int added = 0;
+  for (const pf::sim::Box3& box : pf::sim::warehousePallets()) {
+    const pf::CellIndex lo = world.worldToCell(box.x0, box.y0);
+    const pf::CellIndex hi = world.worldToCell(box.x1, box.y1);
+    for (int y = std::max(0, lo.y); y <= std::min(world.height() - 1, hi.y); ++y) {
+      for (int x = std::max(0, lo.x); x <= std::min(world.width() - 1, hi.x); ++x) {
+        double wx = 0.0, wy = 0.0;
+        world.cellToWorld({x, y}, &wx, &wy);
+        if (wx <= box.x0 || wx >= box.x1 || wy <= box.y0 || wy >= box.y1) continue;
+        pf::sim::CellChange& c = changed->mask[static_cast<std::size_t>(world.linearIndex({x, y}))];
+        if (c == pf::sim::CellChange::kUnchanged) c = pf::sim::CellChange::kAdded, ++added;
+      }
+    }
+  }
+  return added;
+}
+
 // The world the sensors see: the map, or with --changes the map changed,
-// whose changed share is printed and whose mask --change-mask writes.
+// whose changed share is printed and whose mask --change-mask writes (with
+// the rig's own objects the map lacks).
 pf::OccupancyGrid worldOf(const Options& o, pf::OccupancyGrid map) {
   if (o.changes.empty()) return map;
   pf::sim::ChangedWorld changed = pf::sim::applyMapChanges(map, pf::sim::loadMapChanges(o.changes));
@@ -528,6 +553,9 @@ pf::OccupancyGrid worldOf(const Options& o, pf::OccupancyGrid map) {
       "%s: %d cells changed: %d added, %d removed, %.1f %% of the map's %d occupied cells\n",
       o.changes.c_str(), changed.added + changed.removed, changed.added, changed.removed,
       100.0 * changed.changedShare(), changed.map_occupied);
+  if (const int objects = addRigObjects(o.rig, &changed)) {
+    std::printf("the rig's objects the map lacks: %d cells more in the mask\n", objects);
+  }
   if (!o.change_mask.empty()) {
     pf::saveMap(changed.maskGrid(), o.change_mask);
     std::printf("wrote %s: the true change mask\n", o.change_mask.c_str());

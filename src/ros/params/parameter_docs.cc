@@ -196,7 +196,8 @@ std::string parameterHelp(const std::string& program) {
   out << "usage: " << program << " [__name:=NAME] [_PARAM:=VALUE ...]\n"
       << "  (rosrun pf_localization pf_node, or roslaunch pf_localization localization.launch)\n\n"
       << "Subscribes scan, odom, map, initialpose; publishes map -> odom on tf, pf_pose, "
-         "amcl_pose,\nparticlecloud, pf_hypotheses, pf_status and /diagnostics. Parameters "
+         "amcl_pose,\nparticlecloud, pf_hypotheses, pf_status, pf_map_changes and /diagnostics. "
+         "Parameters "
          "(private namespace;\namcl's names are accepted too), with default and valid values; "
          "live ones can change\nwhile it runs (dynamic_reconfigure):\n";
   for (const Row& p : localizerParameters()) {
