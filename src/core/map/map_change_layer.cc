@@ -38,6 +38,13 @@ void MapChangeLayer::count(std::size_t i, Kind kind) {
       bump(&c.ends);
       break;
   }
+  values_[i] = valueOf(classify(i));
+}
+
+void MapChangeLayer::see(std::size_t i) {
+  if (cells_[i] & kSeen) return;
+  cells_[i] |= kSeen;
+  values_[i] = valueOf(Cell::kAsMapped);
 }
 
 MapChangeLayer::MapChangeLayer(const LikelihoodField& field)
@@ -64,11 +71,13 @@ MapChangeLayer::MapChangeLayer(const LikelihoodField& field)
     }
   }
   counts_.resize(cells_.size());
+  values_.assign(cells_.size(), valueOf(Cell::kUnseen));
 }
 
 void MapChangeLayer::clear() {
   std::fill(counts_.begin(), counts_.end(), Counts());
   for (std::uint8_t& c : cells_) c &= kMapBits;
+  std::fill(values_.begin(), values_.end(), valueOf(Cell::kUnseen));
   scans_ = 0;
 }
 
@@ -112,14 +121,15 @@ void MapChangeLayer::walk(double x, double y, double ux, double uy, double range
   double t = 0.0;
   while (t <= length && cx >= 0 && cy >= 0 && cx < width_ && cy < height_) {
     // Most cells are free, and only their byte is touched.
-    std::uint8_t& cell = cells_[static_cast<std::size_t>(cy) * width_ + cx];
+    const std::size_t i = static_cast<std::size_t>(cy) * width_ + cx;
+    std::uint8_t& cell = cells_[i];
     const std::uint8_t map = cell & kMapBits;
     if (map != kMapUnknown) {
-      cell |= kSeen;
+      see(i);
       if (map == kMapOccupied) {
-        count(static_cast<std::size_t>(cy) * width_ + cx, kPass);
+        count(i, kPass);
       } else if (cell & kWasHit) {
-        count(static_cast<std::size_t>(cy) * width_ + cx, kFree);
+        count(i, kFree);
       }
     }
     if (next_x < next_y) {
@@ -140,7 +150,8 @@ void MapChangeLayer::end(double x, double y) {
   if (cx < 0 || cy < 0 || cx >= width_ || cy >= height_) return;
   const std::size_t i = static_cast<std::size_t>(cy) * width_ + cx;
   if ((cells_[i] & kMapBits) == kMapFree) {
-    cells_[i] |= kSeen | kWasHit;
+    see(i);
+    cells_[i] |= kWasHit;
     count(i, kHit);
     return;
   }
@@ -150,7 +161,7 @@ void MapChangeLayer::end(double x, double y) {
     for (int nx = std::max(0, cx - 1); nx <= std::min(width_ - 1, cx + 1); ++nx) {
       const std::size_t j = static_cast<std::size_t>(ny) * width_ + nx;
       if ((cells_[j] & kMapBits) != kMapOccupied) continue;
-      cells_[j] |= kSeen;
+      see(j);
       count(j, kEnd);
     }
   }
@@ -186,41 +197,26 @@ MapChangeLayer::Summary MapChangeLayer::summary() const {
   return s;
 }
 
-namespace {
-
-template <typename T>
-std::vector<T> valuesOf(const MapChangeLayer& layer, T unseen, T as_mapped, T added, T removed) {
-  std::vector<T> out(static_cast<std::size_t>(layer.width()) * layer.height());
-  for (int y = 0; y < layer.height(); ++y) {
-    for (int x = 0; x < layer.width(); ++x) {
-      T& v = out[static_cast<std::size_t>(y) * layer.width() + x];
-      switch (layer.cell(x, y)) {
-        case MapChangeLayer::Cell::kUnseen:
-          v = unseen;
-          break;
-        case MapChangeLayer::Cell::kAsMapped:
-          v = as_mapped;
-          break;
-        case MapChangeLayer::Cell::kAdded:
-          v = added;
-          break;
-        case MapChangeLayer::Cell::kRemoved:
-          v = removed;
-          break;
-      }
-    }
+std::int8_t MapChangeLayer::valueOf(Cell c) {
+  switch (c) {
+    case Cell::kUnseen:
+      return -1;
+    case Cell::kAsMapped:
+      return 0;
+    case Cell::kAdded:
+      return 100;
+    case Cell::kRemoved:
+      return 50;
   }
-  return out;
-}
-
-}  // namespace
-
-std::vector<std::int8_t> MapChangeLayer::occupancy() const {
-  return valuesOf<std::int8_t>(*this, -1, 0, 100, 50);
+  return -1;
 }
 
 std::vector<std::uint8_t> MapChangeLayer::pixels() const {
-  return valuesOf<std::uint8_t>(*this, 128, 254, 0, 205);
+  std::vector<std::uint8_t> out(values_.size());
+  for (std::size_t i = 0; i < values_.size(); ++i) {
+    out[i] = values_[i] == 100 ? 0 : values_[i] == 50 ? 205 : values_[i] == 0 ? 254 : 128;
+  }
+  return out;
 }
 
 }  // namespace pf

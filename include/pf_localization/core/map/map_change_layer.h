@@ -81,8 +81,10 @@ class MapChangeLayer {
   Summary summary() const;
 
   /// Every cell as a nav_msgs/OccupancyGrid value, row-major from the
-  /// lower-left cell: -1 unseen, 0 seen as mapped, 100 added, 50 removed.
-  std::vector<std::int8_t> occupancy() const;
+  /// lower-left cell: -1 unseen, 0 seen as mapped, 100 added, 50 removed
+  /// (kept up to date as scans are added: a copy is all a message costs).
+  const std::vector<std::int8_t>& occupancy() const { return values_; }
+  static std::int8_t valueOf(Cell c);
   /// Every cell as an image's pixel (saveImage, map_loader.h), in the true
   /// change mask's convention (pf_simulator --change-mask): 0 added, 205
   /// removed, 254 seen as mapped; and 128 unseen.
@@ -111,6 +113,8 @@ class MapChangeLayer {
   Cell classify(std::size_t i) const;
   // Counts `kind` in cell i, once per scan.
   void count(std::size_t i, Kind kind);
+  // Marks cell i seen.
+  void see(std::size_t i);
   // One beam from (x, y) along (ux, uy), in cells of the grid's frame.
   void walk(double x, double y, double ux, double uy, double range);
   // The end point of a beam, in cells of the grid's frame.
@@ -122,6 +126,7 @@ class MapChangeLayer {
   double cos_yaw_, sin_yaw_;
   std::vector<std::uint8_t> cells_;  // MapCell | Flag
   std::vector<Counts> counts_;
+  std::vector<std::int8_t> values_;  // occupancy()
   std::size_t scans_ = 0;
   Pose2 last_;  // the robot pose of the last scan added
 };
