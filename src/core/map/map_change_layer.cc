@@ -70,12 +70,13 @@ MapChangeLayer::MapChangeLayer(const LikelihoodField& field)
         break;
     }
   }
-  counts_.resize(cells_.size());
+  // counts_ waits for the first scan: a warehouse's map is millions of
+  // cells, and pf_node builds this while the bag has started.
   values_.assign(cells_.size(), valueOf(Cell::kUnseen));
 }
 
 void MapChangeLayer::clear() {
-  std::fill(counts_.begin(), counts_.end(), Counts());
+  counts_.clear();
   for (std::uint8_t& c : cells_) c &= kMapBits;
   std::fill(values_.begin(), values_.end(), valueOf(Cell::kUnseen));
   scans_ = 0;
@@ -87,6 +88,7 @@ bool MapChangeLayer::wants(const Pose2& robot) const {
 }
 
 void MapChangeLayer::add(const ScanGroup& scans, const Pose2& robot) {
+  if (counts_.empty()) counts_.resize(cells_.size());
   for (const LaserScan& scan : scans) {
     const std::size_t n = scan.ranges.size();
     const Pose2 base = compose(robot, scan.robot_offset);
@@ -179,7 +181,7 @@ MapChangeLayer::Cell MapChangeLayer::classify(std::size_t i) const {
 
 MapChangeLayer::Summary MapChangeLayer::summary() const {
   Summary s;
-  for (std::size_t i = 0; i < counts_.size(); ++i) {
+  for (std::size_t i = 0; i < cells_.size(); ++i) {
     switch (classify(i)) {
       case Cell::kUnseen:
         continue;
