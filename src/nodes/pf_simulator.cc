@@ -525,19 +525,11 @@ double clearanceRadius(RigKind rig) {
 // the changes. Returns how many.
 int addRigObjects(RigKind rig, pf::sim::ChangedWorld* changed) {
   if (rig != RigKind::kWarehouse) return 0;
-  const pf::OccupancyGrid& world = changed->world;
   int added = 0;
   for (const pf::sim::Box3& box : pf::sim::warehousePallets()) {
-    const pf::CellIndex lo = world.worldToCell(box.x0, box.y0);
-    const pf::CellIndex hi = world.worldToCell(box.x1, box.y1);
-    for (int y = std::max(0, lo.y); y <= std::min(world.height() - 1, hi.y); ++y) {
-      for (int x = std::max(0, lo.x); x <= std::min(world.width() - 1, hi.x); ++x) {
-        double wx = 0.0, wy = 0.0;
-        world.cellToWorld({x, y}, &wx, &wy);
-        if (wx <= box.x0 || wx >= box.x1 || wy <= box.y0 || wy >= box.y1) continue;
-        pf::sim::CellChange& c = changed->mask[static_cast<std::size_t>(world.linearIndex({x, y}))];
-        if (c == pf::sim::CellChange::kUnchanged) c = pf::sim::CellChange::kAdded, ++added;
-      }
+    for (int i : pf::sim::cellsInBox(changed->world, {box.x0, box.y0, box.x1, box.y1})) {
+      pf::sim::CellChange& c = changed->mask[static_cast<std::size_t>(i)];
+      if (c == pf::sim::CellChange::kUnchanged) c = pf::sim::CellChange::kAdded, ++added;
     }
   }
   return added;

@@ -289,19 +289,28 @@ def read_pnm(path):
     return px.astype(float).mean(axis=2) / maxval
 
 
-def read_map(yaml_path):
-    """map_server YAML + image -> (grey image for display, extent [x0, x1, y0, y1] in m).
-    Occupied (p > occupied_thresh) is dark, free (p < free_thresh) white, the rest grey."""
-    _need_file(yaml_path, 'map YAML')
+def _map_yaml(yaml_path, what):
+    """A map_server YAML -> (its fields, the path of its image, which must exist)."""
+    _need_file(yaml_path, what + ' YAML')
     import yaml
     with open(yaml_path) as f:
         info = yaml.safe_load(f)
     try:
         image = os.path.join(os.path.dirname(os.path.abspath(yaml_path)), info['image'])
+    except (KeyError, TypeError) as e:
+        raise EvalError('%s YAML %s lacks image (%s)' % (what, yaml_path, e))
+    _need_file(image, what + ' image')
+    return info, image
+
+
+def read_map(yaml_path):
+    """map_server YAML + image -> (grey image for display, extent [x0, x1, y0, y1] in m).
+    Occupied (p > occupied_thresh) is dark, free (p < free_thresh) white, the rest grey."""
+    info, image = _map_yaml(yaml_path, 'map')
+    try:
         res, origin = float(info['resolution']), [float(v) for v in info['origin']]
     except (KeyError, TypeError, ValueError) as e:
         raise EvalError('map YAML %s lacks image/resolution/origin (%s)' % (yaml_path, e))
-    _need_file(image, 'map image')
     if image.lower().endswith(('.pgm', '.ppm', '.pnm')):
         v = read_pnm(image)
     else:  # map_server also accepts PNG etc.; Pillow reads those
@@ -324,12 +333,7 @@ CHANGE_ADDED, CHANGE_REMOVED, CHANGE_AS_MAPPED, CHANGE_UNSEEN = 0, 205, 254, 128
 
 def read_change_image(yaml_path):
     """A changes layer or a change mask (map_server pair) -> (h, w) uint8 pixels, row 0 the top."""
-    _need_file(yaml_path, 'changes YAML')
-    import yaml
-    with open(yaml_path) as f:
-        info = yaml.safe_load(f)
-    image = os.path.join(os.path.dirname(os.path.abspath(yaml_path)), str(info.get('image', '')))
-    _need_file(image, 'changes image')
+    _, image = _map_yaml(yaml_path, 'changes')
     return np.rint(read_pnm(image) * 255).astype(np.uint8)
 
 

@@ -51,6 +51,35 @@ MapChange parseLine(const LineParser<MapChangesError>& p, int line) {
   return c;
 }
 
+}  // namespace
+
+std::vector<int> cellsInBox(const OccupancyGrid& map, const Box& b) {
+  double lo_x = map.width(), lo_y = map.height(), hi_x = 0.0, hi_y = 0.0;
+  for (double x : {b.x0, b.x1}) {
+    for (double y : {b.y0, b.y1}) {
+      const Pose2 p = between(map.origin(), {x, y, 0.0});
+      lo_x = std::min(lo_x, p.x / map.resolution());
+      hi_x = std::max(hi_x, p.x / map.resolution());
+      lo_y = std::min(lo_y, p.y / map.resolution());
+      hi_y = std::max(hi_y, p.y / map.resolution());
+    }
+  }
+  std::vector<int> cells;
+  for (int j = std::max(0, static_cast<int>(lo_y) - 1);
+       j <= std::min(map.height() - 1, static_cast<int>(hi_y) + 1); ++j) {
+    for (int i = std::max(0, static_cast<int>(lo_x) - 1);
+         i <= std::min(map.width() - 1, static_cast<int>(hi_x) + 1); ++i) {
+      double x, y;
+      map.cellToWorld({i, j}, &x, &y);
+      if (x < b.x0 || x > b.x1 || y < b.y0 || y > b.y1) continue;
+      cells.push_back(map.linearIndex({i, j}));
+    }
+  }
+  return cells;
+}
+
+namespace {
+
 // A map's cells under change: the world's values on the map's geometry.
 class WorldCanvas {
  public:
@@ -109,30 +138,17 @@ class WorldCanvas {
 
   // The cells whose centres are inside the change's box (its disc).
   std::vector<int> cellsIn(const MapChange& c) const {
+    std::vector<int> cells = cellsInBox(map_, c.box);
+    if (c.kind != Kind::kAddDisc) return cells;
     const Box& b = c.box;
-    double lo_x = map_.width(), lo_y = map_.height(), hi_x = 0.0, hi_y = 0.0;
-    for (double x : {b.x0, b.x1}) {
-      for (double y : {b.y0, b.y1}) {
-        const Pose2 p = local(x, y);
-        lo_x = std::min(lo_x, p.x / map_.resolution());
-        hi_x = std::max(hi_x, p.x / map_.resolution());
-        lo_y = std::min(lo_y, p.y / map_.resolution());
-        hi_y = std::max(hi_y, p.y / map_.resolution());
-      }
-    }
     const double cx = 0.5 * (b.x0 + b.x1), cy = 0.5 * (b.y0 + b.y1), r = 0.5 * (b.x1 - b.x0);
-    std::vector<int> cells;
-    for (int j = std::max(0, static_cast<int>(lo_y) - 1);
-         j <= std::min(map_.height() - 1, static_cast<int>(hi_y) + 1); ++j) {
-      for (int i = std::max(0, static_cast<int>(lo_x) - 1);
-           i <= std::min(map_.width() - 1, static_cast<int>(hi_x) + 1); ++i) {
-        double x, y;
-        map_.cellToWorld({i, j}, &x, &y);
-        if (x < b.x0 || x > b.x1 || y < b.y0 || y > b.y1) continue;
-        if (c.kind == Kind::kAddDisc && std::hypot(x - cx, y - cy) > r) continue;
-        cells.push_back(map_.linearIndex({i, j}));
-      }
-    }
+    cells.erase(std::remove_if(cells.begin(), cells.end(),
+                               [&](int i) {
+                                 double x, y;
+                                 map_.cellToWorld({i % map_.width(), i / map_.width()}, &x, &y);
+                                 return std::hypot(x - cx, y - cy) > r;
+                               }),
+                cells.end());
     return cells;
   }
 

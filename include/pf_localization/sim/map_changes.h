@@ -90,6 +90,10 @@ struct ChangedWorld {
   OccupancyGrid maskGrid() const;
 };
 
+/// The linear indices of `map`'s cells whose centres lie in `box` (world
+/// frame, edges included), in increasing order.
+std::vector<int> cellsInBox(const OccupancyGrid& map, const Box& box);
+
 /// Applies `changes` to `map` and judges the result. Throws MapChangesError
 /// ("file:line: message") for a box off the map or a `remove` or `move` that
 /// finds no occupied cell.

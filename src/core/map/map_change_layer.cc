@@ -48,12 +48,7 @@ void MapChangeLayer::see(std::size_t i) {
 }
 
 MapChangeLayer::MapChangeLayer(const LikelihoodField& field)
-    : width_(field.grid().width()),
-      height_(field.grid().height()),
-      inv_resolution_(1.0 / field.grid().resolution()),
-      origin_(field.grid().origin()),
-      cos_yaw_(std::cos(origin_.yaw)),
-      sin_yaw_(std::sin(origin_.yaw)) {
+    : width_(field.grid().width()), height_(field.grid().height()), frame_(field.grid()) {
   const OccupancyGrid& grid = field.grid();
   const std::vector<float>& distance = field.distances();
   cells_.resize(grid.data().size());
@@ -95,15 +90,16 @@ void MapChangeLayer::add(const ScanGroup& scans, const Pose2& robot) {
     const bool skewed = !scan.sweep.isStill();
     const std::size_t stride = std::max<std::size_t>(1, n / kRaysPerScan);
     Pose2 sensor = compose(base, scan.sensor_pose);
+    double x, y;  // the sensor in cells of the grid's frame
+    frame_.pointInCells(sensor.x, sensor.y, &x, &y);
     for (std::size_t i = 0; i < n; i += stride) {
       if (!isReading(scan.ranges[i], scan.range_min, scan.range_max)) continue;
-      if (skewed) sensor = compose(base, sensorPoseAtBeam(scan.sensor_pose, scan.sweep, i));
-      const double angle =
-          sensor.yaw - origin_.yaw + scan.angle_min + static_cast<double>(i) * scan.angle_increment;
-      // The sensor in cells of the grid's frame.
-      const double dx = sensor.x - origin_.x, dy = sensor.y - origin_.y;
-      const double x = (cos_yaw_ * dx + sin_yaw_ * dy) * inv_resolution_;
-      const double y = (-sin_yaw_ * dx + cos_yaw_ * dy) * inv_resolution_;
+      if (skewed) {
+        sensor = compose(base, sensorPoseAtBeam(scan.sensor_pose, scan.sweep, i));
+        frame_.pointInCells(sensor.x, sensor.y, &x, &y);
+      }
+      const double angle = sensor.yaw - frame_.yaw() + scan.angle_min +
+                           static_cast<double>(i) * scan.angle_increment;
       walk(x, y, std::cos(angle), std::sin(angle), scan.ranges[i]);
     }
   }
@@ -112,7 +108,7 @@ void MapChangeLayer::add(const ScanGroup& scans, const Pose2& robot) {
 }
 
 void MapChangeLayer::walk(double x, double y, double ux, double uy, double range) {
-  const double length = (std::min(range, kMaxRange) - kEndMargin) * inv_resolution_;
+  const double length = (std::min(range, kMaxRange) - kEndMargin) * frame_.cellsPerMetre();
   int cx = static_cast<int>(std::floor(x)), cy = static_cast<int>(std::floor(y));
   const int step_x = ux >= 0.0 ? 1 : -1, step_y = uy >= 0.0 ? 1 : -1;
   const double inf = std::numeric_limits<double>::infinity();
@@ -144,7 +140,9 @@ void MapChangeLayer::walk(double x, double y, double ux, double uy, double range
       cy += step_y;
     }
   }
-  if (range <= kMaxRange) end(x + ux * range * inv_resolution_, y + uy * range * inv_resolution_);
+  if (range <= kMaxRange) {
+    end(x + ux * range * frame_.cellsPerMetre(), y + uy * range * frame_.cellsPerMetre());
+  }
 }
 
 void MapChangeLayer::end(double x, double y) {

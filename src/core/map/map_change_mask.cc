@@ -5,9 +5,8 @@
 namespace pf {
 namespace {
 
-// Whether a beam with this evidence sees a change of the map (masked when
-// the scan agrees with the map elsewhere).
-// Whether a beam sees a change of the map. One that passes a mapped
+// Whether a beam sees a change of the map (masked when the scan agrees with
+// the map elsewhere). One that passes a mapped
 // obstacle and ends on another (a removed object, or a blurred wall of a
 // real map seen through) fits where it ends, and is kept.
 bool seesChange(BeamEvidence e) {

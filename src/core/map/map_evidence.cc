@@ -41,12 +41,7 @@ void add(BeamEvidence e, EvidenceCounts* c) {
 }  // namespace
 
 MapEvidence::MapEvidence(const LikelihoodField& field)
-    : field_(&field),
-      caster_(field),
-      origin_(field.grid().origin()),
-      cos_yaw_(std::cos(origin_.yaw)),
-      sin_yaw_(std::sin(origin_.yaw)),
-      inv_resolution_(1.0 / field.grid().resolution()) {}
+    : field_(&field), caster_(field), frame_(field.grid()) {}
 
 BeamEvidence MapEvidence::judge(double sx, double sy, double angle, double range) const {
   return judgeRay(sx, sy, std::cos(angle), std::sin(angle), range);
@@ -67,11 +62,10 @@ BeamEvidence MapEvidence::judgeRay(double sx, double sy, double ux, double uy, d
   const double d = field_->distanceAt(sx + inside * ux, sy + inside * uy);
   // Where the map would stop the beam: its first obstacle along the ray, up to
   // just past the measured end (cast in the grid's frame, in cells).
-  const double dx = sx - origin_.x, dy = sy - origin_.y;
-  const double expected = caster_.castInCells((cos_yaw_ * dx + sin_yaw_ * dy) * inv_resolution_,
-                                              (-sin_yaw_ * dx + cos_yaw_ * dy) * inv_resolution_,
-                                              cos_yaw_ * ux + sin_yaw_ * uy,
-                                              -sin_yaw_ * ux + cos_yaw_ * uy, range + kShortMargin);
+  double cx, cy, gx, gy;
+  frame_.pointInCells(sx, sy, &cx, &cy);
+  frame_.directionInGrid(ux, uy, &gx, &gy);
+  const double expected = caster_.castInCells(cx, cy, gx, gy, range + kShortMargin);
   if (expected < range - kThroughMargin) {
     return d <= kOnMapDistance ? BeamEvidence::kThroughOntoMap : BeamEvidence::kThroughIntoOpen;
   }

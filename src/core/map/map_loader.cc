@@ -481,7 +481,6 @@ OccupancyGrid loadMap(const std::string& yaml_path) {
 }
 
 void saveMap(const OccupancyGrid& grid, const std::string& yaml_path) {
-  if (grid.empty()) throw std::invalid_argument("saveMap: the grid is empty");
   std::vector<std::uint8_t> pixels(grid.data().size());
   for (int y = 0; y < grid.height(); ++y) {
     for (int x = 0; x < grid.width(); ++x) {

@@ -121,9 +121,7 @@ class MapChangeLayer {
   void end(double x, double y);
 
   int width_, height_;
-  double inv_resolution_;
-  Pose2 origin_;
-  double cos_yaw_, sin_yaw_;
+  GridFrame frame_;                  // to walk in cells
   std::vector<std::uint8_t> cells_;  // MapCell | Flag
   std::vector<Counts> counts_;
   std::vector<std::int8_t> values_;  // occupancy()

@@ -118,8 +118,7 @@ class MapEvidence {
 
   const LikelihoodField* field_;
   DistanceFieldRayCaster caster_;
-  Pose2 origin_;  // the grid's, and its rotation: to cast in cells
-  double cos_yaw_, sin_yaw_, inv_resolution_;
+  GridFrame frame_;  // to cast in cells
 };
 
 }  // namespace pf

@@ -9,6 +9,7 @@
 // nor treat it as a wall.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -74,6 +75,37 @@ class OccupancyGrid {
   Pose2 origin_;
   std::vector<int8_t> data_;
   std::vector<int> free_cells_;
+};
+
+/// A grid's frame in cells, for walking rays cell by cell: world points and
+/// directions in continuous cell coordinates of the grid's own frame (its
+/// origin's position and rotation; cell (i, j) spans [i, i + 1) x [j, j + 1)).
+class GridFrame {
+ public:
+  explicit GridFrame(const OccupancyGrid& grid)
+      : origin_(grid.origin()),
+        cos_yaw_(std::cos(origin_.yaw)),
+        sin_yaw_(std::sin(origin_.yaw)),
+        cells_per_metre_(1.0 / grid.resolution()) {}
+
+  /// The grid's rotation in the world (rad).
+  double yaw() const { return origin_.yaw; }
+  double cellsPerMetre() const { return cells_per_metre_; }
+  /// The world point (x, y) in cells.
+  void pointInCells(double x, double y, double* cx, double* cy) const {
+    const double dx = x - origin_.x, dy = y - origin_.y;
+    *cx = (cos_yaw_ * dx + sin_yaw_ * dy) * cells_per_metre_;
+    *cy = (-sin_yaw_ * dx + cos_yaw_ * dy) * cells_per_metre_;
+  }
+  /// The world direction (ux, uy) turned into the grid's frame.
+  void directionInGrid(double ux, double uy, double* gx, double* gy) const {
+    *gx = cos_yaw_ * ux + sin_yaw_ * uy;
+    *gy = -sin_yaw_ * ux + cos_yaw_ * uy;
+  }
+
+ private:
+  Pose2 origin_;
+  double cos_yaw_, sin_yaw_, cells_per_metre_;
 };
 
 }  // namespace pf
