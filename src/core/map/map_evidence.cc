@@ -65,7 +65,11 @@ BeamEvidence MapEvidence::judgeRay(double sx, double sy, double ux, double uy, d
   double cx, cy, gx, gy;
   frame_.pointInCells(sx, sy, &cx, &cy);
   frame_.directionInGrid(ux, uy, &gx, &gy);
-  const double expected = caster_.castInCells(cx, cy, gx, gy, range + kShortMargin);
+  // An end beside a mapped obstacle is never short of the map: only an
+  // obstacle before it matters, and the cast stops there (the last cells
+  // before a wall are the ones it crosses one at a time).
+  const double reach = d <= kBesideObstacle ? range - kThroughMargin : range + kShortMargin;
+  const double expected = caster_.castInCells(cx, cy, gx, gy, reach);
   if (expected < range - kThroughMargin) {
     return d <= kOnMapDistance ? BeamEvidence::kThroughOntoMap : BeamEvidence::kThroughIntoOpen;
   }
