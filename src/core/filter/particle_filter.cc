@@ -101,6 +101,7 @@ bool ParticleFilter::setMap(const OccupancyGrid& grid) {
   if (grid.empty()) throw std::invalid_argument("the map is empty");
   sensor_.setModel(makeSensorModel(grid, params_));
   evidence_.emplace(sensor_.model().field());
+  layer_.emplace(sensor_.model().field());
   look_alikes_.setMap(sensor_.model().field());
   look_alike_places_.clear();
   search_.forgetModel();
@@ -321,7 +322,16 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& measured
   confidence_.demoteAfterLowFit(recovery_.lowFitViews(), params_.recovery.patience);
   report.updated = true;
   report.particles = particles_.size();
+  learnMapChanges(measured, report.map_agrees);
   return report;
+}
+
+void ParticleFilter::learnMapChanges(const ScanGroup& scans, bool map_agrees) {
+  if (!layer_ || !map_agrees || confidence_.confidence().state == LocalizationState::kLost ||
+      !layer_->wants(estimate_.pose)) {
+    return;
+  }
+  layer_->add(scans, estimate_.pose);
 }
 
 void ParticleFilter::estimateAndJudge(const std::vector<PreparedScan>& scans,

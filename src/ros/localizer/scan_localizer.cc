@@ -72,7 +72,6 @@ std::string ScanLocalizer::setMap(const nav_msgs::OccupancyGrid& map) {
   }
   const bool kept = filter_.setMap(grid);
   map_info_ = map.info;
-  changes_.emplace(filter_.sensorModel()->field());
   const bool first = !had_map_;
   had_map_ = true;
   if (kept) return "";
@@ -236,12 +235,6 @@ void ScanLocalizer::update(pf::LaserScan scan, std::size_t sensor, const ros::Ti
     group_.back().robot_offset = pf::between(*result->odom, s->odom);
   }
   result->report = filter_.update(*result->odom, group_);
-  const pf::UpdateReport& report = result->report;
-  if (changes_ && report.updated && report.map_agrees &&
-      filter_.confidence().state != pf::LocalizationState::kLost &&
-      changes_->wants(filter_.estimate().pose)) {
-    changes_->add(group_, filter_.estimate().pose);
-  }
   if (latest_.size() > 1) observeHealth(group_.front(), sensor, stamp);
   latest_[sensor] = SensorScan{std::move(group_.front()), *result->odom, stamp, false};
   if (result->report.updated) {
@@ -277,12 +270,13 @@ std::optional<geometry_msgs::PoseWithCovarianceStamped> ScanLocalizer::estimate(
 }
 
 std::optional<nav_msgs::OccupancyGrid> ScanLocalizer::mapChangesMsg(const ros::Time& stamp) const {
-  if (!changes_) return std::nullopt;
+  const pf::MapChangeLayer* changes = filter_.mapChanges();
+  if (!changes) return std::nullopt;
   nav_msgs::OccupancyGrid msg;
   msg.header.stamp = stamp;
   msg.header.frame_id = config_.global_frame;
   msg.info = map_info_;
-  msg.data = changes_->occupancy();
+  msg.data = changes->occupancy();
   return msg;
 }
 

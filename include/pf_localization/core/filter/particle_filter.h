@@ -38,6 +38,7 @@
 #include "pf_localization/core/filter/particle_set.h"
 #include "pf_localization/core/filter/resampler.h"
 #include "pf_localization/core/filter/update_gate.h"
+#include "pf_localization/core/map/map_change_layer.h"
 #include "pf_localization/core/map/map_change_mask.h"
 #include "pf_localization/core/map/map_evidence.h"
 #include "pf_localization/core/map/occupancy_grid.h"
@@ -130,6 +131,11 @@ class ParticleFilter {
   const OccupancyGrid* map() const {
     return sensor_.hasModel() ? &sensor_.model().field().grid() : nullptr;
   }
+  /// Where the world no longer matches the map, learned from the scans of
+  /// the updates that agreed with it at the tracked pose and left the filter
+  /// not lost, placed at the estimate (map_change_layer.h); null without a
+  /// map, and a new map starts it anew.
+  const MapChangeLayer* mapChanges() const { return layer_ ? &*layer_ : nullptr; }
 
   /// Particles drawn around `mean` from a Gaussian with covariance `cov`
   /// (x, y, yaw). Throws std::invalid_argument for a non-finite pose or a
@@ -206,6 +212,9 @@ class ParticleFilter {
                       std::size_t places);
   void resample(UpdateReport* report);
   void restartAfterInitialization(bool place_given);
+  // Adds `scans` to the layer of the map's changes after an update whose
+  // scans agreed with the map.
+  void learnMapChanges(const ScanGroup& scans, bool map_agrees);
   void reserveStorage(std::size_t max_particles);
 
   ParticleFilterParams params_;
@@ -220,6 +229,7 @@ class ParticleFilter {
   std::vector<LaserScan> masked_scans_;  // the scans with the transient beams masked
   std::optional<MapEvidence> evidence_;  // the map's rays (none without a map)
   MapChangeMask changes_;
+  std::optional<MapChangeLayer> layer_;   // over the map (none without one)
   std::vector<LaserScan> changed_scans_;  // the scans with the beams seeing changes masked
   UpdateGate gate_;                       // holds the odometry of the last update
   ConfidenceTracker confidence_;

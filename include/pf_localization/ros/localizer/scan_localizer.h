@@ -106,11 +106,9 @@ class ScanLocalizer {
   /// The particles, stamped `stamp`, in the global frame.
   geometry_msgs::PoseArray particleCloud(const ros::Time& stamp) const;
 
-  /// Where the world no longer matches the map (core/map/map_change_layer.h):
-  /// learned from the scans of the updates whose scans agreed with the map
-  /// at the tracked pose and left the filter localized, placed at the
-  /// estimate. Null before a map; a new map starts it anew.
-  const pf::MapChangeLayer* mapChanges() const { return changes_ ? &*changes_ : nullptr; }
+  /// Where the world no longer matches the map (ParticleFilter::mapChanges()).
+  /// Null before a map; a new map starts it anew.
+  const pf::MapChangeLayer* mapChanges() const { return filter_.mapChanges(); }
   /// That layer over the map as an OccupancyGrid (MapChangeLayer::occupancy()),
   /// stamped `stamp`; none before a map.
   std::optional<nav_msgs::OccupancyGrid> mapChangesMsg(const ros::Time& stamp) const;
@@ -145,7 +143,6 @@ class ScanLocalizer {
   pf::ParticleFilter filter_;
   bool had_map_ = false;
   nav_msgs::MapMetaData map_info_;                 // of the map in use
-  std::optional<pf::MapChangeLayer> changes_;      // over that map
   std::vector<std::optional<SensorScan>> latest_;  // per sensor
   std::vector<pf::LaserScan> group_;               // the scans of the current update
   pf::CloudScanReducer cloud_reducer_;
