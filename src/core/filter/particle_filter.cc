@@ -93,6 +93,7 @@ void ParticleFilter::setParams(const ParticleFilterParams& params) {
   if (model) {
     sensor_.setModel(std::move(model));
     evidence_.emplace(sensor_.model().field());
+    shareMapChanges(true);
     search_.forgetModel();
   }
 }
@@ -250,12 +251,13 @@ ScanGroup ParticleFilter::maskMapChanges(const std::optional<Pose2>& robot,
 
 bool ParticleFilter::judgesFromTrackedPose(const Pose2& odom) const {
   // A place not told apart from its look-alikes, a cloud that holds several,
-  // a look-alike that just fitted clearly better, an estimate that jumped
-  // and is not confirmed yet, a lost one: for the filter's evidence to
-  // settle, and what the map lacks at the tracked place may be what tells.
+  // an estimate that jumped and is not confirmed yet, a lost one: for the
+  // filter's evidence to settle, and what the map lacks at the tracked place
+  // may be what tells. A look-alike that fitted better once is not enough:
+  // the look-alike judge sees every beam, and unmasked, a change of the map
+  // (cabinets along a corridor's wall) pulls the tracked pose onto it.
   if (!evidence_ || !confidence_.placeKnown() || confidence_.settling() ||
-      confidence_.confidence().state == LocalizationState::kLost || places_ > 1 ||
-      look_alikes_.considering()) {
+      confidence_.confidence().state == LocalizationState::kLost || places_ > 1) {
     return false;
   }
   // After a long step, or odometry that may be what is wrong, the tracked
@@ -332,6 +334,24 @@ void ParticleFilter::learnMapChanges(const ScanGroup& scans, bool map_agrees) {
     return;
   }
   layer_->add(scans, estimate_.pose);
+  shareMapChanges(false);
+}
+
+void ParticleFilter::shareMapChanges(bool all) {
+  if (!layer_ || !evidence_) return;
+  if (all) {
+    layer_->takeChangedCells();
+    const std::size_t cells = static_cast<std::size_t>(layer_->width()) * layer_->height();
+    for (std::size_t i = 0; i < cells; ++i) {
+      if (layer_->removed(i)) evidence_->setGone(i, true);
+      if (layer_->added(i)) evidence_->setAdded(i, true);
+    }
+    return;
+  }
+  for (std::size_t i : layer_->takeChangedCells()) {
+    evidence_->setGone(i, layer_->removed(i));
+    evidence_->setAdded(i, layer_->added(i));
+  }
 }
 
 void ParticleFilter::estimateAndJudge(const std::vector<PreparedScan>& scans,

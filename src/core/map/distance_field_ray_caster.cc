@@ -54,6 +54,10 @@ void DistanceFieldRayCaster::fill(const OccupancyGrid& grid, Cells cells) {
   }
 }
 
+void DistanceFieldRayCaster::setOpen(int x, int y, bool open) {
+  skip_[static_cast<std::size_t>(y + 1) * stride_ + x + 1] = open ? 0.0f : kOccupied;
+}
+
 double DistanceFieldRayCaster::cast(double x, double y, double angle, double max_range) const {
   const double dx = x - origin_.x, dy = y - origin_.y;
   const double c = std::cos(origin_.yaw), s = std::sin(origin_.yaw);

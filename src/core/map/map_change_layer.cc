@@ -38,7 +38,15 @@ void MapChangeLayer::count(std::size_t i, Kind kind) {
       bump(&c.ends);
       break;
   }
+  const bool was_changed = removed(i) || added(i);
   values_[i] = valueOf(classify(i));
+  if (was_changed || removed(i) || added(i)) changed_cells_.push_back(i);
+}
+
+std::vector<std::size_t> MapChangeLayer::takeChangedCells() {
+  std::vector<std::size_t> out;
+  out.swap(changed_cells_);
+  return out;
 }
 
 void MapChangeLayer::see(std::size_t i) {
@@ -71,6 +79,9 @@ MapChangeLayer::MapChangeLayer(const LikelihoodField& field)
 }
 
 void MapChangeLayer::clear() {
+  for (std::size_t i = 0; i < values_.size(); ++i) {
+    if (removed(i) || added(i)) changed_cells_.push_back(i);
+  }
   counts_.clear();
   for (std::uint8_t& c : cells_) c &= kMapBits;
   std::fill(values_.begin(), values_.end(), valueOf(Cell::kUnseen));

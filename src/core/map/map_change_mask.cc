@@ -10,8 +10,8 @@ namespace {
 // obstacle and ends on another (a removed object, or a blurred wall of a
 // real map seen through) fits where it ends, and is kept.
 bool seesChange(BeamEvidence e) {
-  return e == BeamEvidence::kShortOfMap || e == BeamEvidence::kThroughIntoOpen ||
-         e == BeamEvidence::kOffMap;
+  return e == BeamEvidence::kShortOfMap || e == BeamEvidence::kThroughOntoAdded ||
+         e == BeamEvidence::kThroughIntoOpen || e == BeamEvidence::kOffMap;
 }
 
 }  // namespace

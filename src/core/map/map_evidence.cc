@@ -25,6 +25,7 @@ void add(BeamEvidence e, EvidenceCounts* c) {
       ++c->short_of_map;
       break;
     case BeamEvidence::kThroughOntoMap:
+    case BeamEvidence::kThroughOntoAdded:
       ++c->through_onto_map;
       break;
     case BeamEvidence::kThroughIntoOpen:
@@ -42,6 +43,37 @@ void add(BeamEvidence e, EvidenceCounts* c) {
 
 MapEvidence::MapEvidence(const LikelihoodField& field)
     : field_(&field), caster_(field), frame_(field.grid()) {}
+
+void MapEvidence::setGone(std::size_t cell, bool gone) {
+  const OccupancyGrid& grid = field_->grid();
+  const CellIndex c{static_cast<int>(cell % grid.width()), static_cast<int>(cell / grid.width())};
+  // Only a mapped obstacle can be gone.
+  if (grid.state(c) == CellState::kOccupied) caster_.setOpen(c.x, c.y, gone);
+}
+
+void MapEvidence::setAdded(std::size_t cell, bool added) {
+  if (added_.empty()) {
+    if (!added) return;
+    added_.assign(field_->grid().data().size(), 0);
+  }
+  added_[cell] = added ? 1 : 0;
+}
+
+bool MapEvidence::endsOnAdded(double x, double y) const {
+  if (added_.empty()) return false;
+  const OccupancyGrid& grid = field_->grid();
+  const CellIndex c = grid.worldToCell(x, y);
+  // Within a cell of one: an end point is a few centimetres off, and a face
+  // is learned added where the beams ended most often.
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      const CellIndex n{c.x + dx, c.y + dy};
+      if (grid.contains(n) && added_[static_cast<std::size_t>(n.y) * grid.width() + n.x])
+        return true;
+    }
+  }
+  return false;
+}
 
 BeamEvidence MapEvidence::judge(double sx, double sy, double angle, double range) const {
   return judgeRay(sx, sy, std::cos(angle), std::sin(angle), range);
@@ -70,11 +102,16 @@ BeamEvidence MapEvidence::judgeRay(double sx, double sy, double ux, double uy, d
   // before a wall are the ones it crosses one at a time).
   const double reach = d <= kBesideObstacle ? range - kThroughMargin : range + kShortMargin;
   const double expected = caster_.castInCells(cx, cy, gx, gy, reach);
+  // An end clear of the map's obstacles, on an object learned added (an
+  // object moved a little behind where the map has it), is a change of the
+  // map however near the map's obstacle it lies.
+  const bool on_added = d > kBesideObstacle && endsOnAdded(sx + range * ux, sy + range * uy);
   if (expected < range - kThroughMargin) {
-    return d <= kOnMapDistance ? BeamEvidence::kThroughOntoMap : BeamEvidence::kThroughIntoOpen;
+    if (d > kOnMapDistance) return BeamEvidence::kThroughIntoOpen;
+    return on_added ? BeamEvidence::kThroughOntoAdded : BeamEvidence::kThroughOntoMap;
   }
   if (expected >= range + kShortMargin && d > kBesideObstacle) return BeamEvidence::kShortOfMap;
-  return BeamEvidence::kOnMap;
+  return on_added ? BeamEvidence::kShortOfMap : BeamEvidence::kOnMap;
 }
 
 EvidenceCounts MapEvidence::judge(const LaserScan& scan, const Pose2& robot,

@@ -102,6 +102,27 @@ TEST(MapChangeLayer, OneGlimpseIsNotAChange) {
   EXPECT_EQ(0u, layer.summary().added);
 }
 
+TEST(MapChangeLayer, ListsEachCellThatBecameOrStoppedBeingAChange) {
+  const OccupancyGrid map = mapOf();
+  const LikelihoodField field(map, 2.0);
+  MapChangeLayer layer(field);
+  for (int k = 0; k < 3; ++k) {
+    for (const Pose2& p : tour()) layer.add(scan360(world(), p), p);
+  }
+  std::vector<std::size_t> changed = layer.takeChangedCells();
+  const MapChangeLayer::Summary s = layer.summary();
+  std::size_t now = 0;
+  for (std::size_t i : changed) now += layer.added(i) || layer.removed(i);
+  // Each changed cell is listed, perhaps more than once, and taken once.
+  EXPECT_GE(now, s.added + s.removed);
+  EXPECT_TRUE(layer.takeChangedCells().empty());
+  // Forgetting lists every cell that was a change, none of them one now.
+  layer.clear();
+  changed = layer.takeChangedCells();
+  EXPECT_GE(changed.size(), s.added + s.removed);
+  for (std::size_t i : changed) EXPECT_FALSE(layer.added(i) || layer.removed(i));
+}
+
 TEST(MapChangeLayer, WritesTheMasksConvention) {
   const OccupancyGrid map = mapOf();
   const MapChangeLayer layer = toured(map, world(), 3);

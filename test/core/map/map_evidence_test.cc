@@ -65,6 +65,51 @@ TEST(MapEvidence, ABeamThroughAMappedObjectThatIsGoneEndsBehindIt) {
   EXPECT_EQ(BeamEvidence::kOnMap, ahead(evidence, 1.2));
 }
 
+TEST(MapEvidence, AnObstacleLearnedGoneLetsRaysThroughAndLearnedBackStopsThem) {
+  const OccupancyGrid map = boxRoom(true);
+  const LikelihoodField field(map, 2.0);
+  MapEvidence evidence(field);
+  ASSERT_EQ(BeamEvidence::kThroughOntoMap, ahead(evidence, 2.95));
+  // Every cell of the box learned gone: the beam to the wall behind it is
+  // on the map as the world has it.
+  std::vector<std::size_t> box;
+  for (std::size_t i = 0; i < map.data().size(); ++i) {
+    const CellIndex c{static_cast<int>(i % map.width()), static_cast<int>(i / map.width())};
+    double x, y;
+    map.cellToWorld(c, &x, &y);
+    if (x > 3.9 && x < 4.7 && y > 1.6 && y < 2.4 && map.state(c) == CellState::kOccupied) {
+      box.push_back(i);
+    }
+  }
+  ASSERT_GT(box.size(), 100u);
+  for (std::size_t i : box) evidence.setGone(i, true);
+  EXPECT_EQ(BeamEvidence::kOnMap, ahead(evidence, 2.95));
+  // A free cell cannot be gone: marking one changes nothing.
+  const CellIndex free = map.worldToCell(3.5, 2.0);
+  evidence.setGone(static_cast<std::size_t>(free.y) * map.width() + free.x, true);
+  EXPECT_EQ(BeamEvidence::kOnMap, ahead(evidence, 2.95));
+  for (std::size_t i : box) evidence.setGone(i, false);
+  EXPECT_EQ(BeamEvidence::kThroughOntoMap, ahead(evidence, 2.95));
+}
+
+TEST(MapEvidence, AnEndOnAnObjectLearnedAddedSeesAChangeEvenBesideTheMap) {
+  // The world has a 0.2 m deep cabinet 0.15 m in front of the east wall
+  // (x 5.60-5.80): a beam ending on its face, 2.6 m ahead, ends within the
+  // wall's short margin, and looks on the map...
+  const OccupancyGrid map = boxRoom(false);
+  const LikelihoodField field(map, 2.0);
+  MapEvidence evidence(field);
+  ASSERT_EQ(BeamEvidence::kOnMap, ahead(evidence, 2.75));
+  // ...until the layer has learned the face added.
+  const CellIndex face = map.worldToCell(kRobot.x + 2.75, kRobot.y);
+  evidence.setAdded(static_cast<std::size_t>(face.y) * map.width() + face.x, true);
+  EXPECT_EQ(BeamEvidence::kShortOfMap, ahead(evidence, 2.75));
+  // An end on the mapped wall beside it stays on the map.
+  EXPECT_EQ(BeamEvidence::kOnMap, ahead(evidence, 2.95));
+  evidence.setAdded(static_cast<std::size_t>(face.y) * map.width() + face.x, false);
+  EXPECT_EQ(BeamEvidence::kOnMap, ahead(evidence, 2.75));
+}
+
 TEST(MapEvidence, ABeamOffTheMapIsOffItButJustPastTheEdgeIsJudgedThere) {
   const LikelihoodField field(boxRoom(false), 2.0);
   const MapEvidence evidence(field);

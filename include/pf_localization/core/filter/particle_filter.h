@@ -134,7 +134,9 @@ class ParticleFilter {
   /// Where the world no longer matches the map, learned from the scans of
   /// the updates that agreed with it at the tracked pose and left the filter
   /// not lost, placed at the estimate (map_change_layer.h); null without a
-  /// map, and a new map starts it anew.
+  /// map, and a new map starts it anew. The scans are judged on the map as
+  /// the layer has it (map_evidence.h): its obstacles seen gone no longer
+  /// stop rays, and a beam that ends on one it has seen added sees a change.
   const MapChangeLayer* mapChanges() const { return layer_ ? &*layer_ : nullptr; }
 
   /// Particles drawn around `mean` from a Gaussian with covariance `cov`
@@ -213,8 +215,11 @@ class ParticleFilter {
   void resample(UpdateReport* report);
   void restartAfterInitialization(bool place_given);
   // Adds `scans` to the layer of the map's changes after an update whose
-  // scans agreed with the map.
+  // scans agreed with the map, and shares what it learned with the judging.
   void learnMapChanges(const ScanGroup& scans, bool map_agrees);
+  // Tells the judging (evidence_) the layer's added and removed cells: those
+  // that changed, or (`all`) every one, for a new MapEvidence.
+  void shareMapChanges(bool all);
   void reserveStorage(std::size_t max_particles);
 
   ParticleFilterParams params_;

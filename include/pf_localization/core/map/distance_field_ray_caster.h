@@ -46,6 +46,12 @@ class DistanceFieldRayCaster {
   /// (max_range too): the form the beam model's inner loop uses.
   double castInCells(double cx, double cy, double dx, double dy, double max_range) const;
 
+  /// Lets rays through the map's occupied cell (x, y) (`open`: the obstacle
+  /// is gone), or stops them there again. The skip distances around it stay:
+  /// measured to an obstacle that no longer stops rays, they are only shorter
+  /// than they could be, and every range is still exact.
+  void setOpen(int x, int y, bool open);
+
   double resolution() const { return resolution_; }
   const Pose2& origin() const { return origin_; }
 

@@ -15,8 +15,11 @@
 // beam model's short and max readings (Thrun et al., "Probabilistic
 // Robotics", 2005, sec. 6.3) judged once per beam at one pose instead of per
 // particle. The ray is cast on the occupancy grid with the beam model's ray
-// caster (distance_field_ray_caster.h). See docs/design.md, "A map out of
-// date is not a wrong pose".
+// caster (distance_field_ray_caster.h), on the map as the change layer has
+// learned it (map_change_layer.h; the temporary map of Meyer-Delius et al.
+// used for the judging): rays pass the obstacles it has seen gone, and a
+// beam that ends on an object it has seen added sees a change. See
+// docs/design.md, "A map out of date is not a wrong pose".
 #pragma once
 
 #include <cstddef>
@@ -36,8 +39,10 @@ enum class BeamEvidence : std::uint8_t {
   kOnMap,       // ends on a mapped obstacle, the way there clear
   kShortOfMap,  // ends well before the map's next obstacle: something the map lacks
   // Passes a mapped obstacle well before its end (it is gone, or the pose is
-  // wrong), and ends on another one, or in the open.
+  // wrong), and ends on another one; near one, but on an object learned
+  // added (counted as ending on the map, but a change); or in the open.
   kThroughOntoMap,
+  kThroughOntoAdded,
   kThroughIntoOpen,
   kOffMap,  // ends outside the map
 };
@@ -56,13 +61,17 @@ struct EvidenceCounts {
   /// Beams that end on a mapped obstacle, whatever they passed.
   std::size_t endingOnMap() const { return on_map + through_onto_map; }
   /// Beams the map contradicts at this pose: through a mapped obstacle into
-  /// the open, or off the map; and, at half weight, through a mapped
-  /// obstacle onto another (a removed object, a thin obstacle's corner, a
-  /// blurred wall: common on a real map at the right pose).
+  /// the open, or off the map; and, at kThroughOntoMapWeight, through a
+  /// mapped obstacle onto another (a removed object, a thin obstacle's
+  /// corner, a blurred wall: common on a real map at the right pose).
   double contradicting() const {
     return static_cast<double>(through_into_open + off_map) +
-           0.5 * static_cast<double>(through_onto_map);
+           kThroughOntoMapWeight * static_cast<double>(through_onto_map);
   }
+  /// A quarter: a storage room whose two shelves are gone sends half its
+  /// beams through them onto the walls behind; at a wrong pose the beams
+  /// that run into the open or off the map are what tell.
+  static constexpr double kThroughOntoMapWeight = 0.25;
   /// Beams that pass a mapped obstacle, wherever they end.
   std::size_t throughMap() const { return through_onto_map + through_into_open; }
   EvidenceCounts& operator+=(const EvidenceCounts& o);
@@ -89,6 +98,13 @@ class MapEvidence {
 
   const LikelihoodField& field() const { return *field_; }
 
+  /// Rays pass the mapped obstacle at the grid's cell index `cell` when
+  /// `gone` (learned gone: MapChangeLayer), and stop there again when not.
+  void setGone(std::size_t cell, bool gone);
+  /// A beam that ends in the grid's cell `cell` ends on an obstacle the map
+  /// lacks when `added` (learned: MapChangeLayer).
+  void setAdded(std::size_t cell, bool added);
+
   /// The evidence of one beam from (sx, sy) along `angle` (world frame) that
   /// measured `range`.
   BeamEvidence judge(double sx, double sy, double angle, double range) const;
@@ -113,12 +129,15 @@ class MapEvidence {
   EvidenceCounts count(const std::vector<PreparedScan>& scans, const Pose2& robot) const;
 
  private:
+  // Whether (x, y) lies on or beside a cell learned added.
+  bool endsOnAdded(double x, double y) const;
   // judge() along the unit vector (ux, uy).
   BeamEvidence judgeRay(double sx, double sy, double ux, double uy, double range) const;
 
   const LikelihoodField* field_;
   DistanceFieldRayCaster caster_;
-  GridFrame frame_;  // to cast in cells
+  GridFrame frame_;                  // to cast in cells
+  std::vector<std::uint8_t> added_;  // per cell: setAdded() (empty until one is)
 };
 
 }  // namespace pf
