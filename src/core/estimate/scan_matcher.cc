@@ -8,6 +8,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 #include "pf_localization/core/util/parameter_table.h"
 
@@ -129,23 +130,46 @@ struct ScanRefiner::MatchedBeam {
   double w;       // the Cauchy weight, rho'(r^2 / 2) = 1 / q
 };
 
+// The field at every beam's end point, the scan placed at one pose.
+struct ScanRefiner::BeamSamples {
+  double c = 1.0, s = 0.0;     // the pose's cos and sin of yaw
+  std::vector<double> mx, my;  // the end points on the map
+  std::vector<FieldSample> f;  // the field there
+};
+
+void ScanRefiner::sampleBeams(const PreparedScan& scan, const Pose2& pose, BeamSamples* out) const {
+  const std::size_t n = scan.size();
+  out->c = std::cos(pose.yaw);
+  out->s = std::sin(pose.yaw);
+  out->mx.resize(n);
+  out->my.resize(n);
+  out->f.resize(n);
+  const double c = out->c, s = out->s;
+  for (std::size_t b = 0; b < n; ++b) {
+    const double px = scan.x[b], py = scan.y[b];
+    out->mx[b] = pose.x + c * px - s * py;
+    out->my[b] = pose.y + s * px + c * py;
+  }
+  field_.sample(out->mx.data(), out->my.data(), n, out->f.data());
+}
+
 template <typename Matched, typename Outlier>
-void ScanRefiner::forEachBeam(const PreparedScan& scan, const Pose2& pose, Matched&& matched,
+void ScanRefiner::forEachBeam(const PreparedScan& scan, const BeamSamples& at, Matched&& matched,
                               Outlier&& outlier) const {
   MatchedBeam beam;
-  beam.c = std::cos(pose.yaw);
-  beam.s = std::sin(pose.yaw);
+  beam.c = at.c;
+  beam.s = at.s;
   const double k2 = params_.cauchy_scale * params_.cauchy_scale;
   for (std::size_t b = 0; b < scan.size(); ++b) {
-    beam.px = scan.x[b];
-    beam.py = scan.y[b];
-    beam.mx = pose.x + beam.c * beam.px - beam.s * beam.py;
-    beam.my = pose.y + beam.s * beam.px + beam.c * beam.py;
-    beam.f = field_.sample(beam.mx, beam.my);
+    beam.f = at.f[b];
     if (!(beam.f.distance < params_.outlier_distance)) {
       outlier();
       continue;
     }
+    beam.px = scan.x[b];
+    beam.py = scan.y[b];
+    beam.mx = at.mx[b];
+    beam.my = at.my[b];
     beam.r = beam.f.distance - params_.wall_offset;
     beam.q = 1.0 + beam.r * beam.r / k2;
     beam.w = 1.0 / beam.q;
@@ -154,20 +178,20 @@ void ScanRefiner::forEachBeam(const PreparedScan& scan, const Pose2& pose, Match
 }
 
 ScanRefiner::Evaluation ScanRefiner::evaluate(const PreparedScan& scan, const Pose2& pose,
-                                              bool with_derivatives) const {
+                                              BeamSamples* samples) const {
+  sampleBeams(scan, pose, samples);
   Evaluation e;
   const double k2 = params_.cauchy_scale * params_.cauchy_scale;
   const double truncated = params_.outlier_distance - params_.wall_offset;
   const double outlier_cost = 0.5 * k2 * std::log1p(truncated * truncated / k2);
   forEachBeam(
-      scan, pose,
+      scan, *samples,
       [&](const MatchedBeam& beam) {
         e.cost += 0.5 * k2 * std::log(beam.q);
         ++e.matched;
         e.sum_weight += beam.w;
         e.sum_weighted_sq += beam.w * beam.r * beam.r;
         e.sum_sq += beam.r * beam.r;
-        if (!with_derivatives) return;
         const Eigen::Vector3d j = beamJacobian(beam.f, beam.px, beam.py, beam.c, beam.s);
         e.hessian.noalias() += beam.w * j * j.transpose();
         e.gradient.noalias() += beam.w * beam.r * j;
@@ -246,6 +270,8 @@ Eigen::Matrix3d fitCovariance(const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3
 Eigen::Matrix3d ScanRefiner::mapErrorCovariance(
     const PreparedScan& scan, const Pose2& pose,
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& eig) const {
+  BeamSamples fitted;
+  sampleBeams(scan, pose, &fitted);
   // The fitted pose moves by H^+ J^T W dr for residual changes dr (the
   // Gauss-Newton step, on the constrained directions only); a wall's offset
   // changes the residuals of all its beams at once.
@@ -262,7 +288,7 @@ Eigen::Matrix3d ScanRefiner::mapErrorCovariance(
     wall.setZero();
   };
   forEachBeam(
-      scan, pose,
+      scan, fitted,
       [&](const MatchedBeam& beam) {
         const double norm = std::hypot(beam.f.dx, beam.f.dy);
         const double nx = norm > 0.0 ? beam.f.dx / norm : 0.0;
@@ -309,6 +335,7 @@ int ScanRefiner::minimise(const PreparedScan& scan, const Pose2& start,
   Pose2& pose = *fitted;
   Evaluation& e = *fitted_evaluation;
   double cost = totalCost(e, pose, start, prior_information);
+  BeamSamples trial_samples;
   int iterations = 0;
   for (int it = 0; it < params_.max_iterations; ++it) {
     const Eigen::Vector3d d(pose.x - start.x, pose.y - start.y,
@@ -339,7 +366,7 @@ int ScanRefiner::minimise(const PreparedScan& scan, const Pose2& start,
     for (int k = 0; k < 10; ++k, scale *= 0.5) {
       const Pose2 trial{pose.x + scale * step(0), pose.y + scale * step(1),
                         normalizeAngle(pose.yaw + scale * step(2) / kYawScale)};
-      const Evaluation te = evaluate(scan, trial, true);
+      const Evaluation te = evaluate(scan, trial, &trial_samples);
       const double trial_cost = totalCost(te, trial, start, prior_information);
       if (trial_cost < cost) {
         pose = trial;
@@ -364,7 +391,8 @@ ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start,
   const Eigen::Matrix3d prior_information = priorInformation(prior_covariance);
 
   Pose2 pose = start;
-  Evaluation e = evaluate(scan, pose, true);
+  BeamSamples samples;
+  Evaluation e = evaluate(scan, pose, &samples);
   if (e.matched < needed) {
     out.matched_beams = e.matched;
     out.rejection = ScanRejection::kTooFewMatchedBeams;

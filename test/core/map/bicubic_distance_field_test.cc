@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <random>
 #include <vector>
 
 namespace pf {
@@ -87,6 +89,48 @@ TEST(BicubicDistanceField, FarOffTheMapIsMaxDistanceAndFlat) {
     EXPECT_EQ(1.5, s.distance);
     EXPECT_EQ(0.0, s.dx);
     EXPECT_EQ(0.0, s.dy);
+  }
+}
+
+// The samples of many points taken together are those taken one by one, to
+// the bit: on maps wide and narrow (where every stencil reaches past an
+// edge), turned or not, at points on the map, by its edges and off it, and
+// for counts that are not a multiple of the four points of the fast path.
+TEST(BicubicDistanceField, ManyPointsAtOnceAreTheSameBits) {
+  std::mt19937 rng(7);
+  std::uniform_int_distribution<int> wall(0, 9);
+  for (const int width : {1, 3, 4, 23}) {
+    const int height = width == 23 ? 17 : width + 1;
+    std::vector<int8_t> data(static_cast<std::size_t>(width) * height, 0);
+    for (auto& v : data) v = wall(rng) == 0 ? 100 : 0;
+    data[0] = 100;
+    for (const Pose2& origin : {Pose2{}, Pose2{-0.3, 0.7, 0.4}}) {
+      const LikelihoodField field(OccupancyGrid(width, height, 0.05, origin, data), 0.5);
+      const BicubicDistanceField smooth(field);
+      // From two cells beyond every edge, where the field ends.
+      std::uniform_real_distribution<double> x(origin.x - 0.15, origin.x + 0.05 * width + 0.15);
+      std::uniform_real_distribution<double> y(origin.y - 0.15, origin.y + 0.05 * height + 0.15);
+      std::vector<double> wx, wy;
+      for (int i = 0; i < 1003; ++i) {
+        wx.push_back(x(rng));
+        wy.push_back(y(rng));
+      }
+      wx[5] = std::numeric_limits<double>::quiet_NaN();
+      wy[9] = std::numeric_limits<double>::infinity();
+      wx[10] = origin.x;  // a cell's edge
+      wy[10] = origin.y;
+      for (const std::size_t n : {std::size_t{0}, std::size_t{3}, std::size_t{8}, wx.size()}) {
+        std::vector<FieldSample> many(n);
+        smooth.sample(wx.data(), wy.data(), n, many.data());
+        for (std::size_t i = 0; i < n; ++i) {
+          const FieldSample one = smooth.sample(wx[i], wy[i]);
+          EXPECT_EQ(0, std::memcmp(&one, &many[i], sizeof(FieldSample)))
+              << "width " << width << ", point " << i << " (" << wx[i] << ", " << wy[i]
+              << "): " << one.distance << " " << one.dx << " " << one.dy << " one by one, "
+              << many[i].distance << " " << many[i].dx << " " << many[i].dy << " together";
+        }
+      }
+    }
   }
 }
 

@@ -142,19 +142,25 @@ class ScanRefiner {
  private:
   struct Evaluation;
   struct MatchedBeam;
-  /// Visits the beams of `scan` at `pose` in scan order: matched(beam) for
-  /// each that ends within outlier_distance of a mapped obstacle, with its
-  /// residual and Cauchy weight; outlier() for each other one.
+  struct BeamSamples;
+  /// The field at the end point of each beam of `scan` placed at `pose`.
+  void sampleBeams(const PreparedScan& scan, const Pose2& pose, BeamSamples* out) const;
+  /// Visits the beams of `scan`, sampled in `at`, in scan order:
+  /// matched(beam) for each that ends within outlier_distance of a mapped
+  /// obstacle, with its residual and Cauchy weight; outlier() for each other
+  /// one.
   template <typename Matched, typename Outlier>
-  void forEachBeam(const PreparedScan& scan, const Pose2& pose, Matched&& matched,
+  void forEachBeam(const PreparedScan& scan, const BeamSamples& at, Matched&& matched,
                    Outlier&& outlier) const;
-  Evaluation evaluate(const PreparedScan& scan, const Pose2& pose, bool with_derivatives) const;
+  /// The scan's cost and Gauss-Newton system at `pose`; `*samples` becomes
+  /// the beams sampled there.
+  Evaluation evaluate(const PreparedScan& scan, const Pose2& pose, BeamSamples* samples) const;
   /// The scan's cost over beam_std^2 plus the prior's, at `at`.
   double totalCost(const Evaluation& e, const Pose2& at, const Pose2& start,
                    const Eigen::Matrix3d& prior_information) const;
   /// Gauss-Newton with a backtracking line search from *fitted (evaluated in
-  /// *fitted_evaluation, with derivatives), both updated to the fit. Returns
-  /// the iterations taken.
+  /// *fitted_evaluation), both updated to the fit. Returns the iterations
+  /// taken.
   int minimise(const PreparedScan& scan, const Pose2& start,
                const Eigen::Matrix3d& prior_information, Pose2* fitted,
                Evaluation* fitted_evaluation) const;

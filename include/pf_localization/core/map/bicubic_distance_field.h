@@ -17,6 +17,8 @@
 // field.
 #pragma once
 
+#include <cstddef>
+
 #include "pf_localization/core/map/likelihood_field.h"
 
 namespace pf {
@@ -37,6 +39,9 @@ class BicubicDistanceField {
   /// cell and a half off the map, or at a non-finite point: max_distance
   /// with a zero gradient.
   FieldSample sample(double wx, double wy) const;
+  /// sample(wx[i], wy[i]) into out[i] for each i < n, the same bits: where
+  /// the processor has AVX2, four points at a time.
+  void sample(const double* wx, const double* wy, std::size_t n, FieldSample* out) const;
 
   /// m: the map's cell size.
   double resolution() const { return 1.0 / inv_resolution_; }
@@ -47,6 +52,8 @@ class BicubicDistanceField {
   // Gauss-Newton evaluation.
   double cos_yaw_, sin_yaw_, inv_resolution_, origin_x_, origin_y_;
   int width_, height_;
+  // Whether every cell's index fits the 32-bit lanes of the four-point path.
+  bool int_indices_;
 };
 
 }  // namespace pf
