@@ -8,6 +8,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 #include <vector>
 
 #include "pf_localization/core/util/parameter_table.h"
@@ -268,10 +269,8 @@ Eigen::Matrix3d fitCovariance(const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3
 }  // namespace
 
 Eigen::Matrix3d ScanRefiner::mapErrorCovariance(
-    const PreparedScan& scan, const Pose2& pose,
+    const PreparedScan& scan, const BeamSamples& fitted,
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& eig) const {
-  BeamSamples fitted;
-  sampleBeams(scan, pose, &fitted);
   // The fitted pose moves by H^+ J^T W dr for residual changes dr (the
   // Gauss-Newton step, on the constrained directions only); a wall's offset
   // changes the residuals of all its beams at once.
@@ -330,7 +329,7 @@ double ScanRefiner::totalCost(const Evaluation& e, const Pose2& at, const Pose2&
 
 int ScanRefiner::minimise(const PreparedScan& scan, const Pose2& start,
                           const Eigen::Matrix3d& prior_information, Pose2* fitted,
-                          Evaluation* fitted_evaluation) const {
+                          Evaluation* fitted_evaluation, BeamSamples* fitted_samples) const {
   const double inv_beam_variance = 1.0 / (params_.beam_std * params_.beam_std);
   Pose2& pose = *fitted;
   Evaluation& e = *fitted_evaluation;
@@ -371,6 +370,7 @@ int ScanRefiner::minimise(const PreparedScan& scan, const Pose2& start,
       if (trial_cost < cost) {
         pose = trial;
         e = te;
+        std::swap(*fitted_samples, trial_samples);
         cost = trial_cost;
         improved = true;
         break;
@@ -399,7 +399,7 @@ ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start,
     out.rejection_detail = tooFewMatchedDetail(e.matched, n, needed, params_.outlier_distance);
     return out;
   }
-  out.iterations = minimise(scan, start, prior_information, &pose, &e);
+  out.iterations = minimise(scan, start, prior_information, &pose, &e, &samples);
 
   out.matched_beams = e.matched;
   out.translation = std::hypot(pose.x - start.x, pose.y - start.y);
@@ -425,7 +425,7 @@ ScanRefinement ScanRefiner::refine(const PreparedScan& scan, const Pose2& start,
     return out;
   }
   out.covariance = fitCovariance(eig, e.sum_weight, e.sum_weighted_sq, params_) +
-                   mapErrorCovariance(scan, pose, eig);
+                   mapErrorCovariance(scan, samples, eig);
   out.rms_distance = std::sqrt(e.sum_sq / e.matched);
   out.scan_cost = e.cost;
   out.pose = pose;

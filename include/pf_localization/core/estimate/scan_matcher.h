@@ -159,18 +159,18 @@ class ScanRefiner {
   double totalCost(const Evaluation& e, const Pose2& at, const Pose2& start,
                    const Eigen::Matrix3d& prior_information) const;
   /// Gauss-Newton with a backtracking line search from *fitted (evaluated in
-  /// *fitted_evaluation), both updated to the fit. Returns the iterations
-  /// taken.
+  /// *fitted_evaluation, with its beams sampled in *fitted_samples), all
+  /// three updated to the fit. Returns the iterations taken.
   int minimise(const PreparedScan& scan, const Pose2& start,
                const Eigen::Matrix3d& prior_information, Pose2* fitted,
-               Evaluation* fitted_evaluation) const;
+               Evaluation* fitted_evaluation, BeamSamples* fitted_samples) const;
 
   // The pose's covariance from the map's error: every wall the beams end on
   // (a run of beams along one line of the map) is drawn with an offset of
-  // its own, uniform over a cell, shared by all its beams. `eig`: the scan's
-  // Hessian at `pose`, the fitted one.
+  // its own, uniform over a cell, shared by all its beams. `fitted`: the
+  // beams sampled at the fitted pose; `eig`: the scan's Hessian there.
   Eigen::Matrix3d mapErrorCovariance(
-      const PreparedScan& scan, const Pose2& pose,
+      const PreparedScan& scan, const BeamSamples& fitted,
       const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& eig) const;
   BicubicDistanceField field_;
   ScanRefinerParams params_;
