@@ -118,7 +118,11 @@ struct ScanRefiner::Evaluation {
 };
 
 ScanRefiner::ScanRefiner(const LikelihoodField& field, const ScanRefinerParams& params)
-    : field_(field), params_((validate(params), params)) {}
+    : field_(field), params_((validate(params), params)) {
+  const double k2 = params_.cauchy_scale * params_.cauchy_scale;
+  const double truncated = params_.outlier_distance - params_.wall_offset;
+  outlier_cost_ = 0.5 * k2 * std::log1p(truncated * truncated / k2);
+}
 
 // One matched beam, as ScanRefiner::forEachBeam gives it.
 struct ScanRefiner::MatchedBeam {
@@ -127,8 +131,8 @@ struct ScanRefiner::MatchedBeam {
   double mx, my;  // the end point on the map
   double c, s;    // the pose's cos and sin of yaw
   double r;       // residual: distance to the wall's line (wall_offset off)
-  double q;       // 1 + r^2 / cauchy_scale^2
-  double w;       // the Cauchy weight, rho'(r^2 / 2) = 1 / q
+  double w;       // the Cauchy weight, rho'(r^2 / 2) = 1 / (1 + r^2 / cauchy_scale^2)
+  double rho;     // m^2: the robust cost, rho(r^2 / 2)
 };
 
 // The field at every beam's end point, the scan placed at one pose.
@@ -136,6 +140,10 @@ struct ScanRefiner::BeamSamples {
   double c = 1.0, s = 0.0;     // the pose's cos and sin of yaw
   std::vector<double> mx, my;  // the end points on the map
   std::vector<FieldSample> f;  // the field there
+  // Of each beam; w and rho of the matched ones only:
+  std::vector<double> q;    // 1 + r^2 / cauchy_scale^2, r the residual
+  std::vector<double> w;    // the Cauchy weight, 1 / q
+  std::vector<double> rho;  // m^2: the robust cost, cauchy_scale^2 / 2 log q
 };
 
 void ScanRefiner::sampleBeams(const PreparedScan& scan, const Pose2& pose, BeamSamples* out) const {
@@ -152,6 +160,22 @@ void ScanRefiner::sampleBeams(const PreparedScan& scan, const Pose2& pose, BeamS
     out->my[b] = pose.y + s * px + c * py;
   }
   field_.sample(out->mx.data(), out->my.data(), n, out->f.data());
+  // Each beam's weight, and the matched beams' costs, in loops of their own:
+  // the divisions of all beams then overlap, and the sums of evaluate() stay
+  // in registers, which every call to log would spill.
+  const double k2 = params_.cauchy_scale * params_.cauchy_scale;
+  std::vector<double>&q = out->q, &w = out->w, &rho = out->rho;
+  q.resize(n);
+  w.resize(n);
+  rho.resize(n);
+  for (std::size_t b = 0; b < n; ++b) {
+    const double r = out->f[b].distance - params_.wall_offset;
+    q[b] = 1.0 + r * r / k2;
+    w[b] = 1.0 / q[b];
+  }
+  for (std::size_t b = 0; b < n; ++b) {
+    if (out->f[b].distance < params_.outlier_distance) rho[b] = 0.5 * k2 * std::log(q[b]);
+  }
 }
 
 template <typename Matched, typename Outlier>
@@ -160,7 +184,6 @@ void ScanRefiner::forEachBeam(const PreparedScan& scan, const BeamSamples& at, M
   MatchedBeam beam;
   beam.c = at.c;
   beam.s = at.s;
-  const double k2 = params_.cauchy_scale * params_.cauchy_scale;
   for (std::size_t b = 0; b < scan.size(); ++b) {
     beam.f = at.f[b];
     if (!(beam.f.distance < params_.outlier_distance)) {
@@ -172,8 +195,8 @@ void ScanRefiner::forEachBeam(const PreparedScan& scan, const BeamSamples& at, M
     beam.mx = at.mx[b];
     beam.my = at.my[b];
     beam.r = beam.f.distance - params_.wall_offset;
-    beam.q = 1.0 + beam.r * beam.r / k2;
-    beam.w = 1.0 / beam.q;
+    beam.w = at.w[b];
+    beam.rho = at.rho[b];
     matched(static_cast<const MatchedBeam&>(beam));
   }
 }
@@ -181,25 +204,33 @@ void ScanRefiner::forEachBeam(const PreparedScan& scan, const BeamSamples& at, M
 ScanRefiner::Evaluation ScanRefiner::evaluate(const PreparedScan& scan, const Pose2& pose,
                                               BeamSamples* samples) const {
   sampleBeams(scan, pose, samples);
-  Evaluation e;
-  const double k2 = params_.cauchy_scale * params_.cauchy_scale;
-  const double truncated = params_.outlier_distance - params_.wall_offset;
-  const double outlier_cost = 0.5 * k2 * std::log1p(truncated * truncated / k2);
+  double cost = 0.0, sum_weight = 0.0, sum_weighted_sq = 0.0, sum_sq = 0.0;
+  int matched = 0;
+  Eigen::Matrix3d hessian = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d gradient = Eigen::Vector3d::Zero();
   forEachBeam(
       scan, *samples,
       [&](const MatchedBeam& beam) {
-        e.cost += 0.5 * k2 * std::log(beam.q);
-        ++e.matched;
-        e.sum_weight += beam.w;
-        e.sum_weighted_sq += beam.w * beam.r * beam.r;
-        e.sum_sq += beam.r * beam.r;
+        cost += beam.rho;
+        ++matched;
+        sum_weight += beam.w;
+        sum_weighted_sq += beam.w * beam.r * beam.r;
+        sum_sq += beam.r * beam.r;
         const Eigen::Vector3d j = beamJacobian(beam.f, beam.px, beam.py, beam.c, beam.s);
-        e.hessian.noalias() += beam.w * j * j.transpose();
-        e.gradient.noalias() += beam.w * beam.r * j;
+        hessian.noalias() += beam.w * j * j.transpose();
+        gradient.noalias() += beam.w * beam.r * j;
       },
       // Constant beyond the truncation, so the cost stays continuous as
       // beams come and go.
-      [&] { e.cost += outlier_cost; });
+      [&] { cost += outlier_cost_; });
+  Evaluation e;
+  e.cost = cost;
+  e.matched = matched;
+  e.sum_weight = sum_weight;
+  e.sum_weighted_sq = sum_weighted_sq;
+  e.sum_sq = sum_sq;
+  e.hessian = hessian;
+  e.gradient = gradient;
   return e;
 }
 

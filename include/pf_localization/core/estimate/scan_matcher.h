@@ -143,7 +143,8 @@ class ScanRefiner {
   struct Evaluation;
   struct MatchedBeam;
   struct BeamSamples;
-  /// The field at the end point of each beam of `scan` placed at `pose`.
+  /// The field at the end point of each beam of `scan` placed at `pose`,
+  /// and each matched beam's Cauchy weight and robust cost.
   void sampleBeams(const PreparedScan& scan, const Pose2& pose, BeamSamples* out) const;
   /// Visits the beams of `scan`, sampled in `at`, in scan order:
   /// matched(beam) for each that ends within outlier_distance of a mapped
@@ -174,6 +175,8 @@ class ScanRefiner {
       const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>& eig) const;
   BicubicDistanceField field_;
   ScanRefinerParams params_;
+  // m^2: the robust cost of a beam beyond outlier_distance, the same for all.
+  double outlier_cost_;
 };
 
 /// What a scan fit's covariance (ScanRefinement::covariance: zero in the
