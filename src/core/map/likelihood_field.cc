@@ -28,14 +28,45 @@ LikelihoodField::LikelihoodField(const OccupancyGrid& grid, double max_distance)
   // map whose obstacles are all that thin (a real map's walls) needs no second
   // transform: its surface distances are its distances.
   if (!hasDeepCells(occupied, grid.width(), grid.height())) return;
-  std::vector<bool> open(occupied.size());
-  for (std::size_t i = 0; i < open.size(); ++i) open[i] = !occupied[i];
-  const std::vector<float> depth = squaredDistanceTransform(open, grid.width(), grid.height());
   surface_distances_ = distances_;
-  for (std::size_t i = 0; i < open.size(); ++i) {
-    if (occupied[i]) {
-      surface_distances_[i] =
-          std::min(std::max(std::sqrt(depth[i]) - 1.0f - kFreeDepth, 0.0f) * res, cap);
+  addDepths(occupied, grid.width(), grid.height(), res, cap);
+}
+
+void LikelihoodField::addDepths(const std::vector<bool>& occupied, int width, int height, float res,
+                                float cap) {
+  // The transform runs over the obstacles' bounding box and one cell round
+  // it: every cell beyond is open, and the nearest open cell of an obstacle
+  // cell is never further than that ring (clamping a cell beyond into the
+  // box brings it closer), so the depths are those of the whole map's.
+  int x0 = width, y0 = height, x1 = -1, y1 = -1;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      if (!occupied[static_cast<std::size_t>(y) * width + x]) continue;
+      x0 = std::min(x0, x);
+      x1 = std::max(x1, x);
+      y0 = std::min(y0, y);
+      y1 = std::max(y1, y);
+    }
+  }
+  x0 = std::max(0, x0 - 1);
+  y0 = std::max(0, y0 - 1);
+  x1 = std::min(width - 1, x1 + 1);
+  y1 = std::min(height - 1, y1 + 1);
+  const int w = x1 - x0 + 1, h = y1 - y0 + 1;
+  std::vector<bool> open(static_cast<std::size_t>(w) * h);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      open[static_cast<std::size_t>(y) * w + x] =
+          !occupied[static_cast<std::size_t>(y + y0) * width + x + x0];
+    }
+  }
+  const std::vector<float> depth = squaredDistanceTransform(open, w, h);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y + y0) * width + x + x0;
+      if (!occupied[i]) continue;
+      const float d = std::sqrt(depth[static_cast<std::size_t>(y) * w + x]);
+      surface_distances_[i] = std::min(std::max(d - 1.0f - kFreeDepth, 0.0f) * res, cap);
     }
   }
 }

@@ -38,9 +38,28 @@ void MapChangeLayer::count(std::size_t i, Kind kind) {
       bump(&c.ends);
       break;
   }
-  const bool was_changed = removed(i) || added(i);
-  values_[i] = valueOf(classify(i));
-  if (was_changed || removed(i) || added(i)) changed_cells_.push_back(i);
+  setValue(i, valueOf(classify(i)));
+}
+
+void MapChangeLayer::setValue(std::size_t i, std::int8_t v) {
+  const std::int8_t was = values_[i];
+  if (v == was) return;
+  // Unseen counts nowhere; every other value once in seen.
+  const auto tally = [this](std::int8_t value, std::size_t* added, std::size_t* removed) {
+    if (value == valueOf(Cell::kAdded)) ++*added;
+    if (value == valueOf(Cell::kRemoved)) ++*removed;
+  };
+  std::size_t gone_added = 0, gone_removed = 0;
+  tally(was, &gone_added, &gone_removed);
+  tally(v, &summary_.added, &summary_.removed);
+  summary_.added -= gone_added;
+  summary_.removed -= gone_removed;
+  if (was == valueOf(Cell::kUnseen)) ++summary_.seen;
+  if (v == valueOf(Cell::kUnseen)) --summary_.seen;
+  values_[i] = v;
+  if (removed(i) || added(i) || was == valueOf(Cell::kAdded) || was == valueOf(Cell::kRemoved)) {
+    changed_cells_.push_back(i);
+  }
 }
 
 std::vector<std::size_t> MapChangeLayer::takeChangedCells() {
@@ -52,7 +71,7 @@ std::vector<std::size_t> MapChangeLayer::takeChangedCells() {
 void MapChangeLayer::see(std::size_t i) {
   if (cells_[i] & kSeen) return;
   cells_[i] |= kSeen;
-  values_[i] = valueOf(Cell::kAsMapped);
+  setValue(i, valueOf(Cell::kAsMapped));
 }
 
 MapChangeLayer::MapChangeLayer(const LikelihoodField& field)
@@ -85,6 +104,7 @@ void MapChangeLayer::clear() {
   counts_.clear();
   for (std::uint8_t& c : cells_) c &= kMapBits;
   std::fill(values_.begin(), values_.end(), valueOf(Cell::kUnseen));
+  summary_ = Summary();
   scans_ = 0;
 }
 
@@ -186,26 +206,6 @@ MapChangeLayer::Cell MapChangeLayer::classify(std::size_t i) const {
   if (hits >= kMinScans && hits >= kChangedShare * stopped) return Cell::kAdded;
   if (passes >= kMinScans && passes >= kChangedShare * reached) return Cell::kRemoved;
   return Cell::kAsMapped;
-}
-
-MapChangeLayer::Summary MapChangeLayer::summary() const {
-  Summary s;
-  for (std::size_t i = 0; i < cells_.size(); ++i) {
-    switch (classify(i)) {
-      case Cell::kUnseen:
-        continue;
-      case Cell::kAdded:
-        ++s.added;
-        break;
-      case Cell::kRemoved:
-        ++s.removed;
-        break;
-      case Cell::kAsMapped:
-        break;
-    }
-    ++s.seen;
-  }
-  return s;
 }
 
 std::int8_t MapChangeLayer::valueOf(Cell c) {

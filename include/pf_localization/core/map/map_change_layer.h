@@ -79,7 +79,7 @@ class MapChangeLayer {
       return seen == 0 ? 0.0 : static_cast<double>(added + removed) / static_cast<double>(seen);
     }
   };
-  Summary summary() const;
+  Summary summary() const { return summary_; }
 
   /// Every cell as a nav_msgs/OccupancyGrid value, row-major from the
   /// lower-left cell: -1 unseen, 0 seen as mapped, 100 added, 50 removed
@@ -124,6 +124,8 @@ class MapChangeLayer {
   void count(std::size_t i, Kind kind);
   // Marks cell i seen.
   void see(std::size_t i);
+  // Sets cell i's occupancy() value, and keeps summary_ and changed_cells_.
+  void setValue(std::size_t i, std::int8_t v);
   // One beam from (x, y) along (ux, uy), in cells of the grid's frame.
   void walk(double x, double y, double ux, double uy, double range);
   // The end point of a beam, in cells of the grid's frame.
@@ -134,6 +136,7 @@ class MapChangeLayer {
   std::vector<std::uint8_t> cells_;  // MapCell | Flag
   std::vector<Counts> counts_;
   std::vector<std::int8_t> values_;         // occupancy()
+  Summary summary_;                         // of values_
   std::vector<std::size_t> changed_cells_;  // takeChangedCells()
   std::size_t scans_ = 0;
   Pose2 last_;  // the robot pose of the last scan added
