@@ -33,6 +33,12 @@ BeamEvidence ahead(const MapEvidence& evidence, double range) {
   return evidence.judge(kRobot.x, kRobot.y, kRobot.yaw, range);
 }
 
+// The row-major index of the cell holding (x, y).
+std::size_t indexAt(const OccupancyGrid& map, double x, double y) {
+  const CellIndex c = map.worldToCell(x, y);
+  return static_cast<std::size_t>(c.y) * map.width() + c.x;
+}
+
 TEST(MapEvidence, ABeamEndingOnTheMapsWallIsOnTheMap) {
   const LikelihoodField field(boxRoom(false), 2.0);
   const MapEvidence evidence(field);
@@ -85,28 +91,27 @@ TEST(MapEvidence, AnObstacleLearnedGoneLetsRaysThroughAndLearnedBackStopsThem) {
   for (std::size_t i : box) evidence.setGone(i, true);
   EXPECT_EQ(BeamEvidence::kOnMap, ahead(evidence, 2.95));
   // A free cell cannot be gone: marking one changes nothing.
-  const CellIndex free = map.worldToCell(3.5, 2.0);
-  evidence.setGone(static_cast<std::size_t>(free.y) * map.width() + free.x, true);
+  evidence.setGone(indexAt(map, 3.5, 2.0), true);
   EXPECT_EQ(BeamEvidence::kOnMap, ahead(evidence, 2.95));
   for (std::size_t i : box) evidence.setGone(i, false);
   EXPECT_EQ(BeamEvidence::kThroughOntoMap, ahead(evidence, 2.95));
 }
 
 TEST(MapEvidence, AnEndOnAnObjectLearnedAddedSeesAChangeEvenBesideTheMap) {
-  // The world has a 0.2 m deep cabinet 0.15 m in front of the east wall
-  // (x 5.60-5.80): a beam ending on its face, 2.6 m ahead, ends within the
-  // wall's short margin, and looks on the map...
+  // The world has a cabinet 0.2 m deep against the east wall (x 5.75-5.95):
+  // a beam ending on its face, 2.75 m ahead, ends within the wall's short
+  // margin, and looks on the map...
   const OccupancyGrid map = boxRoom(false);
   const LikelihoodField field(map, 2.0);
   MapEvidence evidence(field);
   ASSERT_EQ(BeamEvidence::kOnMap, ahead(evidence, 2.75));
   // ...until the layer has learned the face added.
-  const CellIndex face = map.worldToCell(kRobot.x + 2.75, kRobot.y);
-  evidence.setAdded(static_cast<std::size_t>(face.y) * map.width() + face.x, true);
+  const std::size_t face = indexAt(map, kRobot.x + 2.75, kRobot.y);
+  evidence.setAdded(face, true);
   EXPECT_EQ(BeamEvidence::kShortOfMap, ahead(evidence, 2.75));
   // An end on the mapped wall beside it stays on the map.
   EXPECT_EQ(BeamEvidence::kOnMap, ahead(evidence, 2.95));
-  evidence.setAdded(static_cast<std::size_t>(face.y) * map.width() + face.x, false);
+  evidence.setAdded(face, false);
   EXPECT_EQ(BeamEvidence::kOnMap, ahead(evidence, 2.75));
 }
 
