@@ -45,17 +45,12 @@ void MapChangeLayer::setValue(std::size_t i, std::int8_t v) {
   const std::int8_t was = values_[i];
   if (v == was) return;
   // Unseen counts nowhere; every other value once in seen.
-  const auto tally = [this](std::int8_t value, std::size_t* added, std::size_t* removed) {
-    if (value == valueOf(Cell::kAdded)) ++*added;
-    if (value == valueOf(Cell::kRemoved)) ++*removed;
-  };
-  std::size_t gone_added = 0, gone_removed = 0;
-  tally(was, &gone_added, &gone_removed);
-  tally(v, &summary_.added, &summary_.removed);
-  summary_.added -= gone_added;
-  summary_.removed -= gone_removed;
   if (was == valueOf(Cell::kUnseen)) ++summary_.seen;
   if (v == valueOf(Cell::kUnseen)) --summary_.seen;
+  if (was == valueOf(Cell::kAdded)) --summary_.added;
+  if (v == valueOf(Cell::kAdded)) ++summary_.added;
+  if (was == valueOf(Cell::kRemoved)) --summary_.removed;
+  if (v == valueOf(Cell::kRemoved)) ++summary_.removed;
   values_[i] = v;
   if (removed(i) || added(i) || was == valueOf(Cell::kAdded) || was == valueOf(Cell::kRemoved)) {
     changed_cells_.push_back(i);

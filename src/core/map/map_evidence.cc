@@ -105,13 +105,15 @@ BeamEvidence MapEvidence::judgeRay(double sx, double sy, double ux, double uy, d
   // An end clear of the map's obstacles, on an object learned added (an
   // object moved a little behind where the map has it), is a change of the
   // map however near the map's obstacle it lies.
-  const bool on_added = d > kBesideObstacle && endsOnAdded(sx + range * ux, sy + range * uy);
+  const auto on_added = [&] {
+    return d > kBesideObstacle && endsOnAdded(sx + range * ux, sy + range * uy);
+  };
   if (expected < range - kThroughMargin) {
     if (d > kOnMapDistance) return BeamEvidence::kThroughIntoOpen;
-    return on_added ? BeamEvidence::kThroughOntoAdded : BeamEvidence::kThroughOntoMap;
+    return on_added() ? BeamEvidence::kThroughOntoAdded : BeamEvidence::kThroughOntoMap;
   }
   if (expected >= range + kShortMargin && d > kBesideObstacle) return BeamEvidence::kShortOfMap;
-  return on_added ? BeamEvidence::kShortOfMap : BeamEvidence::kOnMap;
+  return on_added() ? BeamEvidence::kShortOfMap : BeamEvidence::kOnMap;
 }
 
 EvidenceCounts MapEvidence::judge(const LaserScan& scan, const Pose2& robot,

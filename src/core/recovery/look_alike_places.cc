@@ -301,10 +301,6 @@ bool seenAsWell(const MapEvidence& evidence, const std::vector<PreparedScan>& sc
 
 }  // namespace
 
-bool LookAlikes::considering() const {
-  return std::any_of(streaks_.begin(), streaks_.end(), [](int s) { return s > 0; });
-}
-
 LookAlikeView LookAlikes::judge(const SensorModel& model, const std::vector<PreparedScan>& scans,
                                 const Pose2& estimate, const MapEvidence* evidence) {
   LookAlikeView view;

@@ -83,9 +83,6 @@ class LookAlikes {
   void setMap(const LikelihoodField& field);
   /// Forgets the streaks of better fits (after an initialisation).
   void restart();
-  /// Whether a look-alike fitted clearly better on the last update (a streak
-  /// under way, kBetterUpdates not yet reached or reached).
-  bool considering() const;
   const std::vector<MapSymmetry>& symmetries() const { return symmetries_; }
 
   /// Places `scans` at the estimate and at each of its look-alikes (those in
