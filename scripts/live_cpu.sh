@@ -3,7 +3,7 @@
 # floor of its messages alone (bench/plumbing_floor_node.cc: tf and scans
 # in, map -> odom and a pose out per scan, nothing else) and the same
 # filter's work without ROS (pf_bag_runner, the same bag, particles and
-# beams, an update on every scan).
+# beams, an update on every scan, at the same pace).
 #
 # neato_ac109_1 from ../shared/data, replayed by ../shared/tools/run_localizer.sh
 # in two modes: "wall" (WALL=1, the bag on the wall clock at 2x, as on a
@@ -15,15 +15,16 @@
 #   kld        pf_node with the defaults (KLD, particles:=5000)
 #   fixed5000  pf_node with 5000 fixed particles
 #   runner_p10, runner_kld, runner_fixed5000  pf_bag_runner on the same bag
-#              with the same particles (once a round): the filter's own work
+#              with the same particles, at the replay's pace: the filter's own
+#              work (its updates and the map's set-up)
 # Prints a line per run: whole-process CPU s, the ATE RMSE for pf_node, and
 # the CPU of each thread (pf_* are pf_node's own, named; main is the main
 # spinner; the unnamed others are roscpp's: the poll thread is the busiest),
 # then the medians and each pf_node run's cost above the floor (and above
-# the floor plus the runner's CPU for the same work). Not a test: the
+# the floor plus the filter's own work). Not a test: the
 # figures depend on the machine and on what else runs on it.
 #
-#   bash scripts/live_cpu.sh [ROUNDS]   (default 3; about 8 minutes a round)
+#   bash scripts/live_cpu.sh [ROUNDS]   (default 3; about 12 minutes a round)
 # Environment: LIVE_CPU_MODES ("wall sim"), LIVE_CPU_RUNS (the run names
 # above, default all), LIVE_CPU_WS (a built workspace to use as it is,
 # instead of building the benchmark workspace), LIVE_CPU_OUT (output folder).
@@ -129,27 +130,40 @@ replay() {
   echo "$mode $name ${cpu:-?} s $ate | threads: $(cat "$dir.threads" 2>/dev/null)"
 }
 
-# runner NAME PARAMS...: pf_bag_runner on the bag with these parameters;
-# prints its CPU (user + system) in both modes' tables.
+# runner NAME PARAMS...: pf_bag_runner on the bag with these parameters, in
+# each mode at that mode's pace (--pace: the scans come as in the replay, so
+# the caches are as cold at each update as pf_node's are; back to back, the
+# same updates cost a half to a third of that on a virtual machine). Prints
+# the filter's own work: the CPU of its updates plus the map's set-up, as
+# the runner measures them (reading the bag stands for the messages, which
+# are the floor's part), then the runner's whole-process CPU for reference.
 runner() {
-  local name=$1 dir=$out/runner.$1.$r cpu
+  local name=$1 dir mode rate cpu work
   shift
-  mkdir -p "$dir"
-  printf '%s\n' "update_min_d: 0" "update_min_a: 0" "$@" >"$dir/params.yaml"
-  # The executable itself: rosrun would add its own start-up (a Python look-up).
-  cpu=$(/usr/bin/python3 - "$dir" "$data" "$ws/devel/lib/pf_localization/pf_bag_runner" <<'EOF'
+  for mode in $modes; do
+    dir=$out/runner.$mode.$name.$r rate=2
+    [ "$mode" = sim ] && rate=10
+    mkdir -p "$dir"
+    printf '%s\n' "update_min_d: 0" "update_min_a: 0" "$@" >"$dir/params.yaml"
+    # The executable itself: rosrun would add its own start-up (a Python look-up).
+    cpu=$(/usr/bin/python3 - "$dir" "$data" "$ws/devel/lib/pf_localization/pf_bag_runner" "$rate" <<'EOF'
 import resource, subprocess, sys
-d, data, runner = sys.argv[1], sys.argv[2], sys.argv[3]
+d, data, runner, rate = sys.argv[1:5]
 with open(d + '/runner.log', 'w') as log:
     subprocess.run([runner, '--bag', data + '/ac109_1.bag',
                     '--map', data + '/ac109_1.yaml', '--out', d + '/traj.tum', '--quiet',
                     '--initial-pose', '3.972', '-0.090', '2.904', '--max-beams', '60',
-                    '--params', d + '/params.yaml'], stdout=log, stderr=log, check=True)
+                    '--params', d + '/params.yaml', '--pace', rate],
+                   stdout=log, stderr=log, check=True)
 u = resource.getrusage(resource.RUSAGE_CHILDREN)
 print('%.2f' % (u.ru_utime + u.ru_stime))
 EOF
-  )
-  for mode in $modes; do echo "$mode $name $cpu s"; done
+    )
+    work=$(awk '/filter updates.*; CPU/ {for (i = 1; i <= NF; ++i) if ($i == "CPU") u = $(i + 1)}
+                /map set-up CPU/ {s = $(NF - 1)}
+                END {if (u != "" && s != "") printf "%.2f", u + s}' "$dir/runner.log")
+    echo "$mode $name ${work:-?} s work | process $cpu s"
+  done
 }
 
 has() { case " $runs " in *" $1 "*) return 0 ;; esac; return 1; }
@@ -170,7 +184,7 @@ median() {
   awk -v m="$1" -v n="$2" '$1 == m && $2 == n && $3 != "?" {print $3}' "$out/runs.txt" | sort -n |
     awk '{v[NR] = $1} END {if (NR) printf "%.2f", NR % 2 ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}'
 }
-echo "medians over $rounds rounds (CPU s), and pf_node above the floor (+ the runner's work):"
+echo "medians over $rounds rounds (CPU s), and pf_node above the floor (+ the filter's own work):"
 for mode in $modes; do
   floor=$(median "$mode" floor)
   for name in floor p10 kld fixed5000; do
@@ -180,7 +194,7 @@ for mode in $modes; do
     if [ -n "$floor" ] && [ $name != floor ]; then
       work=$(median "$mode" runner_$name)
       line+=$(awk -v m="$m" -v f="$floor" -v w="${work:-0}" 'BEGIN {
-        printf "   above the floor %+.0f %%; floor + runner %.2f s: %+.0f %%",
+        printf "   above the floor %+.0f %%; floor + filter work %.2f s: %+.0f %%",
           100 * (m / f - 1), f + w, 100 * (m / (f + w) - 1)}')
     fi
     echo "$line"

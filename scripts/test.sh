@@ -157,6 +157,8 @@ background_lane() {
     warehouse_global_default
   job check "warehouse kidnap into the twin aisle, 10 seeds: found within 10 s of the first distinguishing scans" \
     warehouse_kidnap
+  job check "pf_bag_runner --pace 20: the trajectory back to back, at the bag's pace" \
+    paced_runner_same
   job check "corridor.bag at 5000 particles, 10 seeds: within 0.05 m RMSE and 0.15 m max" \
     corridor_small_budget
   job check "crowd.bag with updates every 0.05 m or 0.1 rad, 16 seeds: never confidently wrong, 15 tracked as with the defaults" \

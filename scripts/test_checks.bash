@@ -161,6 +161,27 @@ sys.exit(0 if max(rmse) <= 0.05 and max(worst) <= 0.15 else 1)
 PY
 }
 
+# --- The runner at a replay's pace --------------------------------------------
+# pf_bag_runner --pace (scripts/live_cpu.sh: the filter's work at pf_node's
+# rhythm) only waits between scans: tracking.bag at 20 times its pace gives
+# the trajectory of the run back to back, byte for byte, and takes its
+# duration divided by 20 (6.6 s). About 8 s.
+paced_runner_same() {
+  local out="$ws/paced_runner" lib="$ws/devel/lib/pf_localization" pace start took
+  rm -rf "$out" && mkdir -p "$out"
+  for pace in none 20; do
+    start=$(date +%s.%N)
+    "$lib/pf_bag_runner" --bag bags/tracking.bag --map maps/building.yaml \
+      --initial-pose 1.5 7.6 0.0 --out "$out/$pace.tum" --quiet \
+      $([ $pace = none ] || echo --pace $pace) >"$out/$pace.log" 2>&1 ||
+      { tail -n 5 "$out/$pace.log"; return 1; }
+    took=$(awk -v a="$start" -v b="$(date +%s.%N)" 'BEGIN {printf "%.1f", b - a}')
+  done
+  echo "tracking.bag at --pace 20: $took s (bag 131.6 s / 20 = 6.6 s)"
+  cmp "$out/none.tum" "$out/20.tum" || return 1
+  awk -v t="$took" 'BEGIN {exit !(t >= 6.5 && t < 20)}'
+}
+
 # --- Updates closer together than the defaults -------------------------------
 # crowd.bag with an amcl configuration's update_min_d 0.05 m and update_min_a
 # 0.1 rad, seeds 1-16: never "localized" more than 1 m off, and at least 15
