@@ -1,6 +1,7 @@
 #include "pf_localization/ros/output/map_to_odom_republisher.h"
 
-#include <pthread.h>
+#include <poll.h>
+#include <ros/poll_manager.h>
 #include <sys/timerfd.h>
 #include <unistd.h>
 
@@ -36,29 +37,44 @@ MapToOdomRepublisher::MapToOdomRepublisher(const MapToOdomRepublisherOptions& op
     : options_(options), hook_(std::move(hook)) {}
 
 void MapToOdomRepublisher::start(ros::NodeHandle clock_nh) {
-  if (thread_.joinable() || clock_sub_) return;
+  if (poll_guard_ || clock_sub_) return;
   if (ros::Time::isSimTime()) {
     clock_sub_ = clock_nh.subscribe<rosgraph_msgs::Clock>(
         "/clock", 1, [this](const rosgraph_msgs::ClockConstPtr& msg) { onClock(msg->clock); });
-  } else {
-    timer_fd_ = ::timerfd_create(CLOCK_MONOTONIC, TFD_CLOEXEC);
-    if (timer_fd_ < 0) {
-      ROS_ERROR("pf_node: no timer for republishing map -> odom (timerfd_create: errno %d)", errno);
-      return;
-    }
-    armLocked(kMinWait);  // the first publication is due at once
-    thread_ = std::thread([this] { run(); });
+    return;
   }
+  timer_fd_ = ::timerfd_create(CLOCK_MONOTONIC, TFD_CLOEXEC | TFD_NONBLOCK);
+  if (timer_fd_ < 0) {
+    ROS_ERROR("pf_node: no timer for republishing map -> odom (timerfd_create: errno %d)", errno);
+    return;
+  }
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    armLocked(kMinWait);  // the first publication is due at once
+  }
+  auto guard = std::make_shared<PollGuard>();
+  poll_guard_ = guard;
+  ros::PollSet& polls = ros::PollManager::instance()->getPollSet();
+  polls.addSocket(timer_fd_, [guard, this](int) {
+    std::lock_guard<std::mutex> alive(guard->mutex);
+    if (guard->alive) onTimer();
+  });
+  polls.addEvents(timer_fd_, POLLIN);
 }
 
 MapToOdomRepublisher::~MapToOdomRepublisher() {
   clock_sub_.shutdown();
+  if (poll_guard_) {
+    {
+      std::lock_guard<std::mutex> lock(poll_guard_->mutex);
+      poll_guard_->alive = false;
+    }
+    ros::PollManager::instance()->getPollSet().delSocket(timer_fd_);
+  }
   {
     std::lock_guard<std::mutex> lock(mutex_);
     stop_ = true;
-    armLocked(kMinWait);  // wakes the thread
   }
-  if (thread_.joinable()) thread_.join();
   if (timer_fd_ >= 0) ::close(timer_fd_);
 }
 
@@ -75,7 +91,7 @@ bool MapToOdomRepublisher::set(const std::optional<geometry_msgs::TransformStamp
   if (!publishLocked(stamp)) return false;
   if (!now.isZero()) {
     schedule_.published(now, delayLocked());
-    armLocked(delayLocked().toSec());  // puts the thread's wake-up off, without waking it
+    armLocked(delayLocked().toSec());  // puts the timed publication off
   }
   return true;
 }
@@ -91,7 +107,7 @@ void MapToOdomRepublisher::reset() {
 void MapToOdomRepublisher::setRate(double hz) {
   std::lock_guard<std::mutex> lock(mutex_);
   options_.rate = hz;
-  armLocked(kMinWait);  // the thread times the next publication by the new rate
+  armLocked(kMinWait);  // the next timed publication goes by the new rate
 }
 
 void MapToOdomRepublisher::setTransformTolerance(double seconds) {
@@ -109,21 +125,16 @@ void MapToOdomRepublisher::onClock(const ros::Time& now) {
   if (lock.owns_lock() && !stop_) tick(now, &lock);
 }
 
-void MapToOdomRepublisher::run() {
-  pthread_setname_np(pthread_self(), "pf_map_odom");
-  for (;;) {
-    std::uint64_t expirations = 0;
-    if (::read(timer_fd_, &expirations, sizeof expirations) < 0 && errno != EINTR) {
-      ROS_ERROR("pf_node: the map -> odom timer failed (errno %d): republishing stops", errno);
-      return;
-    }
-    std::unique_lock<std::mutex> lock(mutex_);
-    if (stop_) return;
-    tick(ros::Time::now(), &lock);
-    if (stop_) return;
-    // Until the next is due; set() moves that later without waking the thread.
-    armLocked(std::max((schedule_.next() - ros::Time::now()).toSec(), kMinWait));
-  }
+void MapToOdomRepublisher::onTimer() {
+  std::uint64_t expirations = 0;
+  // Nothing to read: set() re-armed it since it fired, so it is not due.
+  if (::read(timer_fd_, &expirations, sizeof expirations) < 0) return;
+  std::unique_lock<std::mutex> lock(mutex_);
+  if (stop_) return;
+  tick(ros::Time::now(), &lock);
+  if (stop_) return;
+  // Until the next is due; set() moves that later.
+  armLocked(std::max((schedule_.next() - ros::Time::now()).toSec(), kMinWait));
 }
 
 ros::Duration MapToOdomRepublisher::delayLocked() const {

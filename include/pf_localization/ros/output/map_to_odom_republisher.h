@@ -6,10 +6,12 @@
 // latest transform handed to it, under its own mutex, never the filter.
 //
 // What times the republishing depends on the clock:
-// - on the wall clock, a thread of its own that sleeps on a timer (timerfd)
-//   until a publication is due. Each publication after an update re-arms
-//   the timer, without waking the thread, so that while updates come often
-//   enough it never wakes;
+// - on the wall clock, a timer (timerfd) in roscpp's own poll set, so that
+//   the poll thread, which sends every message anyway, publishes it when it
+//   fires: a publication from a thread of its own cost a wake-up of that
+//   thread and then one of the poll thread to send it. Each publication
+//   after an update re-arms the timer, so that while updates come often
+//   enough it never fires;
 // - under simulated time, /clock itself: no sleep can be timed on a clock
 //   that only /clock moves, so start() subscribes to it on the handle it is
 //   given (pf_node's poll thread), and the /clock message at which a
@@ -23,9 +25,9 @@
 #include <tf2_ros/transform_broadcaster.h>
 
 #include <functional>
+#include <memory>
 #include <mutex>
 #include <optional>
-#include <thread>
 
 namespace pf_ros {
 
@@ -66,7 +68,8 @@ class MapToOdomRepublisher {
 
   /// Starts the timed republishing (once; the hook may be called from then
   /// on): under simulated time by subscribing to /clock on `clock_nh` (its
-  /// callback queue runs onClock()), on the wall clock by starting the thread.
+  /// callback queue runs onClock()), on the wall clock by adding the timer to
+  /// roscpp's poll set (ros::start() must have run: a NodeHandle exists).
   void start(ros::NodeHandle clock_nh);
   ~MapToOdomRepublisher();
   MapToOdomRepublisher(const MapToOdomRepublisher&) = delete;
@@ -97,11 +100,11 @@ class MapToOdomRepublisher {
   void onClock(const ros::Time& now);
 
  private:
-  // The wall clock's thread: sleeps on the timer until a timed publication
-  // is due.
-  void run();
+  // The wall clock's timer fired (on roscpp's poll thread): the timed
+  // publication when one is due, and the timer set for the next.
+  void onTimer();
   // The wall clock's timer fires in `seconds` (no timer: nothing); mutex_
-  // held, or the thread not started.
+  // held, or the timer not yet polled.
   void armLocked(double seconds);
   // How long after the latest publication the next timed one is due: 1.5
   // periods on the wall clock, one under simulated time (see the .cc).
@@ -123,7 +126,14 @@ class MapToOdomRepublisher {
   RepublishSchedule schedule_;
   std::size_t published_ = 0;
   ros::Subscriber clock_sub_;
-  std::thread thread_;
+  // Whether the poll thread may still call onTimer(): the poll set may call
+  // a callback of a timer just taken out of it, so it checks this first,
+  // under the guard's lock, which the destructor takes to clear it.
+  struct PollGuard {
+    std::mutex mutex;
+    bool alive = true;
+  };
+  std::shared_ptr<PollGuard> poll_guard_;
 };
 
 }  // namespace pf_ros
