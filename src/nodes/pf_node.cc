@@ -15,9 +15,9 @@
 // LatestScanSlot to a filter thread of its own, so that under overload the
 // newest scan wins and tf keeps being consumed; the main spinner serves the
 // map, initialpose, odometry, the services, the periodic save and the scans
-// tf dropped; map -> odom is republished by a MapToOdomRepublisher (a thread
-// on the wall clock, /clock on the poll thread under simulated time) that
-// never waits for the filter. No roscpp timer: under simulated time one
+// tf dropped; map -> odom is republished by a MapToOdomRepublisher (on the
+// poll thread: a timer in roscpp's poll set on the wall clock, /clock under
+// simulated time) that never waits for the filter. No roscpp timer: under simulated time one
 // polls the clock every millisecond. filter_mutex_ protects the filter and
 // everything that goes with it (live_).
 #include <nav_msgs/OccupancyGrid.h>
@@ -115,7 +115,7 @@ class PfNode {
     set_map_srv_ = nh_.advertiseService("set_map", &PfNode::onSetMap, this);
     reconfigure_ = std::make_unique<ReconfigureServer>(
         pnh_, config, [this](const LocalizerConfig& c) { return reconfigure(c); }, "pf_node");
-    // /clock on the poll thread too: it republishes when due.
+    // Its timer or /clock on the poll thread too: it republishes when due.
     republisher_->start(withQueue(nh_, &inline_queue_));
     filter_thread_ = std::thread([this] { filterLoop(); });
     // Last: their callbacks may run at once, on roscpp's poll thread.
