@@ -51,7 +51,6 @@
 #include "pf_localization/ros/localizer/limited_log.h"
 #include "pf_localization/ros/localizer/live_localizer.h"
 #include "pf_localization/ros/output/map_to_odom_republisher.h"
-#include "pf_localization/ros/output/poll_thread_outbox.h"
 #include "pf_localization/ros/params/parameter_docs.h"
 #include "pf_localization/ros/params/reconfigure_server.h"
 #include "pf_localization/ros/params/startup_config.h"
@@ -118,10 +117,6 @@ class PfNode {
         pnh_, config, [this](const LocalizerConfig& c) { return reconfigure(c); }, "pf_node");
     // Its timer or /clock on the poll thread too: it republishes when due.
     republisher_->start(withQueue(nh_, &inline_queue_));
-    // What an update publishes goes to the poll thread in one wake-up.
-    outbox_.start();
-    republisher_->sendThrough(&outbox_);
-    live_.sendThrough(&outbox_);
     filter_thread_ = std::thread([this] { filterLoop(); });
     // Last: their callbacks may run at once, on roscpp's poll thread.
     scan_inputs_.subscribe(nh_);
@@ -132,7 +127,6 @@ class PfNode {
     ros::getGlobalCallbackQueue()->removeByID(reinterpret_cast<uint64_t>(this));
     slot_.close();
     filter_thread_.join();
-    outbox_.stop();        // before what its jobs publish on goes
     republisher_.reset();  // before live_ goes: its onTfTick() uses live_
   }
 
@@ -225,7 +219,6 @@ class PfNode {
       auto pending = slot_.take(ros::WallDuration(1.0));
       if (!pending) continue;
       std::lock_guard<std::mutex> lock(filter_mutex_);
-      PollThreadOutbox::Batch publications(&outbox_);
       live_.processScan(*pending, slot_, *reconfigure_);
     }
   }
@@ -340,7 +333,6 @@ class PfNode {
   LimitedWarn warn_{"pf_node", kLogPeriod};
   tf2_ros::Buffer buffer_;
   InlineCallbackQueue inline_queue_;  // before every subscriber that uses it
-  PollThreadOutbox outbox_;  // started and stopped by this node's constructor and destructor
   tf2_ros::TransformListener listener_;
   std::unique_ptr<MapToOdomRepublisher> republisher_;  // started at the end of the constructor
   // Guards live_: taken by the filter thread for a whole update, and by the

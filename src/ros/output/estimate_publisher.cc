@@ -35,15 +35,15 @@ EstimatePublisher::EstimatePublisher(ros::NodeHandle& nh)
 void EstimatePublisher::publishEstimate(const ScanLocalizer& localizer, const ros::Time& stamp,
                                         bool always) {
   if (const auto pose = localizer.estimate(stamp)) {
-    send(&pose_pub_, *pose);
-    send(&amcl_pose_pub_, *pose);
+    pose_pub_.publish(*pose);
+    amcl_pose_pub_.publish(*pose);
   }
   const LocalizerConfig& config = localizer.config();
   if (!cloudDue(last_cloud_stamp_, stamp, config.gui_publish_rate, always)) return;
   // Built only for a subscriber: 500 000 particles take a while.
   if (cloud_pub_.getNumSubscribers() == 0) return;
-  send(&cloud_pub_,
-       localizer.particleCloud(stamp, static_cast<std::size_t>(config.cloud_max_poses)));
+  cloud_pub_.publish(
+      localizer.particleCloud(stamp, static_cast<std::size_t>(config.cloud_max_poses)));
   last_cloud_stamp_ = stamp;
 }
 
@@ -56,7 +56,7 @@ void EstimatePublisher::publishConfidence(const ScanLocalizer& localizer, const 
   hypotheses_msg.header.stamp = stamp;
   hypotheses_msg.header.frame_id = localizer.config().global_frame;
   toHypothesesMsg(hypotheses, &hypotheses_msg);
-  send(&hypotheses_pub_, std::move(hypotheses_msg));
+  hypotheses_pub_.publish(std::move(hypotheses_msg));
 
   const std::string name = ros::this_node::getName() + ": localization";
   diagnostic_msgs::DiagnosticArray array;
@@ -65,8 +65,8 @@ void EstimatePublisher::publishConfidence(const ScanLocalizer& localizer, const 
   timing.addTo(&array.status.front(), dropped, cap);
   addHypotheses(&array.status.front(), hypotheses);
   addSensors(&array.status.front(), localizer.sensorHealth(), stamp.toSec());
-  send(&status_pub_, array.status.front());
-  send(&diagnostics_pub_, std::move(array));
+  diagnostics_pub_.publish(array);
+  status_pub_.publish(array.status.front());
   publishMapChanges(localizer, stamp);
   if (const auto line = state_log_.onConfidence(localizer.filter().confidence())) {
     if (line->warning) {
@@ -85,7 +85,7 @@ void EstimatePublisher::publishMapChanges(const ScanLocalizer& localizer, const 
       (stamp - last_changes_stamp_).toSec() < kMapChangesPeriod) {
     return;
   }
-  if (auto msg = localizer.mapChangesMsg(stamp)) send(&changes_pub_, std::move(*msg));
+  if (auto msg = localizer.mapChangesMsg(stamp)) changes_pub_.publish(std::move(*msg));
   last_changes_stamp_ = stamp;
   changes_scans_ = layer->scans();
 }

@@ -88,7 +88,7 @@ bool MapToOdomRepublisher::set(const std::optional<geometry_msgs::TransformStamp
   // A correction must reach tf now even when the clock has not moved since
   // the last timed publication.
   if (!last_stamp_.isZero() && stamp <= last_stamp_) stamp = last_stamp_ + ros::Duration(1e-3);
-  if (!publishLocked(stamp, false)) return false;
+  if (!publishLocked(stamp)) return false;
   if (!now.isZero()) {
     schedule_.published(now, delayLocked());
     armLocked(delayLocked().toSec());  // puts the timed publication off
@@ -113,11 +113,6 @@ void MapToOdomRepublisher::setRate(double hz) {
 void MapToOdomRepublisher::setTransformTolerance(double seconds) {
   std::lock_guard<std::mutex> lock(mutex_);
   options_.transform_tolerance = seconds;
-}
-
-void MapToOdomRepublisher::sendThrough(PollThreadOutbox* outbox) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  outbox_ = outbox;
 }
 
 std::size_t MapToOdomRepublisher::published() const {
@@ -170,18 +165,14 @@ void MapToOdomRepublisher::tick(const ros::Time& now, std::unique_lock<std::mute
   }
   const ros::Time stamp = std::max(now, scan_stamp_) + ros::Duration(options_.transform_tolerance);
   // Between updates, only a later stamp is news (and tf2 refuses a repeated one).
-  if (stamp > last_stamp_) publishLocked(stamp, true);
+  if (stamp > last_stamp_) publishLocked(stamp);
 }
 
-bool MapToOdomRepublisher::publishLocked(ros::Time stamp, bool here) {
+bool MapToOdomRepublisher::publishLocked(ros::Time stamp) {
   if (!options_.enabled || !transform_) return false;
   geometry_msgs::TransformStamped t = *transform_;
   t.header.stamp = stamp;
-  if (here || outbox_ == nullptr) {
-    broadcaster_.sendTransform(t);
-  } else {
-    outbox_->post([this, t] { broadcaster_.sendTransform(t); });
-  }
+  broadcaster_.sendTransform(t);
   last_stamp_ = stamp;
   ++published_;
   return true;

@@ -1,20 +1,14 @@
 // pf_node's output with a ROS master (test/rostest/live_topics.test): the
-// republisher's cadence under simulated time, driven by /clock, the
-// latched topics that are sent only while subscribed, and the publications
-// handed to the poll thread.
+// republisher's cadence under simulated time, driven by /clock, and the
+// latched topics that are sent only while subscribed.
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <gtest/gtest.h>
 #include <ros/ros.h>
 
 #include <memory>
-#include <mutex>
-#include <thread>
-#include <utility>
-#include <vector>
 
 #include "pf_localization/ros/output/latched_topic.h"
 #include "pf_localization/ros/output/map_to_odom_republisher.h"
-#include "pf_localization/ros/output/poll_thread_outbox.h"
 
 namespace pf_ros {
 namespace {
@@ -91,50 +85,6 @@ TEST(LatchedTopic, KeepsTheLatestMessageForTheFirstSubscriber) {
   ASSERT_EQ(received.size(), 1u);
   EXPECT_EQ(received.front(), 2.0);  // the latest, once
   EXPECT_FALSE(topic.kept().has_value());
-}
-
-// What a thread posts inside a batch runs on roscpp's poll thread once the
-// batch ends, in the order posted; before start() and after stop(), at once
-// on the thread that posts.
-TEST(PollThreadOutbox, ABatchRunsOnThePollThreadInOrderWhenItEnds) {
-  PollThreadOutbox outbox;
-  std::mutex mutex;
-  std::vector<std::pair<int, std::thread::id>> ran;  // each job and where it ran
-  const auto job = [&](int k) {
-    return [&, k] {
-      std::lock_guard<std::mutex> lock(mutex);
-      ran.emplace_back(k, std::this_thread::get_id());
-    };
-  };
-  const auto runs = [&] {
-    std::lock_guard<std::mutex> lock(mutex);
-    return ran;
-  };
-  const std::thread::id here = std::this_thread::get_id();
-  outbox.post(job(0));  // not started: at once, here
-  ASSERT_EQ(runs().size(), 1u);
-  EXPECT_EQ(runs()[0].second, here);
-
-  outbox.start();
-  {
-    PollThreadOutbox::Batch batch(&outbox);
-    for (int k = 1; k <= 3; ++k) outbox.post(job(k));
-    ros::WallDuration(0.2).sleep();
-    EXPECT_EQ(runs().size(), 1u);  // held by the batch
-  }
-  const ros::WallTime give_up = ros::WallTime::now() + ros::WallDuration(10.0);
-  while (runs().size() < 4u && ros::WallTime::now() < give_up) ros::WallDuration(0.01).sleep();
-  const auto batch = runs();
-  ASSERT_EQ(batch.size(), 4u);
-  for (int k = 1; k <= 3; ++k) {
-    EXPECT_EQ(batch[k].first, k);                 // in order
-    EXPECT_NE(batch[k].second, here);             // not here
-    EXPECT_EQ(batch[k].second, batch[1].second);  // all on the one poll thread
-  }
-  outbox.stop();
-  outbox.post(job(4));  // stopped: at once, here again
-  ASSERT_EQ(runs().size(), 5u);
-  EXPECT_EQ(runs()[4].second, here);
 }
 
 }  // namespace

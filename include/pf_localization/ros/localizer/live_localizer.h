@@ -72,9 +72,6 @@ class LiveLocalizer {
   /// before time jumped back (latestChainStamp()).
   void clearStaleBuffer(const std::string& laser_frame);
 
-  /// The output topics go through `outbox` from now on (estimate_publisher.h).
-  void sendThrough(PollThreadOutbox* outbox) { output_.sendThrough(outbox); }
-
   /// What to save, under its own lock: may be used without the mutex.
   const PoseSaver& saver() const { return saver_; }
 

@@ -18,13 +18,11 @@
 #include <cstdint>
 #include <optional>
 #include <string>
-#include <utility>
 
 #include "pf_localization/core/estimate/confidence_verdict.h"
 #include "pf_localization/ros/localizer/output_latency.h"
 #include "pf_localization/ros/localizer/scan_localizer.h"
 #include "pf_localization/ros/output/latched_topic.h"
-#include "pf_localization/ros/output/poll_thread_outbox.h"
 
 namespace pf_ros {
 
@@ -53,11 +51,6 @@ class EstimatePublisher {
   /// Advertises the topics on `nh`.
   explicit EstimatePublisher(ros::NodeHandle& nh);
 
-  /// Publishes through `outbox` (to the poll thread, with the rest of its
-  /// thread's batch) from now on; nullptr: at once. The messages are built
-  /// here either way.
-  void sendThrough(PollThreadOutbox* outbox) { outbox_ = outbox; }
-
   /// The estimate, and the cloud when cloudDue() (gui_publish_rate) and
   /// something subscribes to it, as at most `cloud_max_poses` poses.
   void publishEstimate(const ScanLocalizer& localizer, const ros::Time& stamp, bool always);
@@ -78,16 +71,6 @@ class EstimatePublisher {
  private:
   // pf_map_changes when due and the layer learned something since.
   void publishMapChanges(const ScanLocalizer& localizer, const ros::Time& stamp);
-  // `msg` on `topic` (a LatchedTopic or a ros::Publisher), through outbox_
-  // when there is one.
-  template <typename Topic, typename M>
-  void send(Topic* topic, M msg) {
-    if (outbox_ == nullptr) {
-      topic->publish(std::move(msg));
-      return;
-    }
-    outbox_->post([topic, msg = std::move(msg)]() mutable { topic->publish(std::move(msg)); });
-  }
 
   // Latched, published only while subscribed (latched_topic.h).
   LatchedTopic<geometry_msgs::PoseWithCovarianceStamped> pose_pub_, amcl_pose_pub_;
@@ -99,7 +82,6 @@ class EstimatePublisher {
   ros::Publisher cloud_pub_, diagnostics_pub_;
   ros::Time last_cloud_stamp_;
   StateChangeLog state_log_;
-  PollThreadOutbox* outbox_ = nullptr;
 };
 
 }  // namespace pf_ros

@@ -29,8 +29,6 @@
 #include <mutex>
 #include <optional>
 
-#include "pf_localization/ros/output/poll_thread_outbox.h"
-
 namespace pf_ros {
 
 /// When map -> odom is due again: one period after the latest publication,
@@ -93,11 +91,6 @@ class MapToOdomRepublisher {
   void setRate(double hz);
   void setTransformTolerance(double seconds);
 
-  /// set()'s publications go through `outbox` (to the poll thread, with the
-  /// rest of its thread's batch) from now on; nullptr: at once, where set()
-  /// runs. The timed ones are on the poll thread already.
-  void sendThrough(PollThreadOutbox* outbox);
-
   /// Number of map -> odom messages published since start.
   std::size_t published() const;
 
@@ -119,9 +112,8 @@ class MapToOdomRepublisher {
   // The timed publication at `now`, when due; `lock` holds mutex_ (and is
   // released around the hook).
   void tick(const ros::Time& now, std::unique_lock<std::mutex>* lock);
-  // Publishes the stored transform stamped `stamp` (through outbox_ unless
-  // `here`); mutex_ held.
-  bool publishLocked(ros::Time stamp, bool here);
+  // Publishes the stored transform stamped `stamp`; mutex_ held.
+  bool publishLocked(ros::Time stamp);
 
   MapToOdomRepublisherOptions options_;
   TickHook hook_;
@@ -133,7 +125,6 @@ class MapToOdomRepublisher {
   ros::Time scan_stamp_, last_stamp_;
   RepublishSchedule schedule_;
   std::size_t published_ = 0;
-  PollThreadOutbox* outbox_ = nullptr;
   ros::Subscriber clock_sub_;
   // Whether the poll thread may still call onTimer(): the poll set may call
   // a callback of a timer just taken out of it, so it checks this first,
