@@ -9,17 +9,17 @@
 // interface too (topics, services, parameter names, the saved pose,
 // dynamic_reconfigure), so that it can replace amcl in a bringup.
 //
-// Threads (README.md, "Under overload"): tf and the scans are taken on
-// roscpp's own poll thread as they arrive (InlineCallbackQueue: no hand-off
-// to a spinner); a scan whose tf is there goes through a one-scan
-// LatestScanSlot to a filter thread of its own, so that under overload the
-// newest scan wins and tf keeps being consumed; the main spinner serves the
-// map, initialpose, odometry, the services, the periodic save and the scans
-// tf dropped; map -> odom is republished by a MapToOdomRepublisher (on the
-// poll thread: a timer in roscpp's poll set on the wall clock, /clock under
-// simulated time) that never waits for the filter. No roscpp timer: under simulated time one
-// polls the clock every millisecond. filter_mutex_ protects the filter and
-// everything that goes with it (live_).
+// Threads (docs/ros-interface.md, "Threads, latency and overload"): tf and the
+// scans are taken on roscpp's own poll thread as they arrive
+// (InlineCallbackQueue: no hand-off to a spinner); a scan whose tf is there
+// goes through a one-scan LatestScanSlot to a filter thread of its own, so that
+// under overload the newest scan wins and tf keeps being consumed; the main
+// spinner serves the map, initialpose, odometry, the services, the periodic
+// save and the scans tf dropped; map -> odom is republished by a
+// MapToOdomRepublisher (on the poll thread: a timer in roscpp's poll set on the
+// wall clock, /clock under simulated time) that never waits for the filter. No
+// roscpp timer: under simulated time one polls the clock every millisecond.
+// filter_mutex_ protects the filter and everything that goes with it (live_).
 #include <nav_msgs/OccupancyGrid.h>
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/SetMap.h>

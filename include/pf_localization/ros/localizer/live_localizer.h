@@ -6,11 +6,12 @@
 // tf and the filter start over) and the check of a pose saved by an earlier
 // run on the first map (saved_pose.h).
 //
-// Threads (README.md, "Under overload"): every method but saver() and
-// haveMap() must be called with pf_node's filter mutex held; the filter
-// thread holds it for a whole update, the main spinner's callbacks that
-// touch the filter wait for it. What runs at a steady rate never does: the
-// republisher and the saver get their data under small locks of their own.
+// Threads (docs/ros-interface.md, "Threads, latency and overload"): every
+// method but saver() and haveMap() must be called with pf_node's filter mutex
+// held; the filter thread holds it for a whole update, the main spinner's
+// callbacks that touch the filter wait for it. What runs at a steady rate never
+// does: the republisher and the saver get their data under small locks of their
+// own.
 #pragma once
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
