@@ -46,7 +46,7 @@ MapEvidence::MapEvidence(const LikelihoodField& field)
 
 void MapEvidence::setGone(std::size_t cell, bool gone) {
   const OccupancyGrid& grid = field_->grid();
-  const CellIndex c{static_cast<int>(cell % grid.width()), static_cast<int>(cell / grid.width())};
+  const CellIndex c = grid.cellOf(static_cast<int>(cell));
   // Only a mapped obstacle can be gone.
   if (grid.state(c) == CellState::kOccupied) caster_.setOpen(c.x, c.y, gone);
 }
@@ -68,8 +68,7 @@ bool MapEvidence::endsOnAdded(double x, double y) const {
   for (int dy = -1; dy <= 1; ++dy) {
     for (int dx = -1; dx <= 1; ++dx) {
       const CellIndex n{c.x + dx, c.y + dy};
-      if (grid.contains(n) && added_[static_cast<std::size_t>(n.y) * grid.width() + n.x])
-        return true;
+      if (grid.contains(n) && added_[static_cast<std::size_t>(grid.linearIndex(n))]) return true;
     }
   }
   return false;

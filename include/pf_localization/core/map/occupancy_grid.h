@@ -51,6 +51,8 @@ class OccupancyGrid {
     return c.x >= 0 && c.y >= 0 && c.x < width_ && c.y < height_;
   }
   int linearIndex(const CellIndex& c) const { return c.y * width_ + c.x; }
+  /// The cell at linearIndex() `i`.
+  CellIndex cellOf(int i) const { return {i % width_, i / width_}; }
 
   /// State of a cell; out-of-map cells are kUnknown.
   CellState state(const CellIndex& c) const;
