@@ -12,8 +12,10 @@
 // Threads (docs/ros-interface.md, "Threads, latency and overload"): tf and the
 // scans are taken on roscpp's own poll thread as they arrive
 // (InlineCallbackQueue: no hand-off to a spinner); a scan whose tf is there
-// goes through a one-scan LatestScanSlot to a filter thread of its own, so that
-// under overload the newest scan wins and tf keeps being consumed; the main
+// is updated at once on that thread when its update will be short
+// (UpdatePlacement), otherwise it goes through a one-scan LatestScanSlot to a
+// filter thread of its own, so that under overload the newest scan wins and
+// tf keeps being consumed; the main
 // spinner serves the map, initialpose, odometry, the services, the periodic
 // save and the scans tf dropped; map -> odom is republished by a
 // MapToOdomRepublisher (on the poll thread: a timer in roscpp's poll set on the
@@ -190,9 +192,11 @@ class PfNode {
   }
 
   // Once tf has the scan's stamp, on whichever thread brought the scan or
-  // the transform that completed it (InlineCallbackQueue): only hands the
-  // scan to the filter thread, so that no thread waits here for an update.
+  // the transform that completed it (InlineCallbackQueue): a short update
+  // runs here, any other is handed to the filter thread, so that no thread
+  // waits here for an update.
   void onScan(PendingScan pending) {
+    if (updateHere(pending)) return;
     if (!slot_.put(std::move(pending))) return;
     const std::uint64_t dropped = slot_.dropped();
     warn_.warn("overload",
@@ -200,6 +204,33 @@ class PfNode {
                    std::to_string(dropped) +
                    " since start; see dropped_scans and latency_* in the diagnostics). Lower "
                    "max_particles, or set max_update_time");
+  }
+
+  // Runs the scan's update at once, on the thread that brought the scan
+  // (roscpp's poll thread), when it will be short (UpdatePlacement): a
+  // hand-over to the filter thread costs two wake-ups and the caches the
+  // messages warmed. Not when a scan waits or is in the filter thread's hands
+  // (it would be overtaken), when another thread holds the filter (a new map,
+  // a service), or on a thread already inside an update. This may run inside
+  // roscpp's /tf callback (a transform that completes a waiting scan), which
+  // holds that subscription's mutex: safe, because pf_node publishes every
+  // message by value, which roscpp queues and delivers to this node's own
+  // /tf subscription from its poll loop, after the callback has returned (a
+  // message published by shared pointer would be delivered at once, and wait
+  // for that mutex).
+  bool updateHere(const PendingScan& pending) {
+    if (t_updating) return false;
+    std::unique_lock<std::mutex> lock(filter_mutex_, std::try_to_lock);
+    if (!lock.owns_lock() || !slot_.idle() || !live_.nextUpdateOnPollThread()) return false;
+    process(pending);
+    return true;
+  }
+
+  // One scan's update, with the filter mutex held.
+  void process(const PendingScan& pending) {
+    t_updating = true;
+    live_.processScan(pending, slot_, *reconfigure_);
+    t_updating = false;
   }
 
   // The filter thread: the newest waiting scan, one at a time.
@@ -219,7 +250,8 @@ class PfNode {
       auto pending = slot_.take(ros::WallDuration(1.0));
       if (!pending) continue;
       std::lock_guard<std::mutex> lock(filter_mutex_);
-      live_.processScan(*pending, slot_, *reconfigure_);
+      process(*pending);
+      slot_.done();
     }
   }
 
@@ -332,12 +364,14 @@ class PfNode {
   ros::NodeHandle nh_, pnh_;
   LimitedWarn warn_{"pf_node", kLogPeriod};
   tf2_ros::Buffer buffer_;
+  // Set while this thread runs an update (process()).
+  static inline thread_local bool t_updating = false;
   InlineCallbackQueue inline_queue_;  // before every subscriber that uses it
   tf2_ros::TransformListener listener_;
   std::unique_ptr<MapToOdomRepublisher> republisher_;  // started at the end of the constructor
-  // Guards live_: taken by the filter thread for a whole update, and by the
-  // main spinner's callbacks that touch the filter. The republisher never
-  // waits for it.
+  // Guards live_: taken for a whole update (by the filter thread, or by the
+  // poll thread, which only ever tries it), and by the main spinner's
+  // callbacks that touch the filter. The republisher never waits for it.
   std::mutex filter_mutex_;
   LiveLocalizer live_;
   LatestScanSlot slot_;

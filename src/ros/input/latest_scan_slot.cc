@@ -30,7 +30,18 @@ std::optional<PendingScan> LatestScanSlot::take(ros::WallDuration timeout) {
   if (closed_ || waiting_.empty()) return std::nullopt;
   std::optional<PendingScan> out = std::move(waiting_.front());
   waiting_.erase(waiting_.begin());
+  ++in_hand_;
   return out;
+}
+
+void LatestScanSlot::done() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (in_hand_ > 0) --in_hand_;
+}
+
+bool LatestScanSlot::idle() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return waiting_.empty() && in_hand_ == 0;
 }
 
 void LatestScanSlot::close() {

@@ -40,6 +40,7 @@ bool LiveLocalizer::installMap(const nav_msgs::OccupancyGrid& map) {
     return false;
   }
   have_map_ = true;
+  placement_.reset();
   if (config_.save_pose_rate > 0.0 || (first && saved_pose_)) {
     const std::string signature = mapSignature(map);
     saver_.setMap(signature);
@@ -127,6 +128,7 @@ void LiveLocalizer::processScan(const PendingScan& pending, const LatestScanSlot
   const std_msgs::Header& header = pending.header();
   if (fromBeforeTheJump(header.stamp)) return;
   if (timeJumpedBack(header.stamp)) return;
+  const std::size_t weighed = localizer_.filter().particles().size();
   const ros::WallTime start = ros::WallTime::now();
   const ScanResult result = pending.scan ? localizer_.processScan(*pending.scan, pending.sensor)
                                          : localizer_.processCloud(*pending.cloud, pending.sensor);
@@ -145,6 +147,7 @@ void LiveLocalizer::processScan(const PendingScan& pending, const LatestScanSlot
   if (r.updated) {
     timing_.addUpdate((ros::WallTime::now() - pending.arrival_wall).toSec(),
                       (pending.arrival_clock - stamp).toSec(), update_s);
+    placement_.addUpdate(update_s, weighed);
     if (governor_.enabled()) applyParticleCap(governor_.addUpdate(r.particles, update_s));
     output_.publishEstimate(localizer_, stamp, false);
     output_.publishConfidence(localizer_, stamp, r, reconfigure.generation(), timing_,

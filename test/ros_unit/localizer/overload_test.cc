@@ -75,6 +75,20 @@ TEST(LatestScanSlot, TakeWaitsForAScanFromAnotherThreadAndCloseWakesIt) {
   EXPECT_TRUE(slot.closed());
 }
 
+TEST(LatestScanSlot, IdleOnlyWhenNothingWaitsAndTheScanTakenIsDone) {
+  LatestScanSlot slot;
+  EXPECT_TRUE(slot.idle());
+  slot.put(scanStamped(1.0));
+  EXPECT_FALSE(slot.idle());  // waiting
+  ASSERT_TRUE(slot.take(ros::WallDuration(0.0)).has_value());
+  EXPECT_FALSE(slot.idle());  // in the filter thread's hands: a newer scan must not overtake it
+  slot.done();
+  EXPECT_TRUE(slot.idle());
+  slot.done();  // one too many changes nothing
+  slot.put(scanStamped(2.0));
+  EXPECT_FALSE(slot.idle());
+}
+
 TEST(RollingPercentiles, NearestRankOverTheLastWindow) {
   RollingPercentiles r(100);
   EXPECT_EQ(r.percentile(0.5), 0.0);

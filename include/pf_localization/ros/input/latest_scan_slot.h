@@ -1,4 +1,5 @@
-// The hand-over of scans from pf_node's subscriptions to its filter thread,
+// The hand-over of scans from pf_node's subscriptions to its filter thread
+// (the scans whose updates are too long for roscpp's poll thread),
 // holding at most one waiting scan per sensor: under overload (a filter update slower
 // than the scan period, another process taking the CPU) the newest scan wins
 // and the older waiting one of that sensor is dropped and counted (another
@@ -39,8 +40,14 @@ class LatestScanSlot {
   bool put(PendingScan scan);
 
   /// The waiting scan that arrived first, waiting up to `timeout` for one;
-  /// nothing on time-out or once close() was called.
+  /// nothing on time-out or once close() was called. The scan stays in hand
+  /// (idle() is false) until done().
   std::optional<PendingScan> take(ros::WallDuration timeout);
+  /// The scan last taken was handled.
+  void done();
+  /// No scan waits, and none taken is still being handled: a scan that
+  /// arrives now may be handled at once without overtaking an older one.
+  bool idle() const;
 
   /// Wakes take() for good (shutdown).
   void close();
@@ -55,6 +62,7 @@ class LatestScanSlot {
   std::condition_variable ready_;
   std::vector<PendingScan> waiting_;  // at most one per sensor, in arrival order
   std::uint64_t dropped_ = 0;
+  std::size_t in_hand_ = 0;  // taken and not yet done()
   bool closed_ = false;
 };
 

@@ -4,9 +4,10 @@
 // roscpp reads every message on its poll thread and hands it to a spinner
 // through a callback queue, so each message wakes two threads (the cost:
 // docs/performance.md, "Wake-ups: tf and scans on the poll thread"). The tf
-// listener and the scan's tf message filter (whose callbacks only store a
-// transform or leave a scan for the filter thread: short, thread-safe, never
-// blocking on the filter) run here, so a message costs one wake-up.
+// listener and the scan's tf message filter (whose callbacks store a
+// transform, or run a short update or leave the scan for the filter thread:
+// thread-safe, and never waiting for the filter) run here, so a message costs
+// one wake-up.
 //
 // Threads: a callback runs on roscpp's poll thread for a message from another
 // process, or on the publishing thread for one of this node's own messages

@@ -8,7 +8,8 @@
 //
 // Threads (docs/ros-interface.md, "Threads, latency and overload"): every
 // method but saver() and haveMap() must be called with pf_node's filter mutex
-// held; the filter thread holds it for a whole update, the main spinner's
+// held; an update holds it whole (on the filter thread, or on roscpp's poll
+// thread when it is short), the main spinner's
 // callbacks that touch the filter wait for it. What runs at a steady rate never
 // does: the republisher and the saver get their data under small locks of their
 // own.
@@ -29,6 +30,7 @@
 #include "pf_localization/ros/localizer/output_latency.h"
 #include "pf_localization/ros/localizer/particle_cap_governor.h"
 #include "pf_localization/ros/localizer/scan_localizer.h"
+#include "pf_localization/ros/localizer/update_placement.h"
 #include "pf_localization/ros/output/estimate_publisher.h"
 #include "pf_localization/ros/output/map_to_odom_republisher.h"
 #include "pf_localization/ros/output/saved_pose.h"
@@ -60,7 +62,14 @@ class LiveLocalizer {
   /// update, the republisher's and max_update_time now. Empty, or the error.
   std::string reconfigure(const LocalizerConfig& next);
 
-  /// One scan from the filter thread: the update and everything after it.
+  /// Whether the next update may run on roscpp's poll thread
+  /// (UpdatePlacement: the recent updates of this many particles were short).
+  bool nextUpdateOnPollThread() const {
+    return placement_.onPollThread(localizer_.filter().particles().size());
+  }
+
+  /// One scan, on the filter thread or the poll thread: the update and
+  /// everything after it.
   /// `slot` (its scans dropped) and `reconfigure` (its generation): for the
   /// diagnostics, as they are after the update.
   void processScan(const PendingScan& pending, const LatestScanSlot& slot,
@@ -90,6 +99,7 @@ class LiveLocalizer {
   ScanLocalizer localizer_;
   UpdateTimeGovernor governor_;
   UpdateTiming timing_;
+  UpdatePlacement placement_;
   EstimatePublisher output_;
   TimeJumpDetector jumps_;
   PoseSaver saver_;
