@@ -15,13 +15,13 @@
 // is updated at once on that thread when its update will be short
 // (UpdatePlacement), otherwise it goes through a one-scan LatestScanSlot to a
 // filter thread of its own, so that under overload the newest scan wins and
-// tf keeps being consumed; the main
-// spinner serves the map, initialpose, odometry, the services, the periodic
-// save and the scans tf dropped; map -> odom is republished by a
-// MapToOdomRepublisher (on the poll thread: a timer in roscpp's poll set on the
-// wall clock, /clock under simulated time) that never waits for the filter. No
-// roscpp timer: under simulated time one polls the clock every millisecond.
-// filter_mutex_ protects the filter and everything that goes with it (live_).
+// tf keeps being consumed; the main spinner serves the map, initialpose,
+// odometry, the services, the periodic save and the scans tf dropped; map ->
+// odom is republished by a MapToOdomRepublisher (on the poll thread: a timer
+// in roscpp's poll set on the wall clock, /clock under simulated time) that
+// never waits for the filter. No roscpp timer: under simulated time one polls
+// the clock every millisecond. filter_mutex_ protects the filter and
+// everything that goes with it (live_).
 #include <nav_msgs/OccupancyGrid.h>
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/SetMap.h>
@@ -211,13 +211,9 @@ class PfNode {
   // hand-over to the filter thread costs two wake-ups and the caches the
   // messages warmed. Not when a scan waits or is in the filter thread's hands
   // (it would be overtaken), when another thread holds the filter (a new map,
-  // a service), or on a thread already inside an update. This may run inside
-  // roscpp's /tf callback (a transform that completes a waiting scan), which
-  // holds that subscription's mutex: safe, because pf_node publishes every
-  // message by value, which roscpp queues and delivers to this node's own
-  // /tf subscription from its poll loop, after the callback has returned (a
-  // message published by shared pointer would be delivered at once, and wait
-  // for that mutex).
+  // a service), or on a thread already inside an update. It may run inside
+  // roscpp's /tf callback, which is safe only while pf_node publishes by
+  // value (docs/ros-interface.md, "Threads, latency and overload").
   bool updateHere(const PendingScan& pending) {
     if (t_updating) return false;
     std::unique_lock<std::mutex> lock(filter_mutex_, std::try_to_lock);

@@ -9,10 +9,9 @@
 // Threads (docs/ros-interface.md, "Threads, latency and overload"): every
 // method but saver() and haveMap() must be called with pf_node's filter mutex
 // held; an update holds it whole (on the filter thread, or on roscpp's poll
-// thread when it is short), the main spinner's
-// callbacks that touch the filter wait for it. What runs at a steady rate never
-// does: the republisher and the saver get their data under small locks of their
-// own.
+// thread when it is short), the main spinner's callbacks that touch the filter
+// wait for it. What runs at a steady rate never does: the republisher and the
+// saver get their data under small locks of their own.
 #pragma once
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
