@@ -5,19 +5,20 @@
 namespace pf_ros {
 
 void UpdatePlacement::addUpdate(double wall_s, std::size_t particles) {
-  recent_[seen_ % kWindow] = Update{wall_s, particles};
-  ++seen_;
+  wall_s_.add(wall_s);
+  wall_s_per_particle_.add(wall_s / static_cast<double>(std::max<std::size_t>(particles, 1)));
 }
 
 bool UpdatePlacement::onPollThread(std::size_t particles) const {
-  if (seen_ < kWindow) return false;
-  return std::all_of(recent_.begin(), recent_.end(), [&](const Update& u) {
-    // A larger cloud costs in proportion; a smaller one is not counted on
-    // to be cheaper.
-    const double growth =
-        std::max(1.0, static_cast<double>(particles) / std::max<std::size_t>(u.particles, 1));
-    return u.wall_s * growth <= kBudget;
-  });
+  // A larger cloud costs in proportion; a smaller one is not counted on to be
+  // cheaper.
+  return wall_s_.count() == kWindow && wall_s_.max() <= kBudget &&
+         static_cast<double>(particles) * wall_s_per_particle_.max() <= kBudget;
+}
+
+void UpdatePlacement::reset() {
+  wall_s_ = RollingPercentiles(kWindow);
+  wall_s_per_particle_ = RollingPercentiles(kWindow);
 }
 
 }  // namespace pf_ros

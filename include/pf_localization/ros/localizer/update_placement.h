@@ -13,8 +13,9 @@
 // docs/performance.md, "The fixed cost", has the figures.
 #pragma once
 
-#include <array>
 #include <cstddef>
+
+#include "pf_localization/ros/localizer/output_latency.h"
 
 namespace pf_ros {
 
@@ -38,15 +39,13 @@ class UpdatePlacement {
   bool onPollThread(std::size_t particles) const;
 
   /// Forgets every update (a new map: the costs seen no longer apply).
-  void reset() { seen_ = 0; }
+  void reset();
 
  private:
-  struct Update {
-    double wall_s = 0.0;
-    std::size_t particles = 0;
-  };
-  std::array<Update, kWindow> recent_{};
-  std::size_t seen_ = 0;  // updates added since reset(); the newest is at (seen_ - 1) % kWindow
+  // Each update scaled to a cloud of n particles is within the budget when
+  // the longest is, and n times the longest per particle is.
+  RollingPercentiles wall_s_{kWindow};
+  RollingPercentiles wall_s_per_particle_{kWindow};
 };
 
 }  // namespace pf_ros
