@@ -121,7 +121,8 @@ def missing_in_command(words, code):
     pf_localization`). Everything else in a command is an option, a value or another program."""
     missing = []
     for i, w in enumerate(words):
-        program = (i == 0 and re.fullmatch(r'pf_\w+', w)) or words[max(i - 2, 0):i] == ['rosrun', 'pf_localization']
+        after_rosrun = words[max(i - 2, 0):i] == ['rosrun', 'pf_localization']
+        program = (i == 0 and re.fullmatch(r'pf_\w+', w)) or after_rosrun
         if placeholder(w) or w.startswith(('-', '/', '~', '.', '$')):
             continue
         if is_path(w) or os.path.splitext(w)[1] in SOURCE_EXTENSIONS or program:
@@ -138,7 +139,7 @@ def missing_names(span, code):
         return []
     if re.fullmatch(r'[A-Z][A-Z0-9]*(_[A-Z0-9]+)+', span):  # an environment variable or a constant
         return [] if code.has_name(span) else [span]
-    if span.startswith(('-', '/', '~', '.', '$', '_')) or placeholder(span) or re.search(r'[=:]\s|:=|=', span):
+    if span.startswith(('-', '/', '~', '.', '$', '_')) or placeholder(span) or re.search(r'=|:\s', span):
         return []
     if is_path(span):
         return [] if code.has_path(span) else [span]
@@ -175,7 +176,8 @@ def main(argv):
             for line, span in doc_spans(f.read()):
                 spans += 1
                 for name in missing_names(span, code):
-                    missing.append('%s:%d: `%s` is not in the code' % (os.path.relpath(doc, root), line, name))
+                    where = '%s:%d' % (os.path.relpath(doc, root), line)
+                    missing.append('%s: `%s` is not in the code' % (where, name))
     for m in missing:
         print(m)
     if missing:

@@ -2,8 +2,8 @@
 """check_file_names.py [ROOT]: each C++ file is named after the main type it defines.
 
 Guards that a file's name says what it holds: a reader looking for a type finds it in the file of
-its name, in snake_case (ScanRefiner in scan_refiner.h). ROOT is the repository (default: the one
-holding this script). The files are every header under include/, and every .cc under src/ that
+its name, in snake_case (LikelihoodField in likelihood_field.h). ROOT is the repository (default:
+the one holding this script). The files are every header under include/, and every .cc under src/ that
 has no header of its own path (src/X/Y.cc beside include/PACKAGE/X/Y.h); a .cc defining main() is
 a program, named after its executable, and is left out. Such a .cc must define a class it is named
 after: one that implements a header of another name (a rename that left it behind) is listed.

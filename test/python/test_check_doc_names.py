@@ -46,7 +46,8 @@ class CheckDocNamesTest(unittest.TestCase):
         self.assertIn('every code name found', result.stdout)
 
     def test_a_missing_name_fails_with_its_doc_and_line(self):
-        result = self.run_check('# Utilities\n\n`bin_table` is here;\n`vanished_table` and `old_helper` are gone,\n'
+        result = self.run_check('# Utilities\n\n`bin_table` is here;\n'
+                                '`vanished_table` and `old_helper` are gone,\n'
                                 'so are `core/util/vanished_table.h` and `OldTable::lookUp`.\n')
         self.assertEqual(result.returncode, 1, result.stdout + result.stderr)
         lines = result.stdout.splitlines()

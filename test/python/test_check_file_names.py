@@ -14,7 +14,8 @@ import sys
 import tempfile
 import unittest
 
-SCRIPT = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..', 'scripts', 'check_file_names.py')
+REPO = os.path.join(os.path.dirname(os.path.abspath(__file__)), '..', '..')
+SCRIPT = os.path.join(REPO, 'scripts', 'check_file_names.py')
 
 HEADERS = {
     # Named after its class, with the structs it takes and gives.
@@ -22,11 +23,12 @@ HEADERS = {
                   ' public:\n  class Nested {};\n  void run();\n};\n}  // namespace pkg\n',
     # Free functions, plain data, an enum class and an error type: named after what they do.
     'map_loading.h': 'namespace pkg {\nenum class MapMode { kTrinary };\nstruct MapInfo { int w; };\n'
-                     'class MapLoadError : public std::runtime_error { using runtime_error::runtime_error; };\n'
+                     'class MapLoadError : public std::runtime_error {\n  using runtime_error::runtime_error;\n};\n'
                      'class Forward;\nMapInfo loadMap(const char* path);\n}  // namespace pkg\n',
     # Named after a struct while its class is the main type.
     'widget_status.h': 'namespace pkg {\nstruct WidgetStatus { int n; };\n// class InAComment {};\n'
-                       'class WidgetHealth {\n public:\n  WidgetStatus status() const;\n};\n}  // namespace pkg\n',
+                       'class WidgetHealth {\n public:\n  WidgetStatus status() const;\n};\n'
+                       '}  // namespace pkg\n',
 }
 
 
