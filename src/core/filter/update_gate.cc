@@ -11,8 +11,8 @@ namespace {
 
 GateDecision skipped(SkipReason reason, std::string detail = "") {
   GateDecision d;
-  d.skip = reason;
-  d.detail = std::move(detail);
+  d.skip_reason = reason;
+  d.skip_detail = std::move(detail);
   return d;
 }
 
@@ -31,7 +31,7 @@ OneUpdateStep oneUpdateStep(const ParticleFilterParams& params) {
 
 GateDecision UpdateGate::decide(const Pose2& odom, const ScanGroup& scans, const SensorModel* model,
                                 bool initialized, const Pose2& estimate, bool odometry_suspect,
-                                const ParticleFilterParams& params) {
+                                const ParticleFilterParams& params, int masked) {
   if (!model) return skipped(SkipReason::kNoMap);
   if (!initialized) return skipped(SkipReason::kNotInitialized);
   if (!odom.isFinite()) return skipped(SkipReason::kOdometryNotFinite);
@@ -84,13 +84,15 @@ GateDecision UpdateGate::decide(const Pose2& odom, const ScanGroup& scans, const
     }
   }
   if (!d.scans) d.scans = prepareScans(*model, scans);
-  if (beamCount(*d.scans) == 0) {
+  d.beams_used = static_cast<int>(beamCount(*d.scans));
+  d.beams_dropped = droppedBeams(*d.scans) - masked;
+  if (d.beams_used == 0) {
     // Without evidence the cloud would only be moved; the odometry reference
     // stays, so the motion is applied once a usable scan comes.
-    d.skip = SkipReason::kNoValidBeam;
+    d.skip_reason = SkipReason::kNoValidBeam;
     std::size_t ranges = 0;
     for (const LaserScan& scan : scans) ranges += scan.ranges.size();
-    d.detail =
+    d.skip_detail =
         std::to_string(droppedBeams(*d.scans)) + " of " + std::to_string(ranges) + " beams invalid";
     d.fit_dropped = false;
     return d;

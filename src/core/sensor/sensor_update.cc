@@ -51,6 +51,18 @@ Weighing SensorUpdate::weigh(const SensorModel& model, const std::vector<Prepare
                 threads, evidence_share);
 }
 
+Weighing SensorUpdate::weighCloud(const std::vector<PreparedScan>& scans, double view,
+                                  double min_ess_fraction, const LikelihoodFieldModelParams& sensor,
+                                  const KldParams& kld, ParticleSet* particles, int threads) {
+  const double ess_fraction = std::max(min_ess_fraction, search_.minEssFraction());
+  const SensorModel* smoothed = search_.model(*model_, sensor.sigma_hit, sensor.max_distance, scans,
+                                              *particles, kld, threads);
+  Weighing w = weigh(smoothed ? *smoothed : *model_, scans, ess_fraction,
+                     sensor.likelihood_exponent, particles, threads, view);
+  w.search_sigma = search_.sigma();
+  return w;
+}
+
 Weighing SensorUpdate::finish(std::size_t beams, std::size_t beams_counted, double min_ess_fraction,
                               double likelihood_exponent, ParticleSet* particles, int threads,
                               double evidence_share) {

@@ -46,17 +46,17 @@ TEST(OneUpdateStep, IsTwiceTheThresholdsAndUnboundedWithout) {
 TEST_F(UpdateGateTest, InputChecksComeFirstAndSayWhich) {
   const LaserScan scan = castScan(grid_, kTruth);
   EXPECT_EQ(SkipReason::kNoMap,
-            gate_.decide(kTruth, scan, nullptr, true, kTruth, false, params_).skip);
+            gate_.decide(kTruth, scan, nullptr, true, kTruth, false, params_).skip_reason);
   EXPECT_EQ(SkipReason::kNotInitialized,
-            gate_.decide(kTruth, scan, &model_, false, kTruth, false, params_).skip);
+            gate_.decide(kTruth, scan, &model_, false, kTruth, false, params_).skip_reason);
   const Pose2 nan{std::nan(""), 0.0, 0.0};
   EXPECT_EQ(SkipReason::kOdometryNotFinite,
-            gate_.decide(nan, scan, &model_, true, kTruth, false, params_).skip);
+            gate_.decide(nan, scan, &model_, true, kTruth, false, params_).skip_reason);
   LaserScan bad = scan;
   bad.angle_increment = 0.0;
   const GateDecision d = gate_.decide(kTruth, bad, &model_, true, kTruth, false, params_);
-  EXPECT_EQ(SkipReason::kBadScan, d.skip);
-  EXPECT_EQ(*validateScan(bad), d.detail);
+  EXPECT_EQ(SkipReason::kBadScan, d.skip_reason);
+  EXPECT_EQ(*validateScan(bad), d.skip_detail);
   // None of them counted as an update.
   EXPECT_FALSE(gate_.hasUpdated());
   EXPECT_FALSE(gate_.odomAtUpdate().has_value());
@@ -65,19 +65,19 @@ TEST_F(UpdateGateTest, InputChecksComeFirstAndSayWhich) {
 TEST_F(UpdateGateTest, TheFirstScanRunsWithoutMotionThenOnlyAfterMotion) {
   const Pose2 odom0{5.0, 5.0, 2.0};
   GateDecision d = decide(odom0, kTruth);
-  ASSERT_TRUE(d.runs()) << toString(d.skip);
+  ASSERT_TRUE(d.runs()) << toString(d.skip_reason);
   EXPECT_FALSE(d.from.has_value());
   ASSERT_TRUE(d.scans.has_value());
   EXPECT_GT(beamCount(*d.scans), 0u);
   EXPECT_TRUE(gate_.hasUpdated());
 
-  EXPECT_EQ(SkipReason::kNotMoved, decide(odom0, kTruth).skip);
-  EXPECT_EQ(SkipReason::kNotMoved, decide(compose(odom0, {0.19, 0.0, 0.0}), kTruth).skip);
-  EXPECT_EQ(SkipReason::kNotMoved, decide(compose(odom0, {0.0, 0.0, 0.5}), kTruth).skip);
+  EXPECT_EQ(SkipReason::kNotMoved, decide(odom0, kTruth).skip_reason);
+  EXPECT_EQ(SkipReason::kNotMoved, decide(compose(odom0, {0.19, 0.0, 0.0}), kTruth).skip_reason);
+  EXPECT_EQ(SkipReason::kNotMoved, decide(compose(odom0, {0.0, 0.0, 0.5}), kTruth).skip_reason);
 
   const Pose2 odom1 = compose(odom0, {0.0, -0.21, 0.0});
   d = decide(odom1, kTruth);
-  ASSERT_TRUE(d.runs()) << toString(d.skip);
+  ASSERT_TRUE(d.runs()) << toString(d.skip_reason);
   ASSERT_TRUE(d.from.has_value());
   EXPECT_EQ(odom0.x, d.from->x);
   EXPECT_NEAR(0.21, d.step, 1e-9);
@@ -91,7 +91,7 @@ TEST_F(UpdateGateTest, ARequestedUpdateOrSuspectOdometryRunsWithoutMotion) {
   ASSERT_TRUE(decide(odom, kTruth).runs());
   gate_.requestUpdate();
   EXPECT_TRUE(decide(odom, kTruth).runs());
-  EXPECT_EQ(SkipReason::kNotMoved, decide(odom, kTruth).skip);  // once
+  EXPECT_EQ(SkipReason::kNotMoved, decide(odom, kTruth).skip_reason);  // once
   EXPECT_TRUE(decide(odom, kTruth, /*suspect=*/true).runs());
 }
 
@@ -100,11 +100,11 @@ TEST_F(UpdateGateTest, AnOdometryJumpIsSkippedAndTrackingResumesFromIt) {
   ASSERT_TRUE(decide(odom, kTruth).runs());
   const Pose2 jumped = compose(odom, {10.0, 0.0, 0.0});
   const GateDecision d = decide(jumped, kTruth);
-  EXPECT_EQ(SkipReason::kOdometryJumped, d.skip);
+  EXPECT_EQ(SkipReason::kOdometryJumped, d.skip_reason);
   EXPECT_NEAR(10.0, d.step, 1e-9);
   EXPECT_EQ(jumped.x, gate_.odomAtUpdate()->x);
   // Measured from the new odometry, the robot has not moved.
-  EXPECT_EQ(SkipReason::kNotMoved, decide(jumped, kTruth).skip);
+  EXPECT_EQ(SkipReason::kNotMoved, decide(jumped, kTruth).skip_reason);
 }
 
 TEST_F(UpdateGateTest, AScanWithoutValidBeamKeepsTheReference) {
@@ -114,7 +114,7 @@ TEST_F(UpdateGateTest, AScanWithoutValidBeamKeepsTheReference) {
   blind.ranges.assign(blind.ranges.size(), std::numeric_limits<float>::quiet_NaN());
   const Pose2 moved = compose(odom, {0.5, 0.0, 0.0});
   const GateDecision d = gate_.decide(moved, blind, &model_, true, kTruth, false, params_);
-  EXPECT_EQ(SkipReason::kNoValidBeam, d.skip);
+  EXPECT_EQ(SkipReason::kNoValidBeam, d.skip_reason);
   ASSERT_TRUE(d.scans.has_value());
   EXPECT_EQ(180, droppedBeams(*d.scans));
   EXPECT_EQ(odom.x, gate_.odomAtUpdate()->x);
@@ -136,12 +136,12 @@ TEST_F(UpdateGateTest, AScanThatStopsFittingRunsBeforeTheThresholds) {
             gate_
                 .decide(compose(odom, step), castScan(grid_, compose(kTruth, step)), &model_, true,
                         kTruth, false, params_)
-                .skip);
+                .skip_reason);
   // The robot was pushed 0.4 m while the odometry says 5 cm: runs now.
   const GateDecision d =
       gate_.decide(compose(odom, step), castScan(grid_, compose(kTruth, {0.45, 0.3, 0.0})), &model_,
                    true, kTruth, false, params_);
-  EXPECT_TRUE(d.runs()) << toString(d.skip);
+  EXPECT_TRUE(d.runs()) << toString(d.skip_reason);
   EXPECT_TRUE(d.fit_dropped);
 }
 
@@ -179,13 +179,13 @@ TEST_F(UpdateGateTest, ASuspectOdometrysUpdateCountsAtLeastWhatTheThresholdsLetT
   ASSERT_TRUE(decide(odom, kTruth).runs());
   // The defaults: every update is a whole view, suspect or not.
   GateDecision d = decide(odom, kTruth, true);
-  ASSERT_TRUE(d.runs()) << toString(d.skip);  // standing still, yet it runs
+  ASSERT_TRUE(d.runs()) << toString(d.skip_reason);  // standing still, yet it runs
   EXPECT_DOUBLE_EQ(1.0, d.view);
   // 0.05 m or 0.1 rad: a quarter of 0.2 m, a fifth of pi/6; the least is the turn's.
   params_.update_min_d = 0.05;
   params_.update_min_a = 0.1;
   d = decide(odom, kTruth, true);
-  ASSERT_TRUE(d.runs()) << toString(d.skip);
+  ASSERT_TRUE(d.runs()) << toString(d.skip_reason);
   EXPECT_DOUBLE_EQ(0.1 / (M_PI / 6), d.view);
   EXPECT_DOUBLE_EQ(0.5, decide(compose(odom, {0.1, 0.0, 0.0}), kTruth, true).view);  // its motion
   // Updates on every scan: the motion's share alone.

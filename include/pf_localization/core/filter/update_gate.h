@@ -53,15 +53,23 @@ const char* toString(SkipReason reason);
 /// updates: nothing says how long an update's step is).
 OneUpdateStep oneUpdateStep(const ParticleFilterParams& params);
 
+/// What the gate decided, for the update's report.
+struct GateReport {
+  SkipReason skip_reason = SkipReason::kNone;  // kNone: the update runs
+  std::string skip_detail;                     // the specifics, for the log (may be empty)
+  bool fit_dropped = false;  // runs before the thresholds: the scan stopped fitting
+  // The beams prepared (when the update runs, and for kNoValidBeam), and
+  // those dropped without a reading (those the screening masked not counted).
+  int beams_used = 0;
+  int beams_dropped = 0;
+};
+
 /// What UpdateGate::decide found.
-struct GateDecision {
-  SkipReason skip = SkipReason::kNone;  // kNone: the update runs
-  std::string detail;                   // the specifics of `skip`, for the log
+struct GateDecision : GateReport {
   // The odometry at the last update, which the motion update starts from;
   // empty on the first update after an initialisation (no motion then).
   std::optional<Pose2> from;
-  double step = 0.0;         // m of odometry travelled since the last update
-  bool fit_dropped = false;  // runs before the thresholds: the scan stopped fitting
+  double step = 0.0;  // m of odometry travelled since the last update
   // The share of a new view the update brings (view_share.h): of its motion
   // since the last update; 1 for the first, for a requested one and when the
   // fit dropped (the scan changed, whatever the odometry says); while the
@@ -71,7 +79,7 @@ struct GateDecision {
   // kNoValidBeam (to count the dropped beams).
   std::optional<std::vector<PreparedScan>> scans;
 
-  bool runs() const { return skip == SkipReason::kNone; }
+  bool runs() const { return skip_reason == SkipReason::kNone; }
 };
 
 class UpdateGate {
@@ -88,9 +96,11 @@ class UpdateGate {
   /// `odometry_suspect` says the faulty particles win (every scan updates).
   /// When the update runs, the gate takes `odom` as the last update's
   /// odometry (and forgets a requested update); on an odometry jump too.
+  /// `masked`: the beams of `scans` the screening masked (beam_screen.h),
+  /// which the report does not count as dropped.
   GateDecision decide(const Pose2& odom, const ScanGroup& scans, const SensorModel* model,
                       bool initialized, const Pose2& estimate, bool odometry_suspect,
-                      const ParticleFilterParams& params);
+                      const ParticleFilterParams& params, int masked = 0);
 
   /// Records how well the update's scans fit its estimate: the share of the
   /// beams ending within update_fit_distance of an obstacle, the reference

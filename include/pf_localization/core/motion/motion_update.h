@@ -4,6 +4,9 @@
 // OdometryFaultTracker adapts from scan to scan.
 #pragma once
 
+#include <cstddef>
+#include <vector>
+
 #include "pf_localization/core/filter/particle_set.h"
 #include "pf_localization/core/motion/odometry_fault_tracker.h"
 #include "pf_localization/core/motion/odometry_motion_model.h"
@@ -34,9 +37,28 @@ class MotionUpdate {
                  view_share);
   }
 
+  /// After the weighing of an update whose motion ran `step` m (`moved`:
+  /// the particles were moved): the fault share learns which particles the
+  /// scan favoured, where such a step shows it
+  /// (OdometryFaultTracker::observable). Returns the share for the next update.
+  double adaptFaults(bool moved, double step, const std::vector<double>& weights, int threads,
+                     double view_share) {
+    if (moved && OdometryFaultTracker::observable(step, model_.params())) {
+      faults_.adapt(weights, model_.params(), threads, view_share);
+    }
+    return faults_.fraction();
+  }
+  /// Whether the scan pins the position along the track
+  /// (OdometryFaultTracker::setAlongTrackObservable).
+  void setAlongTrackObservable(bool observable) { faults_.setAlongTrackObservable(observable); }
+  /// Whether the odometry is suspect: the faulty particles win (OdometryFaultTracker::suspect).
+  bool suspect() const { return faults_.suspect(model_.params()); }
+  /// Forgets the fault history (an initialisation).
+  void restart() { faults_.restart(model_.params()); }
+  /// Prefaults the fault flags for `n` particles.
+  void reserve(std::size_t n) { faults_.reserve(n); }
+
   const OdometryMotionParams& params() const { return model_.params(); }
-  OdometryFaultTracker& faults() { return faults_; }
-  const OdometryFaultTracker& faults() const { return faults_; }
 
  private:
   OdometryMotionModel model_;

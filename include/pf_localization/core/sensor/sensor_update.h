@@ -1,8 +1,10 @@
 // The sensor step of the filter update: the sensor model on the map
 // (sensor_model.h) and the weighing of the particles by a scan, MCL's
 // importance weights (Thrun et al., "Probabilistic Robotics", table 8.2),
-// tempered by applyLikelihood (weighting.h). Keeps the scratch storage, so
-// that an update allocates nothing.
+// tempered by applyLikelihood (weighting.h); while a global
+// initialisation's cloud is too sparse for the model, by GlobalSearch's
+// smoothed copy of it. Keeps the scratch storage, so that an update
+// allocates nothing.
 #pragma once
 
 #include <cstddef>
@@ -10,7 +12,10 @@
 #include <vector>
 
 #include "pf_localization/core/filter/particle_set.h"
+#include "pf_localization/core/filter/resampler.h"
 #include "pf_localization/core/filter/weighting.h"
+#include "pf_localization/core/recovery/global_search.h"
+#include "pf_localization/core/sensor/likelihood_field_model.h"
 #include "pf_localization/core/sensor/sensor_model.h"
 
 namespace pf {
@@ -22,6 +27,7 @@ struct Weighing {
   // How well the cloud explains the scan: the per-beam geometric mean
   // likelihood, averaged with the posterior weights.
   double mean_beam_likelihood = 0.0;
+  double search_sigma = 0.0;  // the hit std dev of GlobalSearch's smoothed model (0: the model's)
 };
 
 /// The log-likelihood of a group of scans for every particle of
@@ -35,7 +41,12 @@ std::size_t groupLogLikelihoods(const SensorModel& model, const std::vector<Prep
 
 class SensorUpdate {
  public:
-  void setModel(std::unique_ptr<SensorModel> model) { model_ = std::move(model); }
+  /// A new model (a new map or new sensor parameters): a smoothed copy of
+  /// the old one is dropped.
+  void setModel(std::unique_ptr<SensorModel> model) {
+    model_ = std::move(model);
+    search_.forgetModel();
+  }
   bool hasModel() const { return static_cast<bool>(model_); }
   /// Null without a model.
   const SensorModel* get() const { return model_.get(); }
@@ -67,6 +78,23 @@ class SensorUpdate {
                  double min_ess_fraction, double likelihood_exponent, ParticleSet* particles,
                  int threads = 1, double evidence_share = 1.0);
 
+  /// The weighing of a filter update: `particles` by `scans`, an update
+  /// that brings a share `view` of a new view (view_share.h), by the model
+  /// or, while a global search's cloud is too sparse for it, by the search's
+  /// smoothed copy (`sensor`: the model's parameters; `kld`: what sets how
+  /// dense a cloud is); tempered to leave at least `min_ess_fraction` of the
+  /// effective sample size, or the search's own floor while its cloud
+  /// settles. Precondition: hasModel().
+  Weighing weighCloud(const std::vector<PreparedScan>& scans, double view, double min_ess_fraction,
+                      const LikelihoodFieldModelParams& sensor, const KldParams& kld,
+                      ParticleSet* particles, int threads);
+  /// A global search over `free_area` m^2 starts (GlobalSearch::start); an
+  /// initialisation at a pose stops it.
+  void startSearch(double free_area) { search_.start(free_area); }
+  void stopSearch() { search_.stop(); }
+  /// The places the update's cloud holds (GlobalSearch::observe).
+  void observePlaces(std::size_t places) { search_.observe(places); }
+
   /// Prefaults the scratch for `n` particles.
   void reserve(std::size_t n);
 
@@ -77,6 +105,7 @@ class SensorUpdate {
                   double evidence_share = 1.0);
 
   std::unique_ptr<SensorModel> model_;
+  GlobalSearch search_;  // the smoothed model while a global initialisation's cloud is sparse
   std::vector<double> log_likelihood_;
   std::vector<double> sensor_log_likelihood_;  // one sensor's, while a group is summed
   WeightingScratch scratch_;
