@@ -13,15 +13,15 @@
 #include <memory>
 
 #include "pf_localization/core/estimate/cluster_estimate.h"
-#include "pf_localization/core/estimate/confidence_verdict.h"
-#include "pf_localization/core/estimate/scan_matcher.h"
+#include "pf_localization/core/estimate/confidence.h"
+#include "pf_localization/core/estimate/scan_refiner.h"
 #include "pf_localization/core/filter/particle_filter.h"
-#include "pf_localization/core/filter/resampler.h"
+#include "pf_localization/core/filter/resampling.h"
 #include "pf_localization/core/filter/weighting.h"
 #include "pf_localization/core/motion/odometry_motion_model.h"
-#include "pf_localization/core/recovery/look_alike_places.h"
+#include "pf_localization/core/recovery/look_alikes.h"
 #include "pf_localization/core/sensor/beam_model.h"
-#include "pf_localization/core/sensor/cloud_scan.h"
+#include "pf_localization/core/sensor/cloud_scan_reducer.h"
 #include "pf_localization/core/sensor/likelihood_field_model.h"
 
 namespace {
@@ -295,7 +295,7 @@ BENCHMARK(BM_SystematicResample)
 void BM_LikelihoodField(benchmark::State& state) {
   const pf::OccupancyGrid grid = pillarMap(static_cast<int>(state.range(0)));
   for (auto _ : state) {
-    const pf::LikelihoodField field(grid, 2.0);
+    const pf::DistanceField field(grid, 2.0);
     benchmark::DoNotOptimize(field.distances().data());
   }
 }

@@ -2,7 +2,7 @@
 """check_file_names.py [ROOT]: each C++ file is named after the main type it defines.
 
 Guards that a file's name says what it holds: a reader looking for a type finds it in the file of
-its name, in snake_case (LikelihoodField in likelihood_field.h). ROOT is the repository (default:
+its name, in snake_case (DistanceField in distance_field.h). ROOT is the repository (default:
 the one holding this script). The files are every header under include/, and every .cc under src/ that
 has no header of its own path (src/X/Y.cc beside include/PACKAGE/X/Y.h); a .cc defining main() is
 a program, named after its executable, and is left out. Such a .cc must define a class it is named
@@ -42,6 +42,10 @@ ALLOWED = {
     # streams, one more part of the same partition, not what the file is about.
     'include/pf_localization/core/filter/particle_blocks.h':
         'free functions of the particle blocks; BlockStreams is their random streams',
+    # The simulator's path scripts: the PathScript a script file becomes (a struct: the data the
+    # file is about), its parser, and PathPlayer, which plays one back.
+    'include/pf_localization/sim/path_script.h':
+        'the PathScript struct, its parser and its player',
 }
 
 

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <fstream>
 
-#include "pf_localization/sim/script_line.h"
+#include "pf_localization/sim/line_parser.h"
 
 namespace pf::sim {
 

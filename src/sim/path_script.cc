@@ -5,7 +5,7 @@
 #include <cstdio>
 #include <fstream>
 
-#include "pf_localization/sim/script_line.h"
+#include "pf_localization/sim/line_parser.h"
 
 namespace pf::sim {
 

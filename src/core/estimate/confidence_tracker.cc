@@ -5,7 +5,7 @@
 #include <string>
 
 #include "pf_localization/core/estimate/hypotheses.h"
-#include "pf_localization/core/estimate/scan_matcher.h"
+#include "pf_localization/core/estimate/scan_refiner.h"
 #include "pf_localization/core/filter/view_share.h"
 
 namespace pf {

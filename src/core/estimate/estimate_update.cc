@@ -5,7 +5,7 @@
 
 namespace pf {
 
-void EstimateUpdate::setMap(const LikelihoodField& field) {
+void EstimateUpdate::setMap(const DistanceField& field) {
   look_alikes_.setMap(field);
   look_alike_places_.clear();
   refinement_.reset();  // fitted to the old map

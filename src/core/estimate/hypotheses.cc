@@ -5,7 +5,7 @@
 #include <utility>
 #include <vector>
 
-#include "pf_localization/core/recovery/look_alike_places.h"
+#include "pf_localization/core/recovery/look_alikes.h"
 
 namespace pf {
 

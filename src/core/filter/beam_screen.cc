@@ -18,12 +18,12 @@ PreparedBeams::PreparedBeams(const SensorModel& model, const ScreenedScan& scan,
   if (scan.report.beams_changed > 0) fitting_ = prepareScans(model, scan.fitting);
 }
 
-void BeamScreen::setMap(const LikelihoodField& field) {
+void BeamScreen::setMap(const DistanceField& field) {
   evidence_.emplace(field);
   layer_.emplace(field);
 }
 
-void BeamScreen::setField(const LikelihoodField& field) {
+void BeamScreen::setField(const DistanceField& field) {
   evidence_.emplace(field);
   shareMapChanges(true);
 }
@@ -48,7 +48,7 @@ ScreenedScan BeamScreen::screen(const Pose2& odom, const ScanGroup& measured,
 ScanGroup BeamScreen::maskTransients(const Pose2& odom, const ScanGroup& measured,
                                      const std::optional<Pose2>& robot) {
   if (!robot) return transients_.mask(odom, measured, {}, &steady_);
-  const LikelihoodField& field = evidence_->field();
+  const DistanceField& field = evidence_->field();
   // Two references: std::function holds them without allocating.
   const auto on_map = [&field, &robot](double x, double y) {
     const Pose2 end = compose(*robot, {x, y, 0.0});

@@ -162,7 +162,7 @@ __attribute__((target("avx2"))) std::size_t sampleBlocksAvx2(const Grid& g, cons
 
 }  // namespace
 
-BicubicDistanceField::BicubicDistanceField(const LikelihoodField& field)
+BicubicDistanceField::BicubicDistanceField(const DistanceField& field)
     : field_(field),
       cos_yaw_(std::cos(field.grid().origin().yaw)),
       sin_yaw_(std::sin(field.grid().origin().yaw)),

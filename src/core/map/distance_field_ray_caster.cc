@@ -24,7 +24,7 @@ DistanceFieldRayCaster::DistanceFieldRayCaster(const OccupancyGrid& grid)
   fill(grid, [&d2, w](int x, int y) { return std::sqrt(d2[static_cast<std::size_t>(y) * w + x]); });
 }
 
-DistanceFieldRayCaster::DistanceFieldRayCaster(const LikelihoodField& field)
+DistanceFieldRayCaster::DistanceFieldRayCaster(const DistanceField& field)
     : stride_(field.grid().width() + 2),
       rows_(field.grid().height() + 2),
       resolution_(field.grid().resolution()),

@@ -69,7 +69,7 @@ void MapChangeLayer::see(std::size_t i) {
   setValue(i, valueOf(Cell::kAsMapped));
 }
 
-MapChangeLayer::MapChangeLayer(const LikelihoodField& field)
+MapChangeLayer::MapChangeLayer(const DistanceField& field)
     : width_(field.grid().width()), height_(field.grid().height()), frame_(field.grid()) {
   const OccupancyGrid& grid = field.grid();
   const std::vector<float>& distance = field.distances();

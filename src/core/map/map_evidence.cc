@@ -41,7 +41,7 @@ void add(BeamEvidence e, EvidenceCounts* c) {
 
 }  // namespace
 
-MapEvidence::MapEvidence(const LikelihoodField& field)
+MapEvidence::MapEvidence(const DistanceField& field)
     : field_(&field), caster_(field), frame_(field.grid()) {}
 
 void MapEvidence::setGone(std::size_t cell, bool gone) {

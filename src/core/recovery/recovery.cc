@@ -5,7 +5,7 @@
 #include <utility>
 #include <vector>
 
-#include "pf_localization/core/filter/resampler.h"
+#include "pf_localization/core/filter/resampling.h"
 #include "pf_localization/core/filter/view_share.h"
 #include "pf_localization/core/util/scratch_storage.h"
 
@@ -73,7 +73,7 @@ void ExpansionResetting::spread(const RecoveryParams& params, std::size_t n, Ran
 void LookAlikeMove::contribute(const RecoveryContext& context, const RecoveryParams& /*params*/,
                                RecoveryPlan* plan) {
   // Whenever a look-alike has fitted clearly better for kBetterUpdates in a
-  // row (look_alike_places.h): that streak is what tells a place from an object
+  // row (look_alikes.h): that streak is what tells a place from an object
   // that is not on the map. Asking as well for a fit below the usual one
   // held the move back for seconds where the fit sinks slowly, as the view
   // that tells two aisles apart comes in (docs/design.md).

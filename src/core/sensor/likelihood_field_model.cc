@@ -100,7 +100,7 @@ void validate(const LikelihoodFieldModelParams& params) {
 LikelihoodFieldModel::LikelihoodFieldModel(const OccupancyGrid& grid,
                                            const LikelihoodFieldModelParams& params)
     : params_((validate(params), params)),
-      field_(std::make_shared<const LikelihoodField>(grid, params.max_distance)) {
+      field_(std::make_shared<const DistanceField>(grid, params.max_distance)) {
   if (!params.beam_skip) return;
   const int stride = grid.width() + 2;
   near_.assign(static_cast<std::size_t>(stride) * (grid.height() + 2), 0);

@@ -64,7 +64,7 @@ diagnostic_msgs::DiagnosticStatus toDiagnosticStatus(const pf::ParticleFilter& f
   add(&status, "tempering", report.tempering);
   // 0 but while a global localization's cloud is too sparse for laser_sigma_hit.
   add(&status, "search_smoothing_m", report.search_sigma);
-  // Places elsewhere on the map the scan fits as well (look_alike_places.h), and
+  // Places elsewhere on the map the scan fits as well (look_alikes.h), and
   // the survivors recovery carried to one it fits clearly better.
   add(&status, "look_alike_places", static_cast<double>(report.look_alikes));
   add(&status, "moved_to_look_alikes", static_cast<double>(report.moved));

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <variant>
 
-#include "pf_localization/core/filter/resampler.h"
+#include "pf_localization/core/filter/resampling.h"
 #include "pf_localization/ros/params/amcl_params.h"
 
 namespace pf_ros {

@@ -6,7 +6,7 @@
 #include <variant>
 #include <vector>
 
-#include "pf_localization/core/filter/resampler.h"
+#include "pf_localization/core/filter/resampling.h"
 #include "pf_localization/ros/params/localizer_config.h"
 
 namespace pf_ros {

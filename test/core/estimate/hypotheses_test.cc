@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "pf_localization/core/estimate/confidence_verdict.h"
+#include "pf_localization/core/estimate/confidence.h"
 
 namespace pf {
 namespace {

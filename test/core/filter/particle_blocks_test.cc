@@ -17,7 +17,7 @@
 
 #include "pf_localization/core/estimate/cluster_estimate.h"
 #include "pf_localization/core/filter/particle_filter.h"
-#include "pf_localization/core/filter/resampler.h"
+#include "pf_localization/core/filter/resampling.h"
 #include "support/rooms.h"
 #include "support/scan_simulator.h"
 

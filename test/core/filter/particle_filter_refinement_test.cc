@@ -1,4 +1,4 @@
-// ParticleFilter with refine_estimate: the scan fit of scan_matcher.h feeds
+// ParticleFilter with refine_estimate: the scan fit of scan_refiner.h feeds
 // the published estimate and map -> odom (scan_refiner_test.cc tests the fit
 // itself). In a file of its own, in small_world.h's room, so that it stays
 // apart from the filter's other tests.

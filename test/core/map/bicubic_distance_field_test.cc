@@ -23,7 +23,7 @@ TEST(BicubicDistanceField, PassesThroughTheCellCentres) {
   // One obstacle at cell (2, 2) of a 5 x 5 grid of 0.1 m cells.
   std::vector<int8_t> data(25, 0);
   data[2 * 5 + 2] = 100;
-  const LikelihoodField field(OccupancyGrid(5, 5, 0.1, {}, data), 2.0);
+  const DistanceField field(OccupancyGrid(5, 5, 0.1, {}, data), 2.0);
   const BicubicDistanceField smooth(field);
   for (int y = 0; y < 5; ++y) {
     for (int x = 0; x < 5; ++x) {
@@ -39,7 +39,7 @@ TEST(BicubicDistanceField, PassesThroughTheCellCentres) {
 }
 
 TEST(BicubicDistanceField, ReproducesTheRampBesideAWall) {
-  const LikelihoodField field(wallOnTheLeft(), 2.0);
+  const DistanceField field(wallOnTheLeft(), 2.0);
   const BicubicDistanceField smooth(field);
   // x = 0.43 m is 3.8 cells from the wall's centre: the stencil (columns 2
   // to 5, rows 1 to 4) lies on the ramp, which the cubic reproduces exactly.
@@ -51,7 +51,7 @@ TEST(BicubicDistanceField, ReproducesTheRampBesideAWall) {
 
 TEST(BicubicDistanceField, FollowsARotatedOrigin) {
   // The same grid turned a quarter left about (1, 0): the ramp runs along +y.
-  const LikelihoodField field(wallOnTheLeft({1.0, 0.0, M_PI / 2}), 2.0);
+  const DistanceField field(wallOnTheLeft({1.0, 0.0, M_PI / 2}), 2.0);
   const BicubicDistanceField smooth(field);
   // Grid point (0.43, 0.27) is world (1 - 0.27, 0.43).
   const FieldSample s = smooth.sample(0.73, 0.43);
@@ -64,7 +64,7 @@ TEST(BicubicDistanceField, GradientIsTheDerivativeOfTheValue) {
   // Near a corner of two walls, where the field bends.
   std::vector<int8_t> data(36, 0);
   for (int i = 0; i < 6; ++i) data[i] = data[i * 6] = 100;
-  const LikelihoodField field(OccupancyGrid(6, 6, 0.1, {0.2, -0.1, 0.3}, data), 2.0);
+  const DistanceField field(OccupancyGrid(6, 6, 0.1, {0.2, -0.1, 0.3}, data), 2.0);
   const BicubicDistanceField smooth(field);
   const double h = 1e-6;
   for (const auto& p : {std::pair<double, double>{0.41, 0.17}, {0.33, 0.08}, {0.55, 0.29}}) {
@@ -81,7 +81,7 @@ TEST(BicubicDistanceField, GradientIsTheDerivativeOfTheValue) {
 }
 
 TEST(BicubicDistanceField, FarOffTheMapIsMaxDistanceAndFlat) {
-  const LikelihoodField field(wallOnTheLeft(), 1.5);
+  const DistanceField field(wallOnTheLeft(), 1.5);
   const BicubicDistanceField smooth(field);
   for (const double x : {-50.0, 50.0, std::numeric_limits<double>::quiet_NaN(),
                          std::numeric_limits<double>::infinity()}) {
@@ -105,7 +105,7 @@ TEST(BicubicDistanceField, ManyPointsAtOnceAreTheSameBits) {
     for (auto& v : data) v = wall(rng) == 0 ? 100 : 0;
     data[0] = 100;
     for (const Pose2& origin : {Pose2{}, Pose2{-0.3, 0.7, 0.4}}) {
-      const LikelihoodField field(OccupancyGrid(width, height, 0.05, origin, data), 0.5);
+      const DistanceField field(OccupancyGrid(width, height, 0.05, origin, data), 0.5);
       const BicubicDistanceField smooth(field);
       // From two cells beyond every edge, where the field ends.
       std::uniform_real_distribution<double> x(origin.x - 0.15, origin.x + 0.05 * width + 0.15);

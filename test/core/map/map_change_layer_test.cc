@@ -54,7 +54,7 @@ int cellsIn(const MapChangeLayer& layer, const OccupancyGrid& grid, const Box& b
 
 // The layer after the tour, each pose scanned `times` times.
 MapChangeLayer toured(const OccupancyGrid& map, const OccupancyGrid& seen, int times) {
-  const LikelihoodField field(map, 2.0);
+  const DistanceField field(map, 2.0);
   MapChangeLayer layer(field);
   for (int k = 0; k < times; ++k) {
     for (const Pose2& p : tour()) layer.add(scan360(seen, p), p);
@@ -89,7 +89,7 @@ TEST(MapChangeLayer, FindsWhatTheMapLacksAndWhatIsGone) {
 TEST(MapChangeLayer, OneGlimpseIsNotAChange) {
   // One scan is fewer than kMinScans, however many of its beams hit a cell...
   const OccupancyGrid map = mapOf();
-  const LikelihoodField field(map, 2.0);
+  const DistanceField field(map, 2.0);
   MapChangeLayer layer(field);
   const Pose2 p = tour().front();
   layer.add(scan360(world(), p), p);
@@ -104,7 +104,7 @@ TEST(MapChangeLayer, OneGlimpseIsNotAChange) {
 
 TEST(MapChangeLayer, ListsEachCellThatBecameOrStoppedBeingAChange) {
   const OccupancyGrid map = mapOf();
-  const LikelihoodField field(map, 2.0);
+  const DistanceField field(map, 2.0);
   MapChangeLayer layer(field);
   for (int k = 0; k < 3; ++k) {
     for (const Pose2& p : tour()) layer.add(scan360(world(), p), p);

@@ -40,7 +40,7 @@ std::size_t indexAt(const OccupancyGrid& map, double x, double y) {
 }
 
 TEST(MapEvidence, ABeamEndingOnTheMapsWallIsOnTheMap) {
-  const LikelihoodField field(boxRoom(false), 2.0);
+  const DistanceField field(boxRoom(false), 2.0);
   const MapEvidence evidence(field);
   // The east wall's inner face is at x 5.95: 2.95 m ahead.
   EXPECT_EQ(BeamEvidence::kOnMap, ahead(evidence, 2.95));
@@ -52,7 +52,7 @@ TEST(MapEvidence, ABeamEndingOnTheMapsWallIsOnTheMap) {
 TEST(MapEvidence, ABeamStoppedByWhatTheMapLacksIsShortOfIt) {
   // The world has the box, the map does not: the beam stops 1 m ahead where
   // the map would let it run to the wall.
-  const LikelihoodField field(boxRoom(false), 2.0);
+  const DistanceField field(boxRoom(false), 2.0);
   const MapEvidence evidence(field);
   EXPECT_EQ(BeamEvidence::kShortOfMap, ahead(evidence, 1.0));
   // Within kShortMargin of the mapped wall it is the wall.
@@ -62,7 +62,7 @@ TEST(MapEvidence, ABeamStoppedByWhatTheMapLacksIsShortOfIt) {
 TEST(MapEvidence, ABeamThroughAMappedObjectThatIsGoneEndsBehindIt) {
   // The map has the box, the world does not: the beam passes where the box
   // was and ends on the wall behind it, or in the open.
-  const LikelihoodField field(boxRoom(true), 2.0);
+  const DistanceField field(boxRoom(true), 2.0);
   const MapEvidence evidence(field);
   EXPECT_EQ(BeamEvidence::kThroughOntoMap, ahead(evidence, 2.95));
   EXPECT_EQ(BeamEvidence::kThroughIntoOpen, ahead(evidence, 2.3));
@@ -73,7 +73,7 @@ TEST(MapEvidence, ABeamThroughAMappedObjectThatIsGoneEndsBehindIt) {
 
 TEST(MapEvidence, AnObstacleLearnedGoneLetsRaysThroughAndLearnedBackStopsThem) {
   const OccupancyGrid map = boxRoom(true);
-  const LikelihoodField field(map, 2.0);
+  const DistanceField field(map, 2.0);
   MapEvidence evidence(field);
   ASSERT_EQ(BeamEvidence::kThroughOntoMap, ahead(evidence, 2.95));
   // Every cell of the box learned gone: the beam to the wall behind it is
@@ -102,7 +102,7 @@ TEST(MapEvidence, AnEndOnAnObjectLearnedAddedSeesAChangeEvenBesideTheMap) {
   // a beam ending on its face, 2.75 m ahead, ends within the wall's short
   // margin, and looks on the map...
   const OccupancyGrid map = boxRoom(false);
-  const LikelihoodField field(map, 2.0);
+  const DistanceField field(map, 2.0);
   MapEvidence evidence(field);
   ASSERT_EQ(BeamEvidence::kOnMap, ahead(evidence, 2.75));
   // ...until the layer has learned the face added.
@@ -116,7 +116,7 @@ TEST(MapEvidence, AnEndOnAnObjectLearnedAddedSeesAChangeEvenBesideTheMap) {
 }
 
 TEST(MapEvidence, ABeamOffTheMapIsOffItButJustPastTheEdgeIsJudgedThere) {
-  const LikelihoodField field(boxRoom(false), 2.0);
+  const DistanceField field(boxRoom(false), 2.0);
   const MapEvidence evidence(field);
   // The map ends at x 6.0: a beam ending 0.1 m past it (0.15 m past the
   // wall's face, within kThroughMargin) ends on the wall drawn at the edge,
@@ -127,7 +127,7 @@ TEST(MapEvidence, ABeamOffTheMapIsOffItButJustPastTheEdgeIsJudgedThere) {
 
 TEST(MapEvidence, AScanIsJudgedEveryFewBeamsAndEachVerdictIsItsNeighbours) {
   const OccupancyGrid world = boxRoom(true);
-  const LikelihoodField field(boxRoom(false), 2.0);
+  const DistanceField field(boxRoom(false), 2.0);
   const MapEvidence evidence(field);
   std::vector<BeamEvidence> per_beam;
   const LaserScan scan = simulateScan(world, kRobot);
@@ -159,7 +159,7 @@ std::size_t maskedCount(const LaserScan& scan) {
 
 TEST(MapChangeMask, AtTheRightPoseTheBeamsSeeingTheChangeAreMasked) {
   const OccupancyGrid world = boxRoom(true);
-  const LikelihoodField field(boxRoom(false), 2.0);
+  const DistanceField field(boxRoom(false), 2.0);
   const MapEvidence evidence(field);
   const LaserScan scan = simulateScan(world, kRobot);
   MapChangeMask mask;
@@ -183,7 +183,7 @@ TEST(MapChangeMask, FromAWrongPoseNothingIsMasked) {
   // says: beams run through its walls and off the map, and nothing may be
   // hidden from the filter that has to find that out.
   const OccupancyGrid grid = asymmetricRoom();
-  const LikelihoodField field(grid, 2.0);
+  const DistanceField field(grid, 2.0);
   const MapEvidence evidence(field);
   const LaserScan scan = simulateScan(grid, {1.2, 1.5, 0.0});
   MapChangeMask mask;

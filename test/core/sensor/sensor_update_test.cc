@@ -9,7 +9,7 @@
 #include <numeric>
 
 #include "core/small_world.h"
-#include "pf_localization/core/filter/resampler.h"
+#include "pf_localization/core/filter/resampling.h"
 #include "pf_localization/core/filter/weighting.h"
 #include "pf_localization/core/sensor/likelihood_field_model.h"
 

@@ -13,9 +13,9 @@
 #include <vector>
 
 #include "pf_localization/core/estimate/cluster_estimate.h"
-#include "pf_localization/core/estimate/confidence_verdict.h"
+#include "pf_localization/core/estimate/confidence.h"
 #include "pf_localization/core/filter/particle_set.h"
-#include "pf_localization/core/recovery/look_alike_places.h"
+#include "pf_localization/core/recovery/look_alikes.h"
 #include "pf_localization/core/util/pose2.h"
 
 namespace pf {
@@ -41,7 +41,7 @@ class ConfidenceTracker {
   /// "localized" becomes "uncertain" while the cloud holds more than one
   /// place (`places`, hypothesesOf's count): the published verdict never
   /// says "localized" beside a second place on pf_hypotheses. Nor while the
-  /// scan fits `look_alikes` other places of the map as well (look_alike_places.h).
+  /// scan fits `look_alikes` other places of the map as well (look_alikes.h).
   /// A scan that fits no look-alike as well while the cloud holds one place
   /// tells the place apart from its look-alikes, until the next jump.
   void holdWhileAmbiguous(std::size_t places, std::size_t look_alikes = 0);

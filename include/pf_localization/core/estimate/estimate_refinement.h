@@ -1,4 +1,4 @@
-// The scan fit of the filter's estimate (scan_matcher.h: Cartographer's
+// The scan fit of the filter's estimate (scan_refiner.h: Cartographer's
 // scan-to-map matching, Hess et al., ICRA 2016), at each update and on the
 // scans between updates, and the map -> odom it gives.
 //
@@ -16,8 +16,8 @@
 #include <optional>
 
 #include "pf_localization/core/estimate/cluster_estimate.h"
-#include "pf_localization/core/estimate/confidence_verdict.h"
-#include "pf_localization/core/estimate/scan_matcher.h"
+#include "pf_localization/core/estimate/confidence.h"
+#include "pf_localization/core/estimate/scan_refiner.h"
 #include "pf_localization/core/filter/particle_filter_params.h"
 #include "pf_localization/core/sensor/scan_group.h"
 #include "pf_localization/core/sensor/sensor_model.h"

@@ -18,16 +18,16 @@
 #include <vector>
 
 #include "pf_localization/core/estimate/cluster_estimate.h"
+#include "pf_localization/core/estimate/confidence.h"
 #include "pf_localization/core/estimate/confidence_tracker.h"
-#include "pf_localization/core/estimate/confidence_verdict.h"
 #include "pf_localization/core/estimate/estimate_refinement.h"
 #include "pf_localization/core/estimate/hypotheses.h"
-#include "pf_localization/core/estimate/scan_matcher.h"
+#include "pf_localization/core/estimate/scan_refiner.h"
 #include "pf_localization/core/filter/particle_filter_params.h"
 #include "pf_localization/core/filter/particle_set.h"
-#include "pf_localization/core/map/likelihood_field.h"
+#include "pf_localization/core/map/distance_field.h"
 #include "pf_localization/core/map/map_evidence.h"
-#include "pf_localization/core/recovery/look_alike_places.h"
+#include "pf_localization/core/recovery/look_alikes.h"
 #include "pf_localization/core/sensor/scan_group.h"
 #include "pf_localization/core/sensor/sensor_model.h"
 #include "pf_localization/core/util/pose2.h"
@@ -36,7 +36,7 @@ namespace pf {
 
 /// What judge() found, for the update's report.
 struct JudgeReport {
-  // Look-alike places (look_alike_places.h) the scan fits as well as the
+  // Look-alike places (look_alikes.h) the scan fits as well as the
   // estimate, and those it fits clearly better.
   std::size_t look_alikes = 0;
   std::size_t look_alikes_better = 0;
@@ -52,7 +52,7 @@ struct Judgement {
 class EstimateUpdate {
  public:
   /// A new map: its look-alike places; the last fit and the places listed are forgotten.
-  void setMap(const LikelihoodField& field);
+  void setMap(const DistanceField& field);
   /// No estimate (a map the robot is not on).
   void forget() { estimate_ = PoseEstimate(); }
   /// After an initialisation: `estimate` is the new cloud's; "uncertain",

@@ -22,7 +22,7 @@
 #include <vector>
 
 #include "pf_localization/core/estimate/cluster_estimate.h"
-#include "pf_localization/core/recovery/look_alike_places.h"
+#include "pf_localization/core/recovery/look_alikes.h"
 #include "pf_localization/core/util/pose2.h"
 
 namespace pf {
@@ -68,7 +68,7 @@ Hypotheses hypothesesOf(const PoseEstimate& estimate, double rival_weight_ratio,
                         std::size_t max_listed = kMaxListedHypotheses);
 
 /// Lists after the cloud's hypotheses the look-alike `places` the scan fits
-/// as well as the estimate (look_alike_places.h) that the cloud does not hold (no
+/// as well as the estimate (look_alikes.h) that the cloud does not hold (no
 /// hypothesis within LookAlikes::kMinShift), best fit first: weight 0, no
 /// particles, the heaviest hypothesis's covariance (a shift or half turn
 /// leaves an x-y covariance as it is). A place within kMinShift of a better

@@ -19,7 +19,7 @@
 #include <optional>
 #include <vector>
 
-#include "pf_localization/core/map/likelihood_field.h"
+#include "pf_localization/core/map/distance_field.h"
 #include "pf_localization/core/map/map_change_layer.h"
 #include "pf_localization/core/map/map_change_mask.h"
 #include "pf_localization/core/map/map_evidence.h"
@@ -80,10 +80,10 @@ class BeamScreen {
  public:
   /// A new map (`field`'s): the judging casts rays on it, and the layer of
   /// its changes starts empty.
-  void setMap(const LikelihoodField& field);
+  void setMap(const DistanceField& field);
   /// The same map under a new likelihood field (new sensor parameters): the
   /// judging casts on it, with what the layer learned.
-  void setField(const LikelihoodField& field);
+  void setField(const DistanceField& field);
 
   /// Screens `measured`, taken at odometry `odom`, from `tracked`.
   ScreenedScan screen(const Pose2& odom, const ScanGroup& measured, const TrackedPose& tracked);

@@ -32,10 +32,10 @@
 #include <string>
 
 #include "pf_localization/core/estimate/cluster_estimate.h"
-#include "pf_localization/core/estimate/confidence_verdict.h"
+#include "pf_localization/core/estimate/confidence.h"
 #include "pf_localization/core/estimate/estimate_update.h"
 #include "pf_localization/core/estimate/hypotheses.h"
-#include "pf_localization/core/estimate/scan_matcher.h"
+#include "pf_localization/core/estimate/scan_refiner.h"
 #include "pf_localization/core/filter/beam_screen.h"
 #include "pf_localization/core/filter/particle_filter_params.h"
 #include "pf_localization/core/filter/particle_set.h"

@@ -7,9 +7,9 @@
 #include <memory>
 
 #include "pf_localization/core/estimate/cluster_estimate.h"
-#include "pf_localization/core/estimate/confidence_verdict.h"
-#include "pf_localization/core/estimate/scan_matcher.h"
-#include "pf_localization/core/filter/resampler.h"
+#include "pf_localization/core/estimate/confidence.h"
+#include "pf_localization/core/estimate/scan_refiner.h"
+#include "pf_localization/core/filter/resampling.h"
 #include "pf_localization/core/map/occupancy_grid.h"
 #include "pf_localization/core/motion/odometry_motion_model.h"
 #include "pf_localization/core/sensor/beam_model.h"
@@ -127,7 +127,7 @@ struct ParticleFilterParams {
   RecoveryParams recovery;
   ConfidenceParams confidence;
   // The published pose (and map -> odom) is the cloud's estimate refined
-  // against the map by a scan fit (scan_matcher.h), whenever the filter is
+  // against the map by a scan fit (scan_refiner.h), whenever the filter is
   // not lost and the fit is accepted; the scans between updates are fitted
   // too. On by default (docs/design.md, "The estimate is fitted to the scan").
   bool refine_estimate = true;

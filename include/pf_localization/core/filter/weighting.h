@@ -9,7 +9,7 @@
 
 #include <vector>
 
-#include "pf_localization/core/estimate/confidence_verdict.h"
+#include "pf_localization/core/estimate/confidence.h"
 #include "pf_localization/core/filter/particle_filter_params.h"
 
 namespace pf {

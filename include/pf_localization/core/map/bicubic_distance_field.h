@@ -1,5 +1,5 @@
 // A smooth distance field: the likelihood field's per-cell distances to the
-// obstacles' surfaces (LikelihoodField::surfaceDistances: inside a thick
+// obstacles' surfaces (DistanceField::surfaceDistances: inside a thick
 // obstacle they grow again), interpolated bicubically between cell centres,
 // with the gradient.
 //
@@ -19,7 +19,7 @@
 
 #include <cstddef>
 
-#include "pf_localization/core/map/likelihood_field.h"
+#include "pf_localization/core/map/distance_field.h"
 
 namespace pf {
 
@@ -33,7 +33,7 @@ struct FieldSample {
 class BicubicDistanceField {
  public:
   /// Keeps a reference: `field` must outlive this object.
-  explicit BicubicDistanceField(const LikelihoodField& field);
+  explicit BicubicDistanceField(const DistanceField& field);
 
   /// The distance at world point (wx, wy) and its gradient. More than a
   /// cell and a half off the map, or at a non-finite point: max_distance
@@ -47,7 +47,7 @@ class BicubicDistanceField {
   double resolution() const { return 1.0 / inv_resolution_; }
 
  private:
-  const LikelihoodField& field_;
+  const DistanceField& field_;
   // The grid's geometry, taken once: sample() runs for every beam of every
   // Gauss-Newton evaluation.
   double cos_yaw_, sin_yaw_, inv_resolution_, origin_x_, origin_y_;

@@ -24,7 +24,7 @@
 
 #include <vector>
 
-#include "pf_localization/core/map/likelihood_field.h"
+#include "pf_localization/core/map/distance_field.h"
 #include "pf_localization/core/map/occupancy_grid.h"
 #include "pf_localization/core/util/pose2.h"
 
@@ -36,7 +36,7 @@ class DistanceFieldRayCaster {
   /// The same from a likelihood field's distances, without a transform of
   /// its own: capped at the field's max_distance, they only shorten the jumps
   /// through open space, and every range is the same.
-  explicit DistanceFieldRayCaster(const LikelihoodField& field);
+  explicit DistanceFieldRayCaster(const DistanceField& field);
 
   /// The range in metres from (x, y) along `angle` (world frame) to the first
   /// occupied cell, or max_range when there is none within max_range on the map.

@@ -21,7 +21,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "pf_localization/core/map/likelihood_field.h"
+#include "pf_localization/core/map/distance_field.h"
 #include "pf_localization/core/sensor/scan_group.h"
 #include "pf_localization/core/util/pose2.h"
 
@@ -54,7 +54,7 @@ class MapChangeLayer {
   static constexpr double kChangedShare = 0.5;
 
   /// An empty layer of `field`'s map.
-  explicit MapChangeLayer(const LikelihoodField& field);
+  explicit MapChangeLayer(const DistanceField& field);
 
   /// m, rad: a scan is worth adding once the robot moved this far or turned
   /// this much since the last one added: a scan from the same place says

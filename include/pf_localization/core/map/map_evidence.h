@@ -26,8 +26,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "pf_localization/core/map/distance_field.h"
 #include "pf_localization/core/map/distance_field_ray_caster.h"
-#include "pf_localization/core/map/likelihood_field.h"
 #include "pf_localization/core/sensor/laser_scan.h"
 #include "pf_localization/core/sensor/sensor_model.h"
 #include "pf_localization/core/util/pose2.h"
@@ -94,9 +94,9 @@ class MapEvidence {
 
   /// Casts rays on `field`'s grid (builds the ray caster: one distance
   /// transform of the map).
-  explicit MapEvidence(const LikelihoodField& field);
+  explicit MapEvidence(const DistanceField& field);
 
-  const LikelihoodField& field() const { return *field_; }
+  const DistanceField& field() const { return *field_; }
 
   /// Rays pass the mapped obstacle at the grid's cell index `cell` when
   /// `gone` (learned gone: MapChangeLayer), and stop there again when not.
@@ -134,7 +134,7 @@ class MapEvidence {
   // judge() along the unit vector (ux, uy).
   BeamEvidence judgeRay(double sx, double sy, double ux, double uy, double range) const;
 
-  const LikelihoodField* field_;
+  const DistanceField* field_;
   DistanceFieldRayCaster caster_;
   GridFrame frame_;                  // to cast in cells
   std::vector<std::uint8_t> added_;  // per cell: setAdded() (empty until one is)

@@ -37,7 +37,7 @@
 
 #include "pf_localization/core/filter/particle_filter_params.h"
 #include "pf_localization/core/filter/particle_set.h"
-#include "pf_localization/core/filter/resampler.h"
+#include "pf_localization/core/filter/resampling.h"
 #include "pf_localization/core/sensor/sensor_model.h"
 
 namespace pf {

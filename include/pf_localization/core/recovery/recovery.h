@@ -18,7 +18,7 @@
 //   fitting below expansion_ratio times the long-term average spreads the
 //   survivors of the resampling.
 // - LookAlikeMove: where the scan fits look-alikes of the estimate clearly
-//   better (look_alike_places.h), each gets a copy of the survivors carried there
+//   better (look_alikes.h), each gets a copy of the survivors carried there
 //   by the map's motion, keeping the cloud's shape: the twin a robot was
 //   kidnapped into, or the one a global search missed, is tried at once.
 // Injected particles weigh kidnap_prior together (a mixture proposal: Thrun,
@@ -30,7 +30,7 @@
 #include <utility>
 #include <vector>
 
-#include "pf_localization/core/estimate/confidence_verdict.h"
+#include "pf_localization/core/estimate/confidence.h"
 #include "pf_localization/core/filter/particle_filter_params.h"
 #include "pf_localization/core/filter/particle_set.h"
 #include "pf_localization/core/map/occupancy_grid.h"

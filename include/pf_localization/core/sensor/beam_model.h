@@ -23,8 +23,8 @@
 
 #include <vector>
 
+#include "pf_localization/core/map/distance_field.h"
 #include "pf_localization/core/map/distance_field_ray_caster.h"
-#include "pf_localization/core/map/likelihood_field.h"
 #include "pf_localization/core/sensor/likelihood_field_model.h"
 #include "pf_localization/core/sensor/sensor_model.h"
 
@@ -50,7 +50,7 @@ class BeamModel : public SensorModel {
   BeamModel(const OccupancyGrid& grid, const LikelihoodFieldModelParams& shared,
             const BeamModelParams& params);
 
-  const LikelihoodField& field() const override { return field_; }
+  const DistanceField& field() const override { return field_; }
   const DistanceFieldRayCaster& rayCaster() const { return caster_; }
 
   PreparedScan prepare(const LaserScan& scan) const override {
@@ -72,7 +72,7 @@ class BeamModel : public SensorModel {
 
   LikelihoodFieldModelParams shared_;
   BeamModelParams params_;
-  LikelihoodField field_;
+  DistanceField field_;
   DistanceFieldRayCaster caster_;
 };
 

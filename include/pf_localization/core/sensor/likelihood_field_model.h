@@ -30,7 +30,7 @@
 #include <vector>
 
 #include "pf_localization/core/filter/particle_set.h"
-#include "pf_localization/core/map/likelihood_field.h"
+#include "pf_localization/core/map/distance_field.h"
 #include "pf_localization/core/sensor/laser_scan.h"
 #include "pf_localization/core/sensor/sensor_model.h"
 #include "pf_localization/core/util/parameter_table.h"
@@ -80,7 +80,7 @@ class LikelihoodFieldModel : public SensorModel {
   LikelihoodFieldModel(const OccupancyGrid& grid, const LikelihoodFieldModelParams& params);
 
   const LikelihoodFieldModelParams& params() const { return params_; }
-  const LikelihoodField& field() const override { return *field_; }
+  const DistanceField& field() const override { return *field_; }
 
   /// This model with the hit component's std dev `sigma_hit`, on the same
   /// likelihood field (shared, not copied: only the table is its own).
@@ -115,7 +115,7 @@ class LikelihoodFieldModel : public SensorModel {
                                  const ParticleSet& particles) const;
 
   LikelihoodFieldModelParams params_;
-  std::shared_ptr<const LikelihoodField> field_;
+  std::shared_ptr<const DistanceField> field_;
   // The precomputed table: (width + 2) x (height + 2) with a border of
   // "outside the map" cells, rebuilt only when range_max changes.
   mutable std::vector<float> table_;

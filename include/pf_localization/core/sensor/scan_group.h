@@ -9,7 +9,7 @@
 //
 // Each scan is prepared with its own beam budget and range limits and scored
 // on its own (its own range_max scales z_rand), its log-likelihood weighted
-// by LaserScan::weight; the fit of the estimate (scan_matcher.h) takes every
+// by LaserScan::weight; the fit of the estimate (scan_refiner.h) takes every
 // scan's end points together. A group of one scan is exactly the scan.
 #pragma once
 

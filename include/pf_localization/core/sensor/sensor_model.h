@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "pf_localization/core/filter/particle_set.h"
-#include "pf_localization/core/map/likelihood_field.h"
+#include "pf_localization/core/map/distance_field.h"
 #include "pf_localization/core/sensor/laser_scan.h"
 
 namespace pf {
@@ -47,7 +47,7 @@ class SensorModel {
   virtual ~SensorModel() = default;
 
   /// The map's likelihood field (distances to the nearest obstacle), and through it the grid.
-  virtual const LikelihoodField& field() const = 0;
+  virtual const DistanceField& field() const = 0;
 
   /// The usable beams with the model's own beam budget, and with another (<= 0: all).
   virtual PreparedScan prepare(const LaserScan& scan) const = 0;

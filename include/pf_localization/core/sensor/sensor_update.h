@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "pf_localization/core/filter/particle_set.h"
-#include "pf_localization/core/filter/resampler.h"
+#include "pf_localization/core/filter/resampling.h"
 #include "pf_localization/core/filter/weighting.h"
 #include "pf_localization/core/recovery/global_search.h"
 #include "pf_localization/core/sensor/likelihood_field_model.h"

@@ -26,7 +26,7 @@ void sinCos(const double* angle, std::size_t n, double* s, double* c);
 void exps(const double* x, std::size_t n, double* out);
 
 // atan2 for per-point loops that need an angle to a few microradians, not to
-// the last bit: binning a 30 000-point cloud by bearing (cloud_scan.h).
+// the last bit: binning a 30 000-point cloud by bearing (cloud_scan_reducer.h).
 //
 // fastAtan2() reduces to the first octant (|y/x| <= 1, one division), evaluates
 // Abramowitz & Stegun's polynomial 4.4.49 there (|error| <= 2e-8 rad), and

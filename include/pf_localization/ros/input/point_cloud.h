@@ -1,4 +1,4 @@
-// sensor_msgs/PointCloud2 read into the core's cloud input (core/cloud_scan.h):
+// sensor_msgs/PointCloud2 read into the core's cloud input (core/cloud_scan_reducer.h):
 // the x, y and z of every point, through sensor_msgs' PointCloud2ConstIterator.
 //
 // A cloud is read if its x, y and z fields are float32 (the type every lidar
@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "pf_localization/core/sensor/cloud_scan.h"
+#include "pf_localization/core/sensor/cloud_scan_reducer.h"
 
 namespace pf_ros {
 

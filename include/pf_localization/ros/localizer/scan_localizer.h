@@ -20,7 +20,7 @@
 
 #include "pf_localization/core/filter/particle_filter.h"
 #include "pf_localization/core/map/map_change_layer.h"
-#include "pf_localization/core/sensor/sensor_status.h"
+#include "pf_localization/core/sensor/sensor_health.h"
 #include "pf_localization/ros/params/localizer_config.h"
 
 namespace pf_ros {
@@ -95,7 +95,7 @@ class ScanLocalizer {
 
   /// The same for a 3D lidar's or a depth camera's cloud of sensor `sensor`
   /// (an index of its own, after the scan topics'): reduced to a scan by
-  /// config().cloud (core/cloud_scan.h) from its 3D mounting in tf, then
+  /// config().cloud (core/cloud_scan_reducer.h) from its 3D mounting in tf, then
   /// weighed like any other sensor's scan.
   ScanResult processCloud(const sensor_msgs::PointCloud2& cloud, std::size_t sensor);
 

@@ -9,7 +9,7 @@
 
 #include "pf_localization/core/estimate/hypotheses.h"
 #include "pf_localization/core/filter/particle_filter.h"
-#include "pf_localization/core/sensor/sensor_status.h"
+#include "pf_localization/core/sensor/sensor_health.h"
 
 namespace pf_ros {
 

@@ -19,7 +19,7 @@
 #include <optional>
 #include <string>
 
-#include "pf_localization/core/estimate/confidence_verdict.h"
+#include "pf_localization/core/estimate/confidence.h"
 #include "pf_localization/ros/localizer/output_latency.h"
 #include "pf_localization/ros/localizer/scan_localizer.h"
 #include "pf_localization/ros/output/latched_topic.h"

@@ -17,7 +17,7 @@
 #include <vector>
 
 #include "pf_localization/core/filter/particle_filter.h"
-#include "pf_localization/core/sensor/cloud_scan.h"
+#include "pf_localization/core/sensor/cloud_scan_reducer.h"
 #include "pf_localization/core/util/parameter_table.h"
 
 namespace pf_ros {

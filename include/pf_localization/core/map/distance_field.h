@@ -19,14 +19,14 @@
 
 namespace pf {
 
-class LikelihoodField {
+class DistanceField {
  public:
   /// Cells behind an obstacle's surface cell that still count as on it (a
   /// real map's walls are blurred over two or three cells).
   static constexpr float kFreeDepth = 1.0f;
 
   /// Throws std::invalid_argument when max_distance is not positive and finite.
-  LikelihoodField(const OccupancyGrid& grid, double max_distance);
+  DistanceField(const OccupancyGrid& grid, double max_distance);
 
   double maxDistance() const { return max_distance_; }
   const OccupancyGrid& grid() const { return grid_; }

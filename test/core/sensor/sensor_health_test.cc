@@ -1,5 +1,5 @@
 // SensorHealth: each sensor's rate, age and beams, and which one is missing.
-#include "pf_localization/core/sensor/sensor_status.h"
+#include "pf_localization/core/sensor/sensor_health.h"
 
 #include <gtest/gtest.h>
 

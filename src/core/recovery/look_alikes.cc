@@ -1,4 +1,4 @@
-#include "pf_localization/core/recovery/look_alike_places.h"
+#include "pf_localization/core/recovery/look_alikes.h"
 
 #include <algorithm>
 #include <cmath>
@@ -87,7 +87,7 @@ void peaks(const std::vector<double>& values, int p, double threshold, Keep keep
 
 // The share of `samples` (grid-frame points) that `motion` puts within one
 // cell of an obstacle.
-double overlapOf(const LikelihoodField& field, const std::vector<Eigen::Vector2d>& samples,
+double overlapOf(const DistanceField& field, const std::vector<Eigen::Vector2d>& samples,
                  const Pose2& motion) {
   const OccupancyGrid& grid = field.grid();
   const double res = grid.resolution();
@@ -105,7 +105,7 @@ double overlapOf(const LikelihoodField& field, const std::vector<Eigen::Vector2d
 
 // The best of `candidate` moved by multiples of `step` cells within
 // +-reach cells, scored on `samples`.
-Candidate bestOffset(const LikelihoodField& field, const std::vector<Eigen::Vector2d>& samples,
+Candidate bestOffset(const DistanceField& field, const std::vector<Eigen::Vector2d>& samples,
                      const Pose2& candidate, int reach, int step) {
   const double res = field.grid().resolution();
   Candidate best{candidate, -1.0};
@@ -122,7 +122,7 @@ Candidate bestOffset(const LikelihoodField& field, const std::vector<Eigen::Vect
 // `candidate` moved by whole cells within +-reach, to the best overlap: a
 // search on every step-th cell with `some` of the samples (a quarter), then
 // every cell around its best with them all.
-Candidate refine(const LikelihoodField& field, const std::vector<Eigen::Vector2d>& samples,
+Candidate refine(const DistanceField& field, const std::vector<Eigen::Vector2d>& samples,
                  const std::vector<Eigen::Vector2d>& some, const Pose2& candidate, int reach) {
   const int step = std::max(1, reach / 4);
   const Candidate rough = bestOffset(field, some, candidate, reach - reach % step, step);
@@ -201,7 +201,7 @@ std::vector<Candidate> coarsePeaks(const std::vector<Eigen::Vector2d>& obstacles
 
 }  // namespace
 
-std::vector<MapSymmetry> findMapSymmetries(const LikelihoodField& field) {
+std::vector<MapSymmetry> findMapSymmetries(const DistanceField& field) {
   const OccupancyGrid& grid = field.grid();
   const int w = grid.width(), h = grid.height();
   const double res = grid.resolution();
@@ -243,7 +243,7 @@ std::vector<MapSymmetry> findMapSymmetries(const LikelihoodField& field) {
   return out;
 }
 
-void LookAlikes::setMap(const LikelihoodField& field) {
+void LookAlikes::setMap(const DistanceField& field) {
   symmetries_ = findMapSymmetries(field);
   restart();
 }

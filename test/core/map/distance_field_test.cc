@@ -1,4 +1,4 @@
-#include "pf_localization/core/map/likelihood_field.h"
+#include "pf_localization/core/map/distance_field.h"
 
 #include <gtest/gtest.h>
 
@@ -19,8 +19,8 @@ OccupancyGrid oneObstacle(const Pose2& origin = {}) {
   return OccupancyGrid(5, 4, 0.5, origin, data);
 }
 
-TEST(LikelihoodField, DistancesAreInMetres) {
-  const LikelihoodField field(oneObstacle(), 10.0);
+TEST(DistanceField, DistancesAreInMetres) {
+  const DistanceField field(oneObstacle(), 10.0);
   // Squared cell distances to (1, 1) times the 0.5 m resolution.
   EXPECT_NEAR(0.0, field.distance({1, 1}), kTol);
   EXPECT_NEAR(0.5, field.distance({2, 1}), kTol);
@@ -32,13 +32,13 @@ TEST(LikelihoodField, DistancesAreInMetres) {
   EXPECT_NEAR(0.5 * std::sqrt(13.0), field.distances()[3 * 5 + 4], kTol);
 }
 
-TEST(LikelihoodField, InsideAThickObstacleTheSurfaceDistanceIsHowFarPastItsSurface) {
+TEST(DistanceField, InsideAThickObstacleTheSurfaceDistanceIsHowFarPastItsSurface) {
   // 9 x 3 cells of 0.1 m: a wall 6 cells thick (x 1-6) between free cells.
   std::vector<int8_t> data(27, 0);
   for (int y = 0; y < 3; ++y) {
     for (int x = 1; x <= 6; ++x) data[y * 9 + x] = 100;
   }
-  const LikelihoodField field(OccupancyGrid(9, 3, 0.1, {}, data), 2.0);
+  const DistanceField field(OccupancyGrid(9, 3, 0.1, {}, data), 2.0);
   const auto at = [&field](int x) { return field.surfaceDistances()[1 * 9 + x]; };
   // The surface cells and the next (kFreeDepth) are on the wall ...
   EXPECT_NEAR(0.0, at(1), kTol);
@@ -55,8 +55,8 @@ TEST(LikelihoodField, InsideAThickObstacleTheSurfaceDistanceIsHowFarPastItsSurfa
   EXPECT_NEAR(0.0, field.distance({3, 1}), kTol);
 }
 
-TEST(LikelihoodField, DistancesAreCappedAtMaxDistance) {
-  const LikelihoodField field(oneObstacle(), 1.0);
+TEST(DistanceField, DistancesAreCappedAtMaxDistance) {
+  const DistanceField field(oneObstacle(), 1.0);
   EXPECT_EQ(1.0, field.maxDistance());
   EXPECT_NEAR(0.5 * std::sqrt(2.0), field.distance({0, 0}), kTol);  // below the cap
   EXPECT_NEAR(1.0, field.distance({3, 1}), kTol);                   // exactly 2 cells
@@ -65,12 +65,12 @@ TEST(LikelihoodField, DistancesAreCappedAtMaxDistance) {
   for (float d : field.distances()) EXPECT_LE(d, 1.0f);
 }
 
-TEST(LikelihoodField, NoObstacleIsMaxDistanceEverywhere) {
-  const LikelihoodField field(OccupancyGrid(5, 4, 0.5, {}, std::vector<int8_t>(20, 0)), 2.0);
+TEST(DistanceField, NoObstacleIsMaxDistanceEverywhere) {
+  const DistanceField field(OccupancyGrid(5, 4, 0.5, {}, std::vector<int8_t>(20, 0)), 2.0);
   for (float d : field.distances()) EXPECT_EQ(2.0f, d);
 }
 
-TEST(LikelihoodField, UnknownCellsAreNotObstacles) {
+TEST(DistanceField, UnknownCellsAreNotObstacles) {
   // -1 (unknown) and 50 (between free and occupied) next to the obstacle,
   // 64 just below the occupied threshold, 65 just at it.
   std::vector<int8_t> data(20, 0);
@@ -79,7 +79,7 @@ TEST(LikelihoodField, UnknownCellsAreNotObstacles) {
   data[2 * 5 + 1] = 50;
   data[0 * 5 + 4] = 64;
   data[3 * 5 + 4] = 65;
-  const LikelihoodField field(OccupancyGrid(5, 4, 0.5, {}, data), 10.0);
+  const DistanceField field(OccupancyGrid(5, 4, 0.5, {}, data), 10.0);
   EXPECT_NEAR(0.5, field.distance({2, 1}), kTol);  // unknown: 1 cell away
   EXPECT_NEAR(0.5, field.distance({1, 2}), kTol);  // grey: 1 cell away
   EXPECT_NEAR(1.5, field.distance({4, 0}), kTol);  // 64 is not: 3 cells below the 65
@@ -87,8 +87,8 @@ TEST(LikelihoodField, UnknownCellsAreNotObstacles) {
   EXPECT_NEAR(0.5, field.distance({4, 2}), kTol);  // next to the 65
 }
 
-TEST(LikelihoodField, OutsideTheMapIsMaxDistance) {
-  const LikelihoodField field(oneObstacle(), 1.2);
+TEST(DistanceField, OutsideTheMapIsMaxDistance) {
+  const DistanceField field(oneObstacle(), 1.2);
   EXPECT_EQ(1.2, field.distance({-1, 0}));
   EXPECT_EQ(1.2, field.distance({0, -1}));
   EXPECT_EQ(1.2, field.distance({5, 0}));
@@ -102,8 +102,8 @@ TEST(LikelihoodField, OutsideTheMapIsMaxDistance) {
   EXPECT_EQ(1.2, field.distanceAt(0.25, 2.01));
 }
 
-TEST(LikelihoodField, DistanceAtUsesWorldCoordinates) {
-  const LikelihoodField field(oneObstacle({-1.0, 2.0, 0.0}), 10.0);
+TEST(DistanceField, DistanceAtUsesWorldCoordinates) {
+  const DistanceField field(oneObstacle({-1.0, 2.0, 0.0}), 10.0);
   // Cell (0, 0) spans [-1, -0.5) x [2, 2.5); the obstacle cell (1, 1) is
   // [-0.5, 0) x [2.5, 3).
   EXPECT_NEAR(0.0, field.distanceAt(-0.25, 2.75), kTol);
@@ -113,10 +113,10 @@ TEST(LikelihoodField, DistanceAtUsesWorldCoordinates) {
   EXPECT_EQ(10.0, field.distanceAt(0.25, 0.25));  // outside, under the shifted origin
 }
 
-TEST(LikelihoodField, RotatedOriginIsHonoured) {
+TEST(DistanceField, RotatedOriginIsHonoured) {
   // The map's x axis points along world +y: cell (i, j) has its centre at
   // (1 - (j + 0.5) * 0.5, 2 + (i + 0.5) * 0.5).
-  const LikelihoodField field(oneObstacle({1.0, 2.0, M_PI / 2}), 10.0);
+  const DistanceField field(oneObstacle({1.0, 2.0, M_PI / 2}), 10.0);
   EXPECT_NEAR(0.0, field.distanceAt(1.0 - 0.75, 2.0 + 0.75), kTol);  // cell (1, 1)
   EXPECT_NEAR(0.5 * std::sqrt(13.0), field.distanceAt(1.0 - 1.75, 2.0 + 2.25), kTol);  // (4, 3)
   EXPECT_NEAR(1.5, field.distanceAt(1.0 - 0.75, 2.0 + 2.25), kTol);  // cell (4, 1)
@@ -124,15 +124,14 @@ TEST(LikelihoodField, RotatedOriginIsHonoured) {
   EXPECT_EQ(10.0, field.distanceAt(1.75, 2.25));
 }
 
-TEST(LikelihoodField, InvalidMaxDistanceThrows) {
+TEST(DistanceField, InvalidMaxDistanceThrows) {
   const OccupancyGrid grid = oneObstacle();
-  EXPECT_THROW(LikelihoodField(grid, 0.0), std::invalid_argument);
-  EXPECT_THROW(LikelihoodField(grid, -1.0), std::invalid_argument);
-  EXPECT_THROW(LikelihoodField(grid, std::numeric_limits<double>::infinity()),
+  EXPECT_THROW(DistanceField(grid, 0.0), std::invalid_argument);
+  EXPECT_THROW(DistanceField(grid, -1.0), std::invalid_argument);
+  EXPECT_THROW(DistanceField(grid, std::numeric_limits<double>::infinity()), std::invalid_argument);
+  EXPECT_THROW(DistanceField(grid, std::numeric_limits<double>::quiet_NaN()),
                std::invalid_argument);
-  EXPECT_THROW(LikelihoodField(grid, std::numeric_limits<double>::quiet_NaN()),
-               std::invalid_argument);
-  EXPECT_NO_THROW(LikelihoodField(grid, 1e-3));
+  EXPECT_NO_THROW(DistanceField(grid, 1e-3));
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 // LookAlikes: the map's symmetries (shifts between twin rooms, the half turn
 // of a bare hall, none in a scatter of obstacles), what a scan says of them,
 // and a filter carried into a twin room finding itself there.
-#include "pf_localization/core/recovery/look_alike_places.h"
+#include "pf_localization/core/recovery/look_alikes.h"
 
 #include <gtest/gtest.h>
 
@@ -52,7 +52,7 @@ bool hasMotion(const std::vector<MapSymmetry>& symmetries, const Pose2& motion, 
 
 TEST(FindMapSymmetries, FindsTheShiftBetweenTwinRoomsBothWays) {
   const OccupancyGrid grid = twinRooms();
-  const LikelihoodField field(grid, 2.0);
+  const DistanceField field(grid, 2.0);
   const std::vector<MapSymmetry> s = findMapSymmetries(field);
   EXPECT_TRUE(hasMotion(s, kEastShift, 0.051));
   EXPECT_TRUE(hasMotion(s, inverse(kEastShift), 0.051));
@@ -65,7 +65,7 @@ TEST(FindMapSymmetries, FindsTheShiftBetweenTwinRoomsBothWays) {
 TEST(FindMapSymmetries, FindsTheHalfTurnOfABareHallAboutItsCentre) {
   // A hall of 80 x 60 cells: the half turn about (2, 1.5) maps it onto itself.
   const OccupancyGrid grid = test::room(4.0, 3.0, 0.05);
-  const std::vector<MapSymmetry> s = findMapSymmetries(LikelihoodField(grid, 2.0));
+  const std::vector<MapSymmetry> s = findMapSymmetries(DistanceField(grid, 2.0));
   EXPECT_TRUE(hasMotion(s, {4.0, 3.0, M_PI}, 0.051));
 }
 
@@ -75,13 +75,13 @@ TEST(FindMapSymmetries, FindsNoneInAScatterOfObstacles) {
   for (int k = 0; k < 300; ++k)
     data[static_cast<std::size_t>(random.uniform() * data.size())] = 100;
   const OccupancyGrid grid(120, 90, 0.05, {}, data);
-  EXPECT_TRUE(findMapSymmetries(LikelihoodField(grid, 2.0)).empty());
+  EXPECT_TRUE(findMapSymmetries(DistanceField(grid, 2.0)).empty());
 }
 
 TEST(FindMapSymmetries, GivesWorldMotionsOnAGridWithAnOrigin) {
   const Pose2 origin{-3.0, 5.0, 0.5};
   const OccupancyGrid rotated = test::room(4.0, 3.0, 0.05, {}, origin);
-  const std::vector<MapSymmetry> s = findMapSymmetries(LikelihoodField(rotated, 2.0));
+  const std::vector<MapSymmetry> s = findMapSymmetries(DistanceField(rotated, 2.0));
   // The hall's centre, in the world, is a fixed point of its half turn.
   double cx = 0.0, cy = 0.0;
   rotated.cellToWorld({40, 30}, &cx, &cy);

@@ -1,4 +1,4 @@
-#include "pf_localization/core/estimate/scan_matcher.h"
+#include "pf_localization/core/estimate/scan_refiner.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
@@ -117,7 +117,7 @@ struct ScanRefiner::Evaluation {
   Eigen::Vector3d gradient = Eigen::Vector3d::Zero();  // J^T W r
 };
 
-ScanRefiner::ScanRefiner(const LikelihoodField& field, const ScanRefinerParams& params)
+ScanRefiner::ScanRefiner(const DistanceField& field, const ScanRefinerParams& params)
     : field_(field), params_((validate(params), params)) {
   const double k2 = params_.cauchy_scale * params_.cauchy_scale;
   const double truncated = params_.outlier_distance - params_.wall_offset;

@@ -18,7 +18,7 @@
 #include <cstddef>
 #include <vector>
 
-#include "pf_localization/core/map/likelihood_field.h"
+#include "pf_localization/core/map/distance_field.h"
 #include "pf_localization/core/map/map_evidence.h"
 #include "pf_localization/core/sensor/sensor_model.h"
 #include "pf_localization/core/util/pose2.h"
@@ -33,7 +33,7 @@ struct MapSymmetry {
 
 /// The map's symmetries with an overlap of at least kMinSymmetryOverlap,
 /// strongest first, at most kMaxSymmetries.
-std::vector<MapSymmetry> findMapSymmetries(const LikelihoodField& field);
+std::vector<MapSymmetry> findMapSymmetries(const DistanceField& field);
 
 /// A look-alike place and the scans' log-likelihood there.
 struct LookAlikePlace {
@@ -80,7 +80,7 @@ class LookAlikes {
   static constexpr double kSeenMargin = 0.2;
 
   /// Finds the symmetries of `field`'s map (findMapSymmetries).
-  void setMap(const LikelihoodField& field);
+  void setMap(const DistanceField& field);
   /// Forgets the streaks of better fits (after an initialisation).
   void restart();
   const std::vector<MapSymmetry>& symmetries() const { return symmetries_; }

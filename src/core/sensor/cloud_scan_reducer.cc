@@ -1,4 +1,4 @@
-#include "pf_localization/core/sensor/cloud_scan.h"
+#include "pf_localization/core/sensor/cloud_scan_reducer.h"
 
 #include <Eigen/LU>  // determinant()
 #include <cmath>

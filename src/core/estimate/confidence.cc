@@ -1,4 +1,4 @@
-#include "pf_localization/core/estimate/confidence_verdict.h"
+#include "pf_localization/core/estimate/confidence.h"
 
 #include <cmath>
 #include <iomanip>

@@ -1,4 +1,4 @@
-#include "pf_localization/core/map/likelihood_field.h"
+#include "pf_localization/core/map/distance_field.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 namespace pf {
 
-LikelihoodField::LikelihoodField(const OccupancyGrid& grid, double max_distance)
+DistanceField::DistanceField(const OccupancyGrid& grid, double max_distance)
     : grid_(grid), max_distance_(max_distance) {
   if (!(max_distance > 0.0) || !std::isfinite(max_distance)) {
     throw std::invalid_argument("likelihood field: max_distance must be positive and finite, got " +
@@ -32,8 +32,8 @@ LikelihoodField::LikelihoodField(const OccupancyGrid& grid, double max_distance)
   addDepths(occupied, grid.width(), grid.height(), res, cap);
 }
 
-void LikelihoodField::addDepths(const std::vector<bool>& occupied, int width, int height, float res,
-                                float cap) {
+void DistanceField::addDepths(const std::vector<bool>& occupied, int width, int height, float res,
+                              float cap) {
   // The transform runs over the obstacles' bounding box and one cell round
   // it: every cell beyond is open, and the nearest open cell of an obstacle
   // cell is never further than that ring (clamping a cell beyond into the
@@ -71,7 +71,7 @@ void LikelihoodField::addDepths(const std::vector<bool>& occupied, int width, in
   }
 }
 
-bool LikelihoodField::hasDeepCells(const std::vector<bool>& occupied, int width, int height) {
+bool DistanceField::hasDeepCells(const std::vector<bool>& occupied, int width, int height) {
   // Deeper than 1 + kFreeDepth cells: every cell within that radius occupied
   // or off the map (off the map is no free cell to measure to either).
   const int r = static_cast<int>(1.0f + kFreeDepth);
@@ -93,7 +93,7 @@ bool LikelihoodField::hasDeepCells(const std::vector<bool>& occupied, int width,
   return false;
 }
 
-double LikelihoodField::distance(const CellIndex& c) const {
+double DistanceField::distance(const CellIndex& c) const {
   return grid_.contains(c) ? distances_[grid_.linearIndex(c)] : max_distance_;
 }
 

@@ -1,4 +1,4 @@
-#include "pf_localization/core/estimate/scan_matcher.h"
+#include "pf_localization/core/estimate/scan_refiner.h"
 
 #include <gtest/gtest.h>
 
@@ -56,7 +56,7 @@ const Pose2 kTruth{0.83, 0.57, 0.2};
 
 TEST(ScanRefiner, RecoversAKnownOffsetToAMillimetre) {
   const OccupancyGrid grid = test::gridFromRows(kRoom, kCell);
-  const LikelihoodField field(grid, 2.0);
+  const DistanceField field(grid, 2.0);
   const ScanRefiner refiner(field, ScanRefinerParams());
   const PreparedScan scan = scanOfObstacles(grid, kTruth);
   ASSERT_EQ(58u, scan.size());
@@ -83,7 +83,7 @@ TEST(ScanRefiner, RecoversAKnownOffsetToAMillimetre) {
 
 TEST(ScanRefiner, StartingAtTheTruthStaysThere) {
   const OccupancyGrid grid = test::gridFromRows(kRoom, kCell);
-  const LikelihoodField field(grid, 2.0);
+  const DistanceField field(grid, 2.0);
   const ScanRefiner refiner(field, ScanRefinerParams());
   const ScanRefinement r = refiner.refine(scanOfObstacles(grid, kTruth), kTruth);
   ASSERT_TRUE(r.accepted) << r.rejection_detail;
@@ -94,7 +94,7 @@ TEST(ScanRefiner, AScanWithNothingToMatchIsRejected) {
   // A 2 m x 2 m room with nothing in it but its walls.
   std::vector<int8_t> data(400, 0);
   for (int i = 0; i < 20; ++i) data[i] = data[380 + i] = data[20 * i] = data[20 * i + 19] = 100;
-  const LikelihoodField field(OccupancyGrid(20, 20, 0.1, {}, data), 2.0);
+  const DistanceField field(OccupancyGrid(20, 20, 0.1, {}, data), 2.0);
   const ScanRefiner refiner(field, ScanRefinerParams());
   // Twelve end points 0.1 m around the robot in the middle of the room,
   // 0.75 m or more from the walls.
@@ -117,7 +117,7 @@ TEST(ScanRefiner, AScanWithNothingToMatchIsRejected) {
 
 TEST(ScanRefiner, AnEmptyScanIsRejected) {
   const OccupancyGrid grid = test::gridFromRows(kRoom, kCell);
-  const LikelihoodField field(grid, 2.0);
+  const DistanceField field(grid, 2.0);
   const ScanRefinement r = ScanRefiner(field, ScanRefinerParams()).refine(PreparedScan(), kTruth);
   EXPECT_FALSE(r.accepted);
   EXPECT_EQ(ScanRejection::kTooFewMatchedBeams, r.rejection) << r.rejection_detail;
@@ -125,7 +125,7 @@ TEST(ScanRefiner, AnEmptyScanIsRejected) {
 
 TEST(ScanRefiner, AFitThatMovesTooFarIsRejected) {
   const OccupancyGrid grid = test::gridFromRows(kRoom, kCell);
-  const LikelihoodField field(grid, 2.0);
+  const DistanceField field(grid, 2.0);
   const PreparedScan scan = scanOfObstacles(grid, kTruth);
   const Pose2 start{kTruth.x + 0.06, kTruth.y - 0.04, kTruth.yaw};
   ScanRefinerParams params;
@@ -164,7 +164,7 @@ OccupancyGrid corridorGrid() {
 TEST(ScanRefiner, AlongAFeaturelessCorridorTheStartIsKept) {
   // The scan says nothing about x.
   const OccupancyGrid grid = corridorGrid();
-  const LikelihoodField field(grid, 2.0);
+  const DistanceField field(grid, 2.0);
   const Pose2 truth{1.5, 0.42, 0.0};
   // Only cells well inside the map, so that no stencil sees past its ends.
   const PreparedScan scan = scanOfObstacles(grid, truth, 6);
@@ -198,7 +198,7 @@ PreparedScan corridorScan(const OccupancyGrid& grid, const Pose2& truth, int per
 
 TEST(ScanRefiner, MoreBeamsOfTheSameWallsDoNotNarrowTheCovarianceBelowTheMapsError) {
   const OccupancyGrid grid = corridorGrid();
-  const LikelihoodField field(grid, 2.0);
+  const DistanceField field(grid, 2.0);
   const ScanRefiner refiner(field, ScanRefinerParams());
   const Pose2 truth{1.5, 0.42, 0.0};
   // Each wall is drawn with one offset, uniform over a cell: across the
@@ -235,7 +235,7 @@ TEST(ScanRefiner, AtACornerEachWallHasItsOwnOffset) {
           "################",  //
       },
       kCell);
-  const LikelihoodField field(grid, 2.0);
+  const DistanceField field(grid, 2.0);
   const Pose2 truth{0.62, 0.47, 0.0};
   const ScanRefinement r =
       ScanRefiner(field, ScanRefinerParams()).refine(scanOfObstacles(grid, truth), truth);

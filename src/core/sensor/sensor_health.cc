@@ -1,4 +1,4 @@
-#include "pf_localization/core/sensor/sensor_status.h"
+#include "pf_localization/core/sensor/sensor_health.h"
 
 #include <algorithm>
 #include <cstdio>

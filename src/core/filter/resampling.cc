@@ -1,4 +1,4 @@
-#include "pf_localization/core/filter/resampler.h"
+#include "pf_localization/core/filter/resampling.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "pf_localization/core/sensor/cloud_scan.h"
+#include "pf_localization/core/sensor/cloud_scan_reducer.h"
 
 #include <gtest/gtest.h>
 
@@ -16,7 +16,7 @@ constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr double kDeg = M_PI / 180.0;
 
-// The bearing of bin k's centre (cloud_scan.h: -pi + k * width).
+// The bearing of bin k's centre (cloud_scan_reducer.h: -pi + k * width).
 double binBearing(const LaserScan& scan, int k) {
   return scan.angle_min + k * scan.angle_increment;
 }

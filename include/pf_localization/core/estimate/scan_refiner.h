@@ -108,7 +108,7 @@ struct ScanRefinement {
   Pose2 pose;                                      // the refined pose when accepted, else the start
   // The fit's covariance (x, y, yaw): the residual variance times the
   // inverse Hessian, widened for the beams' correlation, plus the error of
-  // the map's walls, one offset per wall (scan_matcher.cc, kIndependentBeams,
+  // the map's walls, one offset per wall (scan_refiner.cc, kIndependentBeams,
   // mapErrorCovariance); zero in the directions the scan does not constrain.
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
   int iterations = 0;
@@ -126,7 +126,7 @@ class ScanRefiner {
  public:
   /// Keeps a reference to `field`, which must outlive the refiner.
   /// Throws std::invalid_argument (see validate()).
-  ScanRefiner(const LikelihoodField& field, const ScanRefinerParams& params);
+  ScanRefiner(const DistanceField& field, const ScanRefinerParams& params);
 
   const ScanRefinerParams& params() const { return params_; }
 
