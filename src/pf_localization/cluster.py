@@ -1,6 +1,6 @@
 """The Dask client that pf_tune and benchmark_datasets run their tasks on.
 
-A task is a function of this package (pf_localization.tune.evaluate_bag,
+A task is a function of this package (pf_localization.tune_tasks.evaluate_bag,
 pf_localization.benchmark.run_one): Dask sends it by name, so every worker must import the
 pf_localization Python package. The LocalCluster's worker processes inherit the tool's sys.path;
 a worker of a cluster started by hand needs the workspace's setup.bash sourced.

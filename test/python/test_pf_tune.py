@@ -26,7 +26,7 @@ TUNE = os.path.join(REPO, 'scripts', 'pf_tune')
 # This checkout's package, built or not (before any installed pf_localization).
 sys.path.insert(0, os.path.join(REPO, 'src'))
 from pf_localization import locate  # noqa: E402
-from pf_localization import tune as pft  # noqa: E402
+from pf_localization import tune_objective, tune_space, tune_study, tune_tasks  # noqa: E402
 
 
 try:
@@ -87,7 +87,7 @@ def completed_trials(out):
 
 class SpaceAndParamsTest(unittest.TestCase):
     def test_default_space_names_parameters_of_pf_yaml(self):
-        space = pft.load_space(None, base_params())
+        space = tune_space.load_space(None, base_params())
         for name in ('odom_alpha1', 'odom_alpha4', 'laser_sigma_hit', 'laser_z_hit', 'laser_z_rand',
                      'laser_likelihood_exponent', 'recovery_alpha_slow', 'recovery_alpha_fast', 'laser_max_beams'):
             self.assertIn(name, space)
@@ -107,11 +107,11 @@ class SpaceAndParamsTest(unittest.TestCase):
             for text, message in cases:
                 with open(path, 'w') as f:
                     f.write(text)
-                with self.assertRaises(pft.TuneError) as cm:
-                    pft.load_space(path, base_params())
+                with self.assertRaises(tune_space.TuneError) as cm:
+                    tune_space.load_space(path, base_params())
                 self.assertIn(message, str(cm.exception), text)
-            with self.assertRaises(pft.TuneError) as cm:
-                pft.load_space(os.path.join(d, 'missing.yaml'), base_params())
+            with self.assertRaises(tune_space.TuneError) as cm:
+                tune_space.load_space(os.path.join(d, 'missing.yaml'), base_params())
             self.assertIn('space file not found', str(cm.exception))
 
     def test_missing_bag_is_a_clear_error(self):
@@ -127,7 +127,7 @@ class SpaceAndParamsTest(unittest.TestCase):
             text = f.read()
         with tempfile.TemporaryDirectory() as d:
             path = os.path.join(d, 'best.yaml')
-            pft.write_params_yaml(text, {'odom_alpha1': 0.0123456789, 'laser_max_beams': 90}, path, '# head\n')
+            tune_space.write_params_yaml(text, {'odom_alpha1': 0.0123456789, 'laser_max_beams': 90}, path, '# head\n')
             with open(path) as f:
                 out = f.read()
             loaded = yaml.safe_load(out)
@@ -148,7 +148,7 @@ class SpaceAndParamsTest(unittest.TestCase):
         # AC109's case: trial 49 was the luckiest single draw, trial 37 has the lowest mean, and
         # neither is lower than the baseline by more than --min-gain.
         lucky = {48: [0.0036, 0.0060, 0.0062, 0.0039], 36: [0.0038, 0.0057, 0.0053, 0.0040]}
-        chosen, stats, verdict = pft.choose(base, lucky, 0.005)
+        chosen, stats, verdict = tune_study.choose(base, lucky, 0.005)
         self.assertIsNone(chosen)
         self.assertIn("trial 37's", verdict)
         self.assertIn('not by more than --min-gain 0.005', verdict)
@@ -156,17 +156,18 @@ class SpaceAndParamsTest(unittest.TestCase):
         self.assertAlmostEqual(stats['baseline'][0], 0.005675)
         # Without a minimum gain, the spread of the seeds still decides: 0.00098 is more than twice
         # the standard error here, 0.00002 is not.
-        self.assertEqual(pft.choose(base, lucky, 0.0)[0], 36)
-        chosen, _, verdict = pft.choose(base, {5: [0.0056, 0.0058, 0.0055, 0.0058]}, 0.0)
+        self.assertEqual(tune_study.choose(base, lucky, 0.0)[0], 36)
+        chosen, _, verdict = tune_study.choose(base, {5: [0.0056, 0.0058, 0.0055, 0.0058]}, 0.0)
         self.assertIsNone(chosen)
         self.assertIn('twice the standard error', verdict)
         # A clear gain on every seed wins; among several, the lowest mean, not the lowest first value.
-        chosen, stats, _ = pft.choose([0.081, 0.080, 0.083, 0.085],
-                                      {33: [0.0340, 0.0347, 0.0353, 0.0345], 34: [0.0339, 0.0342, 0.0347, 0.0361]},
-                                      0.005)
+        chosen, stats, _ = tune_study.choose([0.081, 0.080, 0.083, 0.085],
+                                             {33: [0.0340, 0.0347, 0.0353, 0.0345],
+                                              34: [0.0339, 0.0342, 0.0347, 0.0361]},
+                                             0.005)
         self.assertEqual(chosen, 33)
         # No other trial: the baseline.
-        self.assertIsNone(pft.choose(base, {}, 0.005)[0])
+        self.assertIsNone(tune_study.choose(base, {}, 0.005)[0])
 
 
 @REPLAYS
@@ -177,10 +178,11 @@ class ScoreTest(unittest.TestCase):
     def run_bag(self, bag, mapname, pose, params, objective='self'):
         full = base_params()
         full.update(params)
-        return pft.evaluate_bag(dict(runner=RUNNER, bag=os.path.join(REPO, 'bags', bag),
-                                     map=os.path.join(REPO, 'maps', mapname), pose=pose, reference=None,
-                                     params=full, seed=1, objective=objective, fit_distance=pft.FIT_DISTANCE,
-                                     timeout=300, odom_frame='odom', base_frame='base_link'))
+        return tune_tasks.evaluate_bag(dict(runner=RUNNER, bag=os.path.join(REPO, 'bags', bag),
+                                            map=os.path.join(REPO, 'maps', mapname), pose=pose, reference=None,
+                                            params=full, seed=1, objective=objective,
+                                            fit_distance=tune_objective.FIT_DISTANCE,
+                                            timeout=300, odom_frame='odom', base_frame='base_link'))
 
     def test_self_supervised_score_ranks_defaults_above_wrong_alphas_and_sigma_hit(self):
         for bag, mapname, pose in (('tracking.bag', 'building.yaml', (1.5, 7.6, 0.0)),
@@ -200,10 +202,11 @@ class ScoreTest(unittest.TestCase):
     def test_with_two_lidars_the_fit_is_over_both_lidars_scans(self):
         job = dict(runner=RUNNER, bag=os.path.join(REPO, 'bags', 'two_lidar.bag'),
                    map=os.path.join(REPO, 'maps', 'building.yaml'), pose=(1.2, 7.6, 0.0), reference=None,
-                   params=base_params(), seed=1, objective='self', fit_distance=pft.FIT_DISTANCE, timeout=300,
+                   params=base_params(), seed=1, objective='self', fit_distance=tune_objective.FIT_DISTANCE,
+                   timeout=300,
                    odom_frame='odom', base_frame='base_link', scan_topics=['/scan_front', '/scan_rear'])
-        both = pft.evaluate_bag(job)
-        front = pft.evaluate_bag(dict(job, scan_topics=['/scan_front']))
+        both = tune_tasks.evaluate_bag(job)
+        front = tune_tasks.evaluate_bag(dict(job, scan_topics=['/scan_front']))
         self.assertTrue(both['ok'] and front['ok'], (both.get('error'), front.get('error')))
         # 942 front and 753 rear scans, each with the pose published at its stamp but the last one
         # (the bag's odometry ends before it)
@@ -220,9 +223,9 @@ class ScoreTest(unittest.TestCase):
             job = dict(runner=RUNNER, bag=broken, map=os.path.join(REPO, 'maps', 'small.yaml'), pose=None,
                        reference=None, params=base_params(), seed=1, objective='self', fit_distance=0.1, timeout=60,
                        odom_frame='odom', base_frame='base_link')
-            r = pft.evaluate_bag(job)
+            r = tune_tasks.evaluate_bag(job)
         self.assertFalse(r['ok'])
-        self.assertEqual(r['score'], pft.FAIL_SCORE['self'])
+        self.assertEqual(r['score'], tune_objective.FAIL_SCORE['self'])
         self.assertIn('pf_bag_runner exit', r['error'])
 
 
@@ -333,7 +336,7 @@ class StudyTest(unittest.TestCase):
         self.assertEqual(len(trials), 2)
         for t in trials:
             ok = {os.path.basename(r['bag']): (r['ok'], r['score']) for r in t.user_attrs['bags']}
-            self.assertEqual(ok['broken.bag'], (False, pft.FAIL_SCORE['self']))
+            self.assertEqual(ok['broken.bag'], (False, tune_objective.FAIL_SCORE['self']))
             self.assertTrue(ok['small.bag'][0])
         with open(os.path.join(self.out, 'report.md')) as f:
             self.assertIn('| broken.bag | failed: pf_bag_runner exit 2', f.read())

@@ -1,0 +1,58 @@
+// ParticleFilter::setMap on a filter that has particles: they stay while the
+// estimate is still on free space of the new map, and are dropped otherwise.
+#include <gtest/gtest.h>
+
+#include <stdexcept>
+
+#include "core/filter/particle_filter_world.h"
+#include "pf_localization/core/filter/particle_filter.h"
+
+namespace pf {
+namespace {
+
+using filter_world::asymmetricRoom;
+using filter_world::baseParams;
+using filter_world::diag;
+using filter_world::odomOf;
+using filter_world::room;
+using filter_world::simulateScan;
+
+// --- Map changes -------------------------------------------------------------------
+
+TEST(ParticleFilter, SetMapKeepsParticlesWhenTheEstimateIsStillFree) {
+  const OccupancyGrid grid = asymmetricRoom();
+  ParticleFilter filter(baseParams());
+  filter.setMap(grid);
+  filter.initializeGaussian({1.0, 1.5, 0.0}, diag(0.05, 0.05, 0.05));
+  ASSERT_TRUE(filter.update(odomOf({1.0, 1.5, 0.0}), simulateScan(grid, {1.0, 1.5, 0.0})).updated);
+  const ParticleSet before = filter.particles();
+
+  // The same room with an extra box elsewhere: particles stay.
+  EXPECT_TRUE(filter.setMap(room(4.0, 3.0, {{2.5, 0.5, 3.0, 1.2}, {3.0, 2.0, 3.5, 2.5}})));
+  EXPECT_TRUE(filter.isInitialized());
+  EXPECT_EQ(before.x, filter.particles().x);
+  EXPECT_EQ(before.yaw, filter.particles().yaw);
+  EXPECT_TRUE(filter.mapToOdom().has_value());
+
+  // A map with a box over the estimate: the particles are dropped.
+  EXPECT_FALSE(filter.setMap(room(4.0, 3.0, {{0.5, 1.0, 1.5, 2.0}})));
+  EXPECT_FALSE(filter.isInitialized());
+  EXPECT_TRUE(filter.particles().empty());
+  EXPECT_TRUE(filter.estimate().clusters.empty());
+  EXPECT_FALSE(filter.mapToOdom().has_value());
+  const UpdateReport r = filter.update(odomOf({1.0, 1.5, 0.0}), simulateScan(grid, {1, 1.5, 0}));
+  EXPECT_FALSE(r.updated);
+  EXPECT_EQ(SkipReason::kNotInitialized, r.skip_reason) << skipMessage(r);
+}
+
+TEST(ParticleFilter, SetMapDropsParticlesWhenTheEstimateLeavesTheMap) {
+  ParticleFilter filter(baseParams());
+  filter.setMap(asymmetricRoom());
+  filter.initializeGaussian({3.5, 2.5, 0.0}, diag(0.05, 0.05, 0.05));
+  EXPECT_FALSE(filter.setMap(room(2.0, 2.0, {})));  // (3.5, 2.5) is outside
+  EXPECT_FALSE(filter.isInitialized());
+  EXPECT_THROW(filter.setMap(OccupancyGrid()), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace pf
