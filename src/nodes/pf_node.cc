@@ -44,18 +44,18 @@
 #include <utility>
 #include <vector>
 
-#include "pf_localization/ros/input/latest_scan_slot.h"
+#include "pf_localization/ros/diagnostics/limited_warn.h"
 #include "pf_localization/ros/input/odometry_source.h"
 #include "pf_localization/ros/input/pose_transform.h"
-#include "pf_localization/ros/input/scan_drop.h"
+#include "pf_localization/ros/input/scan_drop_message.h"
 #include "pf_localization/ros/input/scan_inputs.h"
-#include "pf_localization/ros/localizer/inline_callback_queue.h"
-#include "pf_localization/ros/localizer/limited_log.h"
 #include "pf_localization/ros/localizer/live_localizer.h"
 #include "pf_localization/ros/output/map_to_odom_republisher.h"
 #include "pf_localization/ros/params/parameter_docs.h"
 #include "pf_localization/ros/params/reconfigure_server.h"
 #include "pf_localization/ros/params/startup_config.h"
+#include "pf_localization/ros/scheduling/inline_callback_queue.h"
+#include "pf_localization/ros/scheduling/latest_scan_slot.h"
 
 namespace pf_ros {
 namespace {

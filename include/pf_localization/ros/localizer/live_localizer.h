@@ -23,17 +23,17 @@
 #include <optional>
 #include <string>
 
-#include "pf_localization/ros/input/latest_scan_slot.h"
+#include "pf_localization/ros/diagnostics/limited_warn.h"
+#include "pf_localization/ros/diagnostics/update_timing.h"
 #include "pf_localization/ros/input/time_jump_detector.h"
-#include "pf_localization/ros/localizer/limited_log.h"
-#include "pf_localization/ros/localizer/output_latency.h"
-#include "pf_localization/ros/localizer/particle_cap_governor.h"
 #include "pf_localization/ros/localizer/scan_localizer.h"
-#include "pf_localization/ros/localizer/update_placement.h"
 #include "pf_localization/ros/output/estimate_publisher.h"
 #include "pf_localization/ros/output/map_to_odom_republisher.h"
 #include "pf_localization/ros/output/saved_pose.h"
 #include "pf_localization/ros/params/reconfigure_server.h"
+#include "pf_localization/ros/scheduling/latest_scan_slot.h"
+#include "pf_localization/ros/scheduling/update_placement.h"
+#include "pf_localization/ros/scheduling/update_time_governor.h"
 
 namespace pf_ros {
 

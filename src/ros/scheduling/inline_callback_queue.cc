@@ -1,4 +1,4 @@
-#include "pf_localization/ros/localizer/inline_callback_queue.h"
+#include "pf_localization/ros/scheduling/inline_callback_queue.h"
 
 #include <boost/make_shared.hpp>
 #include <mutex>

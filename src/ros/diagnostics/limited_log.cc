@@ -1,6 +1,5 @@
-#include "pf_localization/ros/localizer/limited_log.h"
+#include "pf_localization/ros/diagnostics/limited_log.h"
 
-#include <ros/console.h>
 #include <ros/time.h>
 
 namespace pf_ros {
@@ -19,17 +18,6 @@ bool LimitedLog::due(const std::string& key, double now_s, int* suppressed) {
 
 bool LimitedLog::due(const std::string& key, int* suppressed) {
   return due(key, ros::WallTime::now().toSec(), suppressed);
-}
-
-void LimitedWarn::warn(const std::string& key, const std::string& text) {
-  int suppressed = 0;
-  if (!log_.due(key, &suppressed)) return;
-  ROS_WARN("%s: %s", prefix_.c_str(), line(text, suppressed).c_str());
-}
-
-std::string LimitedWarn::line(const std::string& text, int suppressed) {
-  if (suppressed <= 0) return text;
-  return text + " (" + std::to_string(suppressed) + " more like it since the last such line)";
 }
 
 }  // namespace pf_ros

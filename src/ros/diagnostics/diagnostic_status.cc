@@ -1,4 +1,4 @@
-#include "pf_localization/ros/output/diagnostics.h"
+#include "pf_localization/ros/diagnostics/diagnostic_status.h"
 
 #include <cmath>
 #include <cstdio>

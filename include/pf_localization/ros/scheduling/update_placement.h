@@ -15,7 +15,7 @@
 
 #include <cstddef>
 
-#include "pf_localization/ros/localizer/output_latency.h"
+#include "pf_localization/ros/diagnostics/rolling_percentiles.h"
 
 namespace pf_ros {
 

@@ -1,4 +1,4 @@
-#include "pf_localization/ros/output/map_to_odom_republisher.h"
+#include "pf_localization/ros/output/republish_schedule.h"
 
 #include <gtest/gtest.h>
 

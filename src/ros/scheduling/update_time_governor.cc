@@ -1,4 +1,4 @@
-#include "pf_localization/ros/localizer/particle_cap_governor.h"
+#include "pf_localization/ros/scheduling/update_time_governor.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "pf_localization/ros/localizer/update_placement.h"
+#include "pf_localization/ros/scheduling/update_placement.h"
 
 #include <algorithm>
 

@@ -1,4 +1,4 @@
-#include "pf_localization/ros/input/scan_drop.h"
+#include "pf_localization/ros/input/scan_drop_message.h"
 
 #include <sys/resource.h>
 #include <sys/syscall.h>

@@ -1,6 +1,6 @@
 // Which updates pf_node runs on roscpp's poll thread: only those that the
 // recent updates, scaled to the particle count, show to be short.
-#include "pf_localization/ros/localizer/update_placement.h"
+#include "pf_localization/ros/scheduling/update_placement.h"
 
 #include <gtest/gtest.h>
 

@@ -7,11 +7,11 @@
 #include <map>
 #include <thread>
 
+#include "pf_localization/ros/diagnostics/limited_log.h"
+#include "pf_localization/ros/diagnostics/update_timing.h"
 #include "pf_localization/ros/input/conversions.h"
-#include "pf_localization/ros/input/latest_scan_slot.h"
-#include "pf_localization/ros/localizer/limited_log.h"
-#include "pf_localization/ros/localizer/output_latency.h"
-#include "pf_localization/ros/localizer/particle_cap_governor.h"
+#include "pf_localization/ros/scheduling/latest_scan_slot.h"
+#include "pf_localization/ros/scheduling/update_time_governor.h"
 
 namespace pf_ros {
 namespace {

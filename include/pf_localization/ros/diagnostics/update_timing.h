@@ -10,25 +10,11 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <deque>
 #include <mutex>
 
+#include "pf_localization/ros/diagnostics/rolling_percentiles.h"
+
 namespace pf_ros {
-
-/// p50 / p95 / max of the last `window` values added.
-class RollingPercentiles {
- public:
-  explicit RollingPercentiles(std::size_t window);
-  void add(double value);
-  std::size_t count() const { return values_.size(); }
-  /// The nearest-rank `p` quantile (p in [0, 1]) of the window; 0 when empty.
-  double percentile(double p) const;
-  double max() const;
-
- private:
-  std::size_t window_;
-  std::deque<double> values_;
-};
 
 struct UpdateTimingOptions {
   // Updates the percentiles are taken over: 100 covers 10 s at a 10 Hz laser,

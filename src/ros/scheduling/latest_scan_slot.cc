@@ -1,4 +1,4 @@
-#include "pf_localization/ros/input/latest_scan_slot.h"
+#include "pf_localization/ros/scheduling/latest_scan_slot.h"
 
 #include <algorithm>
 #include <chrono>
