@@ -12,20 +12,19 @@
 // Threads (docs/ros-interface.md, "Threads, latency and overload"): tf and the
 // scans are taken on roscpp's own poll thread as they arrive
 // (InlineCallbackQueue: no hand-off to a spinner); a scan whose tf is there
-// is updated at once on that thread when its update will be short
-// (UpdatePlacement), otherwise it goes through a one-scan LatestScanSlot to a
-// filter thread of its own, so that under overload the newest scan wins and
-// tf keeps being consumed; the main spinner serves the map, initialpose,
-// odometry, the services, the periodic save and the scans tf dropped; map ->
-// odom is republished by a MapToOdomRepublisher (on the poll thread: a timer
-// in roscpp's poll set on the wall clock, /clock under simulated time) that
+// goes to the UpdateScheduler, which updates it at once on that thread when
+// the update will be short, otherwise hands it to a filter thread of its
+// own, so that under overload the newest scan wins and tf keeps being
+// consumed; the main spinner serves the map, initialpose, odometry, the
+// services, the periodic save and the scans tf dropped; map -> odom is
+// republished by a MapToOdomRepublisher (on the poll thread: a timer in
+// roscpp's poll set on the wall clock, /clock under simulated time) that
 // never waits for the filter. No roscpp timer: under simulated time one polls
-// the clock every millisecond. filter_mutex_ protects the filter and
+// the clock every millisecond. The scheduler's lock protects the filter and
 // everything that goes with it (live_).
 #include <nav_msgs/OccupancyGrid.h>
 #include <nav_msgs/Odometry.h>
 #include <nav_msgs/SetMap.h>
-#include <pthread.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
 #include <sensor_msgs/LaserScan.h>
@@ -55,14 +54,10 @@
 #include "pf_localization/ros/params/reconfigure_server.h"
 #include "pf_localization/ros/params/startup_config.h"
 #include "pf_localization/ros/scheduling/inline_callback_queue.h"
-#include "pf_localization/ros/scheduling/latest_scan_slot.h"
+#include "pf_localization/ros/scheduling/update_scheduler.h"
 
 namespace pf_ros {
 namespace {
-
-// How much lower the filter thread's priority is than the rest of the node
-// (nice); see filterLoop().
-constexpr int kFilterNiceIncrement = 5;
 
 // s between two log lines about the same kind of bad input.
 constexpr double kLogPeriod = 5.0;
@@ -92,15 +87,17 @@ class PfNode {
         live_(config, std::move(saved), &buffer_, republisher_.get(), &warn_, nh_),
         odometry_(config.odom_frame, config.base_frame, nh_.resolveName("odom")),
         // A dropped scan may restart the filter (a bag that starts over),
-        // which takes filter_mutex_; the thread that dropped it may hold that
-        // mutex (its map -> odom reached tf), so the main spinner handles it.
+        // which takes the filter's lock; the thread that dropped it may hold
+        // that lock (its map -> odom reached tf), so the main spinner handles it.
         scan_inputs_(
             scanTopics(config), cloudTopics(config), buffer_, config.odom_frame, &inline_queue_,
             [this](const sensor_msgs::LaserScanConstPtr& scan, std::size_t sensor) {
-              onScan(PendingScan{scan, ros::WallTime::now(), ros::Time::now(), sensor, nullptr});
+              scheduler_->onScan(
+                  PendingScan{scan, ros::WallTime::now(), ros::Time::now(), sensor, nullptr});
             },
             [this](const sensor_msgs::PointCloud2ConstPtr& cloud, std::size_t sensor) {
-              onScan(PendingScan{nullptr, ros::WallTime::now(), ros::Time::now(), sensor, cloud});
+              scheduler_->onScan(
+                  PendingScan{nullptr, ros::WallTime::now(), ros::Time::now(), sensor, cloud});
             },
             [this](const std_msgs::Header& header,
                    tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
@@ -119,7 +116,11 @@ class PfNode {
         pnh_, config, [this](const LocalizerConfig& c) { return reconfigure(c); }, "pf_node");
     // Its timer or /clock on the poll thread too: it republishes when due.
     republisher_->start(withQueue(nh_, &inline_queue_));
-    filter_thread_ = std::thread([this] { filterLoop(); });
+    scheduler_ = std::make_unique<UpdateScheduler>(
+        [this](const PendingScan& scan, const LatestScanSlot& slot) {
+          live_.processScan(scan, slot, *reconfigure_);
+        },
+        [this] { return live_.nextUpdateOnPollThread(); }, &warn_);
     // Last: their callbacks may run at once, on roscpp's poll thread.
     scan_inputs_.subscribe(nh_);
   }
@@ -127,9 +128,8 @@ class PfNode {
   ~PfNode() {
     scan_inputs_.unsubscribe();
     ros::getGlobalCallbackQueue()->removeByID(reinterpret_cast<uint64_t>(this));
-    slot_.close();
-    filter_thread_.join();
-    republisher_.reset();  // before live_ goes: its onTfTick() uses live_
+    scheduler_->stop();
+    republisher_.reset();  // before live_ and scheduler_ go: its onTfTick() uses them
   }
 
   // The main spinner: roscpp's own loop (ros::spin() waits on the queue
@@ -160,13 +160,11 @@ class PfNode {
       }
       return;
     }
-    std::lock_guard<std::mutex> lock(filter_mutex_);
-    live_.installMap(*msg);
+    scheduler_->withFilter([&] { live_.installMap(*msg); });
   }
 
   std::string reconfigure(const LocalizerConfig& next) {
-    std::lock_guard<std::mutex> lock(filter_mutex_);
-    return live_.reconfigure(next);
+    return scheduler_->withFilter([&] { return live_.reconfigure(next); });
   }
 
   // Odometry from the topic, for robots that have none on tf (OdometrySource).
@@ -191,69 +189,13 @@ class PfNode {
     if (const auto line = odometry_.takeAnnouncement()) ROS_INFO("pf_node: %s", line->c_str());
   }
 
-  // Once tf has the scan's stamp, on whichever thread brought the scan or
-  // the transform that completed it (InlineCallbackQueue): a short update
-  // runs here, any other is handed to the filter thread, so that no thread
-  // waits here for an update.
-  void onScan(PendingScan pending) {
-    if (updateHere(pending)) return;
-    if (!slot_.put(std::move(pending))) return;
-    const std::uint64_t dropped = slot_.dropped();
-    warn_.warn("overload",
-               "the filter cannot keep up: a scan waiting for it was dropped for a newer one (" +
-                   std::to_string(dropped) +
-                   " since start; see dropped_scans and latency_* in the diagnostics). Lower "
-                   "max_particles, or set max_update_time");
-  }
-
-  // Runs the scan's update at once, on the thread that brought the scan
-  // (roscpp's poll thread), when it will be short (UpdatePlacement): a
-  // hand-over to the filter thread costs two wake-ups and the caches the
-  // messages warmed. Not when a scan waits or is in the filter thread's hands
-  // (it would be overtaken), when another thread holds the filter (a new map,
-  // a service), or on a thread already inside an update. It may run inside
-  // roscpp's /tf callback, which is safe only while pf_node publishes by
-  // value (docs/ros-interface.md, "Threads, latency and overload").
-  bool updateHere(const PendingScan& pending) {
-    if (t_updating) return false;
-    std::unique_lock<std::mutex> lock(filter_mutex_, std::try_to_lock);
-    if (!lock.owns_lock() || !slot_.idle() || !live_.nextUpdateOnPollThread()) return false;
-    process(pending);
-    return true;
-  }
-
-  // One scan's update, with the filter mutex held.
-  void process(const PendingScan& pending) {
-    t_updating = true;
-    live_.processScan(pending, slot_, *reconfigure_);
-    t_updating = false;
-  }
-
-  // The filter thread: the newest waiting scan, one at a time.
-  void filterLoop() {
-    // The filter yields the CPU to this node's other threads (map -> odom,
-    // odometry and tf, the clock): a lower priority for this thread, which
-    // the update's worker threads take for its jobs (worker_pool.h).
-    // Raising the nice value needs no privilege; failing, it changes
-    // nothing.
-    lowerThreadPriority(kFilterNiceIncrement);
-    // Named for the per-thread CPU in scripts/live_cpu.sh, top and perf.
-    pthread_setname_np(pthread_self(), "pf_filter");
-    // The destructor's close() wakes the wait; its time-out only bounds how
-    // long a shutdown by another way goes unseen (a shorter one would wake
-    // an idle node ten times a second for nothing).
-    while (ros::ok() && !slot_.closed()) {
-      auto pending = slot_.take(ros::WallDuration(1.0));
-      if (!pending) continue;
-      std::lock_guard<std::mutex> lock(filter_mutex_);
-      process(*pending);
-      slot_.done();
-    }
-  }
-
   void onScanDropped(const std_msgs::Header& header,
                      tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-    std::lock_guard<std::mutex> lock(filter_mutex_);
+    scheduler_->withFilter([&] { onScanDroppedLocked(header, reason); });
+  }
+
+  void onScanDroppedLocked(const std_msgs::Header& header,
+                           tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
     // The first scans after a bag starts over often land here as older than
     // the buffer, which still holds the old timeline: the jump back is
     // detected on them too, so that the filter restarts on the first scan of
@@ -281,8 +223,7 @@ class PfNode {
     } else if (pose.header.frame_id != config_.global_frame) {
       if (!transformToGlobal(&pose)) return false;
     }
-    std::lock_guard<std::mutex> lock(filter_mutex_);
-    return live_.setInitialPose(pose);
+    return scheduler_->withFilter([&] { return live_.setInitialPose(pose); });
   }
 
   // amcl's set_map: a new map and the pose on it in one call (a robot moved
@@ -290,10 +231,7 @@ class PfNode {
   // that guards against map topic updates, not against an explicit request.
   bool onSetMap(nav_msgs::SetMap::Request& req, nav_msgs::SetMap::Response& res) {
     bool installed = false;
-    {
-      std::lock_guard<std::mutex> lock(filter_mutex_);
-      installed = live_.installMap(req.map);
-    }
+    installed = scheduler_->withFilter([&] { return live_.installMap(req.map); });
     res.success = installed && applyInitialPose(req.initial_pose);
     return true;
   }
@@ -315,13 +253,11 @@ class PfNode {
   }
 
   bool onGlobalLocalization(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
-    std::lock_guard<std::mutex> lock(filter_mutex_);
-    return live_.startGlobalLocalization();
+    return scheduler_->withFilter([&] { return live_.startGlobalLocalization(); });
   }
 
   bool onNoMotionUpdate(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
-    std::lock_guard<std::mutex> lock(filter_mutex_);
-    live_.requestNoMotionUpdate();
+    scheduler_->withFilter([&] { live_.requestNoMotionUpdate(); });
     return true;
   }
 
@@ -333,8 +269,7 @@ class PfNode {
   // next tick.
   void onTfTick(const ros::Time& now) {
     if (!ros::Time::isSimTime()) return;
-    std::unique_lock<std::mutex> lock(filter_mutex_, std::try_to_lock);
-    if (lock.owns_lock()) live_.timeJumpedBack(now, kSimClockLead);
+    scheduler_->tryWithFilter([&] { live_.timeJumpedBack(now, kSimClockLead); });
   }
 
   // Every 1 / save_pose_rate s of the clock (amcl's timer), give or take
@@ -360,24 +295,18 @@ class PfNode {
   ros::NodeHandle nh_, pnh_;
   LimitedWarn warn_{"pf_node", kLogPeriod};
   tf2_ros::Buffer buffer_;
-  // Set while this thread runs an update (process()).
-  static inline thread_local bool t_updating = false;
   InlineCallbackQueue inline_queue_;  // before every subscriber that uses it
   tf2_ros::TransformListener listener_;
   std::unique_ptr<MapToOdomRepublisher> republisher_;  // started at the end of the constructor
-  // Guards live_: taken for a whole update (by the filter thread, or by the
-  // poll thread, which only ever tries it), and by the main spinner's
-  // callbacks that touch the filter. The republisher never waits for it.
-  std::mutex filter_mutex_;
   LiveLocalizer live_;
-  LatestScanSlot slot_;
   ros::Subscriber odom_sub_, map_sub_, initial_pose_sub_, tf_watch_sub_;
   OdometrySource odometry_;  // main spinner only
-  ScanInputs scan_inputs_;   // after slot_ and live_, which its callbacks use
+  ScanInputs scan_inputs_;   // after live_, which its callbacks use
   ros::ServiceServer global_srv_, nomotion_srv_, set_map_srv_;
   RepublishSchedule save_schedule_;  // main spinner only
   std::unique_ptr<ReconfigureServer> reconfigure_;
-  std::thread filter_thread_;  // last: started when everything else exists
+  // Guards live_ and runs the updates (started in the constructor's body).
+  std::unique_ptr<UpdateScheduler> scheduler_;
 };
 
 }  // namespace

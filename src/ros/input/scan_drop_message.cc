@@ -1,12 +1,5 @@
 #include "pf_localization/ros/input/scan_drop_message.h"
 
-#include <sys/resource.h>
-#include <sys/syscall.h>
-#include <unistd.h>
-
-#include <algorithm>
-#include <cerrno>
-
 namespace pf_ros {
 namespace {
 
@@ -30,13 +23,6 @@ std::string scanDropMessage(const std_msgs::Header& header,
          "' to '" + base_frame + "' (the sensor's mounting) and '" + base_frame + "' to '" +
          odom_frame + "' (odometry) at t=" + std::to_string(header.stamp.toSec()) +
          "; check that both are published";
-}
-
-void lowerThreadPriority(int increment) {
-  const id_t tid = static_cast<id_t>(::syscall(SYS_gettid));
-  errno = 0;
-  const int nice = ::getpriority(PRIO_PROCESS, tid);
-  if (errno == 0) ::setpriority(PRIO_PROCESS, tid, std::min(19, nice + increment));
 }
 
 }  // namespace pf_ros
