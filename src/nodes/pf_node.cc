@@ -46,7 +46,6 @@
 #include "pf_localization/ros/diagnostics/limited_warn.h"
 #include "pf_localization/ros/input/odometry_source.h"
 #include "pf_localization/ros/input/pose_transform.h"
-#include "pf_localization/ros/input/scan_drop_message.h"
 #include "pf_localization/ros/input/scan_inputs.h"
 #include "pf_localization/ros/localizer/live_localizer.h"
 #include "pf_localization/ros/output/map_to_odom_republisher.h"
@@ -191,25 +190,7 @@ class PfNode {
 
   void onScanDropped(const std_msgs::Header& header,
                      tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-    scheduler_->withFilter([&] { onScanDroppedLocked(header, reason); });
-  }
-
-  void onScanDroppedLocked(const std_msgs::Header& header,
-                           tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-    // The first scans after a bag starts over often land here as older than
-    // the buffer, which still holds the old timeline: the jump back is
-    // detected on them too, so that the filter restarts on the first scan of
-    // the new timeline. (Not on scans dropped from a full queue: those are
-    // the oldest waiting, legitimately older than the last scan used.)
-    if (ros::Time::isSimTime()) {
-      if (reason == tf2_ros::filter_failure_reasons::OutTheBack &&
-          live_.timeJumpedBack(header.stamp)) {
-        return;
-      }
-      if (!header.frame_id.empty()) live_.clearStaleBuffer(header.frame_id);
-    }
-    warn_.warn("scan dropped " + header.frame_id,
-               scanDropMessage(header, reason, config_.base_frame, config_.odom_frame));
+    scheduler_->withFilter([&] { live_.scanDropped(header, reason); });
   }
 
   void onInitialPose(const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg) {
@@ -262,14 +243,10 @@ class PfNode {
   }
 
   // Before each timed map -> odom (under simulated time on the poll thread,
-  // from /clock). Under simulated time the clock itself shows a bag
-  // starting over, often before any scan of the new timeline gets through
-  // tf. (It lags the messages a little, hence the wider tolerance.) Never
-  // waits for the filter: while an update runs, the check waits for the
-  // next tick.
+  // from /clock), which may show time jumping back. Never waits for the
+  // filter: while an update runs, the check waits for the next tick.
   void onTfTick(const ros::Time& now) {
-    if (!ros::Time::isSimTime()) return;
-    scheduler_->tryWithFilter([&] { live_.timeJumpedBack(now, kSimClockLead); });
+    scheduler_->tryWithFilter([&] { live_.clockTick(now); });
   }
 
   // Every 1 / save_pose_rate s of the clock (amcl's timer), give or take
