@@ -83,7 +83,8 @@ class PfNode {
             MapToOdomRepublisherOptions{config.tf_publish_rate, config.transform_tolerance,
                                         config.tf_broadcast},
             [this](const ros::Time& now) { onTfTick(now); })),
-        live_(config, std::move(saved), &buffer_, republisher_.get(), &warn_, nh_),
+        live_(config, std::move(saved), &buffer_, republisher_.get(), &warn_, nh_,
+              [pnh](const PoseSaver::Record& record) { writeSavedPose(record, pnh); }),
         odometry_(config.odom_frame, config.base_frame, nh_.resolveName("odom")),
         // A dropped scan may restart the filter (a bag that starts over),
         // which takes the filter's lock; the thread that dropped it may hold
@@ -142,10 +143,11 @@ class PfNode {
     ros::CallbackQueue* queue = ros::getGlobalCallbackQueue();
     while (ros::ok()) {
       queue->callAvailable(ros::WallDuration(0.1));
-      savePoseWhenDue();
+      PoseSaver& saver = live_.saver();
+      saver.saveWhenDue(ros::Time::now());
       if (!g_sigint) continue;
       // Without a master the save would block, waiting for one.
-      if (config_.save_pose_rate > 0.0 && ros::master::check()) savePose();
+      if (saver.enabled() && ros::master::check()) saver.saveNow();
       ros::shutdown();
     }
   }
@@ -249,25 +251,6 @@ class PfNode {
     scheduler_->tryWithFilter([&] { live_.clockTick(now); });
   }
 
-  // Every 1 / save_pose_rate s of the clock (amcl's timer), give or take
-  // the spinner's wait.
-  void savePoseWhenDue() {
-    if (config_.save_pose_rate <= 0.0) return;
-    const ros::Time now = ros::Time::now();
-    const ros::Duration period(1.0 / config_.save_pose_rate);
-    // The first look only starts the schedule, as a timer's first period.
-    const bool first = save_schedule_.next().isZero();
-    if (now.isZero() || !save_schedule_.due(now, period)) return;
-    save_schedule_.published(now, period);
-    if (!first) savePose();
-  }
-
-  // As amcl does, with the map it is on (saved_pose.h). Never waits for the
-  // filter: the pose is kept under a small lock of its own.
-  void savePose() {
-    if (const auto record = live_.saver().latest()) writeSavedPose(*record, pnh_);
-  }
-
   const LocalizerConfig config_;  // as read: the live values are live_'s
   ros::NodeHandle nh_, pnh_;
   LimitedWarn warn_{"pf_node", kLogPeriod};
@@ -280,7 +263,6 @@ class PfNode {
   OdometrySource odometry_;  // main spinner only
   ScanInputs scan_inputs_;   // after live_, which its callbacks use
   ros::ServiceServer global_srv_, nomotion_srv_, set_map_srv_;
-  RepublishSchedule save_schedule_;  // main spinner only
   std::unique_ptr<ReconfigureServer> reconfigure_;
   // Guards live_ and runs the updates (started in the constructor's body).
   std::unique_ptr<UpdateScheduler> scheduler_;

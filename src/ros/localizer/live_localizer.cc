@@ -16,7 +16,7 @@ ros::Time simClockNow() { return ros::Time::isSimTime() ? ros::Time::now() : ros
 
 LiveLocalizer::LiveLocalizer(const LocalizerConfig& config, std::optional<SavedPoseMap> saved,
                              tf2_ros::Buffer* tf, MapToOdomRepublisher* republisher,
-                             LimitedWarn* warn, ros::NodeHandle& nh)
+                             LimitedWarn* warn, ros::NodeHandle& nh, PoseSaver::Write write_pose)
     : config_(config),
       tf_(tf),
       republisher_(republisher),
@@ -26,6 +26,7 @@ LiveLocalizer::LiveLocalizer(const LocalizerConfig& config, std::optional<SavedP
       output_(nh),
       jumps_(tf, config.odom_frame, config.base_frame, warn,
              [this](double back_s) { restartAfterJump(back_s); }),
+      saver_(config.save_pose_rate, std::move(write_pose)),
       saved_pose_(std::move(saved)) {
   logInitialPose();
 }
@@ -204,7 +205,7 @@ void LiveLocalizer::clockTick(const ros::Time& now) {
 // spinner that waited would hold back the scans and odometry queued behind it).
 void LiveLocalizer::filterChanged(const ros::Time& scan_stamp) {
   republisher_->set(localizer_.mapToOdom(ros::Time()), scan_stamp);
-  if (config_.save_pose_rate <= 0.0) return;  // nothing is ever saved
+  if (!saver_.enabled()) return;  // nothing is ever saved
   saver_.set(poseToSave(localizer_, last_odom_));
 }
 

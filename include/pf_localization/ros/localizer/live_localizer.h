@@ -31,8 +31,9 @@
 #include "pf_localization/ros/localizer/scan_localizer.h"
 #include "pf_localization/ros/output/estimate_publisher.h"
 #include "pf_localization/ros/output/map_to_odom_republisher.h"
-#include "pf_localization/ros/output/saved_pose.h"
+#include "pf_localization/ros/output/pose_saver.h"
 #include "pf_localization/ros/params/reconfigure_server.h"
+#include "pf_localization/ros/params/saved_pose.h"
 #include "pf_localization/ros/scheduling/latest_scan_slot.h"
 #include "pf_localization/ros/scheduling/update_placement.h"
 #include "pf_localization/ros/scheduling/update_time_governor.h"
@@ -43,10 +44,11 @@ class LiveLocalizer {
  public:
   /// `saved`: config.initial_pose was saved by an earlier run (isSavedPose()).
   /// `tf`, `republisher` and `warn` must outlive it; the topics are
-  /// advertised on `nh`. Logs the initial pose it will start from.
+  /// advertised on `nh`; `write_pose` saves the pose (saver()). Logs the
+  /// initial pose it will start from.
   LiveLocalizer(const LocalizerConfig& config, std::optional<SavedPoseMap> saved,
                 tf2_ros::Buffer* tf, MapToOdomRepublisher* republisher, LimitedWarn* warn,
-                ros::NodeHandle& nh);
+                ros::NodeHandle& nh, PoseSaver::Write write_pose = {});
 
   /// A new map (map topic or set_map). False when it was refused (logged).
   bool installMap(const nav_msgs::OccupancyGrid& map);
@@ -86,8 +88,9 @@ class LiveLocalizer {
   /// through tf.
   void clockTick(const ros::Time& now);
 
-  /// What to save, under its own lock: may be used without the mutex.
-  const PoseSaver& saver() const { return saver_; }
+  /// The pose to save and its schedule (pose_saver.h): may be used without
+  /// the filter's lock.
+  PoseSaver& saver() { return saver_; }
 
  private:
   void logInitialPose() const;

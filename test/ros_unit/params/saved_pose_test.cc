@@ -1,10 +1,9 @@
 // The pose saved on the parameter server and its map: the map's
 // signature, ~saved_pose_map's value, whether a configured pose is a saved
 // one, and what the first map decides about it.
-#include "pf_localization/ros/output/saved_pose.h"
+#include "pf_localization/ros/params/saved_pose.h"
 
 #include <gtest/gtest.h>
-#include <tf2/buffer_core.h>
 
 #include <cmath>
 
@@ -109,44 +108,6 @@ TEST(DecideSavedPose, APoseOutsideTheFreeSpaceStartsGlobalLocalization) {
   const SavedPoseDecision outside = decide(room(), pf::Pose2{7.0, 1.0, 0.0}, room());
   EXPECT_FALSE(outside.resume);
   EXPECT_NE(std::string::npos, outside.message.find("outside")) << outside.message;
-}
-
-TEST(PoseSaver, NothingToSaveBeforeAPoseOnTheCurrentMap) {
-  PoseSaver saver;
-  EXPECT_FALSE(saver.latest());
-  saver.setMap("map A");
-  EXPECT_FALSE(saver.latest());
-  saver.set(PoseToSave{pf::Pose2{1.0, 2.0, 0.5}, 0.1, 0.2, 0.05});
-  const auto record = saver.latest();
-  ASSERT_TRUE(record);
-  EXPECT_EQ("map A", record->map_signature);
-  EXPECT_DOUBLE_EQ(2.0, record->pose.pose.y);
-  EXPECT_DOUBLE_EQ(0.2, record->pose.cov_yy);
-  // A new map: the pose on the old one is not saved with the new signature.
-  saver.setMap("map B");
-  EXPECT_FALSE(saver.latest());
-  saver.set(std::nullopt);
-  EXPECT_FALSE(saver.latest());
-}
-
-TEST(PoseToSave, TheEstimateCarriedByTheLatestOdometry) {
-  tf2::BufferCore tf;
-  LocalizerConfig config;
-  config.initial_pose = pf::Pose2{1.5, 1.0, M_PI / 2};
-  config.initial_cov = Eigen::Vector3d(0.01, 0.02, 0.003).asDiagonal();
-  ScanLocalizer localizer(config, &tf);
-  EXPECT_FALSE(poseToSave(localizer, std::nullopt));  // no map, no estimate
-  ASSERT_EQ("", localizer.setMap(room()));
-  const auto at_estimate = poseToSave(localizer, std::nullopt);
-  ASSERT_TRUE(at_estimate);
-  EXPECT_NEAR(1.5, at_estimate->pose.x, 0.05);
-  EXPECT_NEAR(1.0, at_estimate->pose.y, 0.05);
-  EXPECT_NEAR(0.01, at_estimate->cov_xx, 0.005);
-  EXPECT_NEAR(0.02, at_estimate->cov_yy, 0.01);
-  // Without a filter update there is no map -> odom: still the estimate.
-  const auto with_odom = poseToSave(localizer, pf::Pose2{0.5, 0.0, 0.0});
-  ASSERT_TRUE(with_odom);
-  EXPECT_DOUBLE_EQ(at_estimate->pose.x, with_odom->pose.x);
 }
 
 }  // namespace

@@ -8,18 +8,17 @@
 // records is a saved one, and it is only used on a first map with the same
 // signature that has the pose in a free cell; otherwise global localization
 // (a roscore that had run another bag may hold a pose on another map).
+// PoseSaver (pose_saver.h) saves it; this is what it saves, and what a later
+// run makes of it.
 #pragma once
 
 #include <nav_msgs/OccupancyGrid.h>
-#include <ros/node_handle.h>
 
-#include <mutex>
 #include <optional>
 #include <string>
 
 #include "pf_localization/core/map/occupancy_grid.h"
 #include "pf_localization/core/util/pose2.h"
-#include "pf_localization/ros/localizer/scan_localizer.h"
 
 namespace pf_ros {
 
@@ -29,19 +28,6 @@ namespace pf_ros {
 /// A map's identity, as text: "W x H cells of R m, origin (x, y, yaw), cells
 /// <64-bit FNV-1a hash of the cells, hex>". Equal for the same map sent again.
 std::string mapSignature(const nav_msgs::OccupancyGrid& map);
-
-/// One pose to save: the estimate and its variances.
-struct PoseToSave {
-  pf::Pose2 pose;
-  double cov_xx = 0.0, cov_yy = 0.0, cov_aa = 0.0;
-};
-
-/// What to save after the filter changed: the estimate, carried by the
-/// odometry of the latest scan (`odom`, odom -> base; used or not: the
-/// estimate is as old as the last update) to the robot's pose then, with the
-/// estimate's variances. Nothing without an estimate, or when not finite.
-std::optional<PoseToSave> poseToSave(const ScanLocalizer& localizer,
-                                     const std::optional<pf::Pose2>& odom);
 
 /// ~saved_pose_map's value: "<map signature>; pose <x> <y> <yaw>".
 std::string savedPoseMapValue(const std::string& map_signature, const pf::Pose2& pose);
@@ -69,32 +55,5 @@ struct SavedPoseDecision {
 /// a map of that signature and lies in one of its free cells.
 SavedPoseDecision decideSavedPose(const SavedPoseMap& saved, const pf::Pose2& pose,
                                   const std::string& map_signature, const pf::OccupancyGrid& grid);
-
-/// The latest pose to save and the map it is on. Thread-safe, under a small
-/// mutex of its own: the filter thread sets it after every update, and the
-/// saver (on the main spinner) never waits for an update.
-class PoseSaver {
- public:
-  struct Record {
-    PoseToSave pose;
-    std::string map_signature;
-  };
-
-  /// A new map: nothing to save until the pose on it is set().
-  void setMap(const std::string& map_signature);
-  /// The pose to save from now on (nothing: none).
-  void set(const std::optional<PoseToSave>& pose);
-  /// What to save: nothing before a map and a pose on it.
-  std::optional<Record> latest() const;
-
- private:
-  mutable std::mutex mutex_;
-  std::string map_signature_;
-  std::optional<PoseToSave> pose_;
-};
-
-/// Writes `record` to `pnh`'s ~initial_pose_*, ~initial_cov_* and
-/// ~saved_pose_map (the last last: see isSavedPose()). Needs the master.
-void writeSavedPose(const PoseSaver::Record& record, const ros::NodeHandle& pnh);
 
 }  // namespace pf_ros

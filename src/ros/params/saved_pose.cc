@@ -1,11 +1,13 @@
-#include "pf_localization/ros/output/saved_pose.h"
+#include "pf_localization/ros/params/saved_pose.h"
 
 #include <cinttypes>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
+#include <vector>
 
 #include "pf_localization/ros/input/conversions.h"
+#include "pf_localization/ros/params/localizer_config.h"
 
 namespace pf_ros {
 namespace {
@@ -50,18 +52,6 @@ std::string mapSignature(const nav_msgs::OccupancyGrid& map) {
                 map.info.width, map.info.height, static_cast<double>(map.info.resolution),
                 o.position.x, o.position.y, yawOf(o.orientation), fnv1a(map.data));
   return text;
-}
-
-std::optional<PoseToSave> poseToSave(const ScanLocalizer& localizer,
-                                     const std::optional<pf::Pose2>& odom) {
-  const auto estimate = localizer.estimate(ros::Time());
-  if (!estimate) return std::nullopt;
-  pf::Pose2 pose = toPose2(estimate->pose.pose);
-  const auto map_to_odom = localizer.filter().mapToOdom();
-  if (map_to_odom && odom) pose = pf::compose(*map_to_odom, *odom);
-  if (!pose.isFinite()) return std::nullopt;
-  const auto& cov = estimate->pose.covariance;
-  return PoseToSave{pose, cov[0], cov[7], cov[35]};
 }
 
 std::string savedPoseMapValue(const std::string& map_signature, const pf::Pose2& pose) {
@@ -109,34 +99,6 @@ SavedPoseDecision decideSavedPose(const SavedPoseMap& saved, const pf::Pose2& po
         "resuming from the pose saved by an earlier run at " + describe(pose) + " on this map";
   }
   return d;
-}
-
-void PoseSaver::setMap(const std::string& map_signature) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  map_signature_ = map_signature;
-  pose_.reset();
-}
-
-void PoseSaver::set(const std::optional<PoseToSave>& pose) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  pose_ = pose;
-}
-
-std::optional<PoseSaver::Record> PoseSaver::latest() const {
-  std::lock_guard<std::mutex> lock(mutex_);
-  if (!pose_) return std::nullopt;
-  return Record{*pose_, map_signature_};
-}
-
-void writeSavedPose(const PoseSaver::Record& record, const ros::NodeHandle& pnh) {
-  const PoseToSave& s = record.pose;
-  pnh.setParam("initial_pose_x", s.pose.x);
-  pnh.setParam("initial_pose_y", s.pose.y);
-  pnh.setParam("initial_pose_a", s.pose.yaw);
-  pnh.setParam("initial_cov_xx", s.cov_xx);
-  pnh.setParam("initial_cov_yy", s.cov_yy);
-  pnh.setParam("initial_cov_aa", s.cov_aa);
-  pnh.setParam(kSavedPoseMapParam, savedPoseMapValue(record.map_signature, s.pose));
 }
 
 }  // namespace pf_ros
