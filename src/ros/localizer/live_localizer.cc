@@ -18,7 +18,6 @@ LiveLocalizer::LiveLocalizer(const LocalizerConfig& config, std::optional<SavedP
                              tf2_ros::Buffer* tf, MapToOdomRepublisher* republisher,
                              LimitedWarn* warn, ros::NodeHandle& nh, PoseSaver::Write write_pose)
     : config_(config),
-      tf_(tf),
       republisher_(republisher),
       warn_(warn),
       localizer_(config, tf),

@@ -61,6 +61,17 @@ struct Recorder {
   }
 };
 
+// Waits (up to 5 s) until no thread holds the filter: the filter thread
+// marks its scan done before it lets go.
+bool waitFilterFree(UpdateScheduler* scheduler) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (!scheduler->tryWithFilter([] {})) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    std::this_thread::yield();
+  }
+  return true;
+}
+
 struct Fixture {
   explicit Fixture(bool is_short)
       : short_updates(is_short),
@@ -103,7 +114,7 @@ TEST(UpdateScheduler, NeverWaitsForTheFilterAnotherThreadHolds) {
   holder.join();
   ASSERT_TRUE(f.rec.waitUpdates(1));
   EXPECT_NE(std::this_thread::get_id(), f.rec.threads[0]);  // the filter thread took it
-  EXPECT_TRUE(f.scheduler.tryWithFilter([] {}));
+  EXPECT_TRUE(waitFilterFree(&f.scheduler));
 }
 
 TEST(UpdateScheduler, UnderOverloadTheNewestScanWinsAndNoneOvertakesAnOlderOne) {
@@ -123,6 +134,7 @@ TEST(UpdateScheduler, UnderOverloadTheNewestScanWinsAndNoneOvertakesAnOlderOne) 
   EXPECT_EQ((std::vector<double>{1.0, 4.0}), f.rec.stamps);
   EXPECT_EQ(2u, f.rec.dropped[1]);
   // Idle again: the next short one runs at once, here.
+  ASSERT_TRUE(waitFilterFree(&f.scheduler));
   f.scheduler.onScan(scanStamped(5.0));
   ASSERT_EQ(3u, f.rec.stamps.size());
   EXPECT_EQ(std::this_thread::get_id(), f.rec.threads[2]);

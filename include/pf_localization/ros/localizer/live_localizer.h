@@ -100,7 +100,6 @@ class LiveLocalizer {
   void filterChanged(const ros::Time& scan_stamp);
 
   const LocalizerConfig config_;  // as read at start-up: the live values are localizer_'s
-  tf2_ros::Buffer* tf_;
   MapToOdomRepublisher* republisher_;
   LimitedWarn* warn_;
   ScanLocalizer localizer_;

@@ -4,8 +4,8 @@
 // on /diagnostics (for robot monitors) and pf_status (for anything that only
 // wants this node's verdict); and a log line for each change of the
 // localization state (localized / uncertain / lost), which is news where the
-// same state on every scan is not. Not thread-safe: pf_node calls it under
-// its filter mutex, since it reads the filter.
+// same state on every scan is not (StateChangeLog). Not thread-safe: pf_node
+// calls it with the filter's lock held, since it reads the filter.
 #pragma once
 
 #include <diagnostic_msgs/DiagnosticStatus.h>

@@ -17,9 +17,9 @@
 // waiting: order is kept, as roscpp's subscription queue hands out its
 // messages oldest first to whichever thread calls.
 //
-// Only for callbacks that never take a lock that a thread publishing on one
-// of these topics may hold (pf_node's filter mutex, for one): the publisher
-// would wait for itself.
+// Only for callbacks that never wait for a lock that a thread publishing on
+// one of these topics may hold (the filter's, UpdateScheduler's, for one):
+// the publisher would wait for itself.
 #pragma once
 
 #include <ros/callback_queue_interface.h>
