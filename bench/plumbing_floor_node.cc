@@ -15,7 +15,7 @@
 #include <tf2_ros/transform_broadcaster.h>
 #include <tf2_ros/transform_listener.h>
 
-#include "pf_localization/ros/localizer/inline_callback_queue.h"
+#include "pf_localization/ros/scheduling/inline_callback_queue.h"
 
 int main(int argc, char** argv) {
   ros::init(argc, argv, "pf_node");

@@ -37,8 +37,8 @@
 #include <vector>
 
 #include "pf_localization/core/map/map_loader.h"
+#include "pf_localization/ros/diagnostics/update_timing.h"
 #include "pf_localization/ros/input/conversions.h"
-#include "pf_localization/ros/localizer/output_latency.h"
 #include "pf_localization/ros/localizer/scan_localizer.h"
 #include "pf_localization/ros/params/localizer_config.h"
 

@@ -1,71 +1,42 @@
-// pf_node: the live ROS front door of the particle filter.
+// pf_node: the live ROS front door of the particle filter, and only its
+// wiring: it subscribes scan (or scan_topics, and cloud_topics), odom, map
+// and initialpose, serves amcl's services and dynamic_reconfigure, reads the
+// parameters, and hands each to the part that does the work: TfInput,
+// ScanInputs and OdometryInput (the inputs), UpdateScheduler (where each
+// update runs, and the filter's lock), LiveLocalizer (the filter and what goes
+// with it: time jumping back, the saved pose, pf_pose, amcl_pose,
+// particlecloud), MapToOdomRepublisher (map -> odom on tf), ReconfigureServer.
 //
-// Subscribes scan (or each of scan_topics, and of cloud_topics: PointCloud2),
-// odom, map (latched) and initialpose; publishes map -> odom
-// on tf, the particles on particlecloud and the estimate on pf_pose and
-// amcl_pose. The localization happens in pf_ros::ScanLocalizer and the core,
-// what goes with the filter (time jumping back, the saved pose, the output)
-// in pf_ros::LiveLocalizer; this file wires them to roscpp. It speaks amcl's
-// interface too (topics, services, parameter names, the saved pose,
-// dynamic_reconfigure), so that it can replace amcl in a bringup.
-//
-// Threads (docs/ros-interface.md, "Threads, latency and overload"): tf and the
-// scans are taken on roscpp's own poll thread as they arrive
-// (InlineCallbackQueue: no hand-off to a spinner); a scan whose tf is there
-// is updated at once on that thread when its update will be short
-// (UpdatePlacement), otherwise it goes through a one-scan LatestScanSlot to a
-// filter thread of its own, so that under overload the newest scan wins and
-// tf keeps being consumed; the main spinner serves the map, initialpose,
-// odometry, the services, the periodic save and the scans tf dropped; map ->
-// odom is republished by a MapToOdomRepublisher (on the poll thread: a timer
-// in roscpp's poll set on the wall clock, /clock under simulated time) that
-// never waits for the filter. No roscpp timer: under simulated time one polls
-// the clock every millisecond. filter_mutex_ protects the filter and
-// everything that goes with it (live_).
+// Threads (docs/ros-interface.md, "Threads, latency and overload"): tf, the
+// scans, short updates and map -> odom's timer or /clock on roscpp's poll
+// thread, longer updates on the scheduler's filter thread, the rest (and the
+// pose's save) on the main spinner; the destructor stops them in order.
 #include <nav_msgs/OccupancyGrid.h>
-#include <nav_msgs/Odometry.h>
 #include <nav_msgs/SetMap.h>
-#include <pthread.h>
 #include <ros/callback_queue.h>
 #include <ros/ros.h>
-#include <sensor_msgs/LaserScan.h>
 #include <std_srvs/Empty.h>
-#include <tf2_msgs/TFMessage.h>
-#include <tf2_ros/buffer.h>
-#include <tf2_ros/message_filter.h>
-#include <tf2_ros/transform_listener.h>
 
 #include <csignal>
 #include <memory>
-#include <mutex>
 #include <optional>
-#include <string>
-#include <thread>
-#include <utility>
 #include <vector>
 
-#include "pf_localization/ros/input/latest_scan_slot.h"
-#include "pf_localization/ros/input/odometry_source.h"
+#include "pf_localization/ros/input/odometry_input.h"
 #include "pf_localization/ros/input/pose_transform.h"
-#include "pf_localization/ros/input/scan_drop.h"
 #include "pf_localization/ros/input/scan_inputs.h"
-#include "pf_localization/ros/localizer/inline_callback_queue.h"
-#include "pf_localization/ros/localizer/limited_log.h"
+#include "pf_localization/ros/input/tf_input.h"
 #include "pf_localization/ros/localizer/live_localizer.h"
 #include "pf_localization/ros/output/map_to_odom_republisher.h"
 #include "pf_localization/ros/params/parameter_docs.h"
 #include "pf_localization/ros/params/reconfigure_server.h"
 #include "pf_localization/ros/params/startup_config.h"
+#include "pf_localization/ros/scheduling/update_scheduler.h"
 
 namespace pf_ros {
 namespace {
 
-// How much lower the filter thread's priority is than the rest of the node
-// (nice); see filterLoop().
-constexpr int kFilterNiceIncrement = 5;
-
-// s between two log lines about the same kind of bad input.
-constexpr double kLogPeriod = 5.0;
+constexpr double kLogPeriod = 5.0;  // s between two log lines about the same kind of bad input
 
 // Set by SIGINT; the running node saves its pose, then shuts down (see main()).
 volatile std::sig_atomic_t g_sigint = 0;
@@ -76,308 +47,134 @@ class PfNode {
   // `saved`: config.initial_pose was saved by an earlier run (readSavedPose()).
   PfNode(const LocalizerConfig& config, std::optional<SavedPoseMap> saved, ros::NodeHandle nh,
          ros::NodeHandle pnh)
-      : config_(config),
-        nh_(nh),
-        pnh_(pnh),
-        buffer_(ros::Duration(30.0)),
-        inline_queue_(ros::getGlobalCallbackQueue()),
-        // tf as it arrives, with no thread or spinner of the listener's own: a
-        // transform that completes a waiting scan hands it to the filter thread
-        // directly (docs/performance.md, "Wake-ups: tf and scans on the poll thread").
-        listener_(buffer_, withQueue(nh_, &inline_queue_), false),
-        republisher_(std::make_unique<MapToOdomRepublisher>(
-            MapToOdomRepublisherOptions{config.tf_publish_rate, config.transform_tolerance,
-                                        config.tf_broadcast},
-            [this](const ros::Time& now) { onTfTick(now); })),
-        live_(config, std::move(saved), &buffer_, republisher_.get(), &warn_, nh_),
-        odometry_(config.odom_frame, config.base_frame, nh_.resolveName("odom")),
-        // A dropped scan may restart the filter (a bag that starts over),
-        // which takes filter_mutex_; the thread that dropped it may hold that
-        // mutex (its map -> odom reached tf), so the main spinner handles it.
-        scan_inputs_(
-            scanTopics(config), cloudTopics(config), buffer_, config.odom_frame, &inline_queue_,
-            [this](const sensor_msgs::LaserScanConstPtr& scan, std::size_t sensor) {
-              onScan(PendingScan{scan, ros::WallTime::now(), ros::Time::now(), sensor, nullptr});
-            },
-            [this](const sensor_msgs::PointCloud2ConstPtr& cloud, std::size_t sensor) {
-              onScan(PendingScan{nullptr, ros::WallTime::now(), ros::Time::now(), sensor, cloud});
-            },
-            [this](const std_msgs::Header& header,
-                   tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-              postCallback(ros::getGlobalCallbackQueue(), reinterpret_cast<uint64_t>(this),
-                           [this, header, reason] { onScanDropped(header, reason); });
-            }) {
-    odom_sub_ = nh_.subscribe("odom", 50, &PfNode::onOdom, this);
-    tf_watch_sub_ = nh_.subscribe("/tf", 100, &PfNode::onTf, this);
-    map_sub_ = nh_.subscribe("map", 1, &PfNode::onMap, this);
-    initial_pose_sub_ = nh_.subscribe("initialpose", 2, &PfNode::onInitialPose, this);
-    global_srv_ = nh_.advertiseService("global_localization", &PfNode::onGlobalLocalization, this);
-    nomotion_srv_ =
-        nh_.advertiseService("request_nomotion_update", &PfNode::onNoMotionUpdate, this);
-    set_map_srv_ = nh_.advertiseService("set_map", &PfNode::onSetMap, this);
+      : config_(config) {
+    tf_ = std::make_unique<TfInput>(nh);
+    republisher_ = std::make_unique<MapToOdomRepublisher>(
+        MapToOdomRepublisherOptions{config.tf_publish_rate, config.transform_tolerance,
+                                    config.tf_broadcast},
+        // Never waits for the filter: while an update runs, the next tick looks.
+        [this](const ros::Time& now) {
+          scheduler_->tryWithFilter([&] { live_->clockTick(now); });
+        });
+    live_ = std::make_unique<LiveLocalizer>(
+        config, std::move(saved), &tf_->buffer(), republisher_.get(), &warn_, nh,
+        [pnh](const PoseSaver::Record& record) { writeSavedPose(record, pnh); });
+    scheduler_ = std::make_unique<UpdateScheduler>(
+        [this](const PendingScan& scan, const LatestScanSlot& slot) {
+          live_->processScan(scan, slot, *reconfigure_);
+        },
+        [this] { return live_->nextUpdateOnPollThread(); }, &warn_);
+    odometry_ = std::make_unique<OdometryInput>(nh, config.odom_frame, config.base_frame,
+                                                &tf_->buffer(), &warn_);
+    map_sub_ = nh.subscribe("map", 1, &PfNode::onMap, this);
+    initial_pose_sub_ = nh.subscribe<geometry_msgs::PoseWithCovarianceStamped>(
+        "initialpose", 2, [this](const auto& msg) { applyInitialPose(*msg); });
+    services_ = {nh.advertiseService("global_localization", &PfNode::onGlobalLocalization, this),
+                 nh.advertiseService("request_nomotion_update", &PfNode::onNoMotionUpdate, this),
+                 nh.advertiseService("set_map", &PfNode::onSetMap, this)};
     reconfigure_ = std::make_unique<ReconfigureServer>(
-        pnh_, config, [this](const LocalizerConfig& c) { return reconfigure(c); }, "pf_node");
-    // Its timer or /clock on the poll thread too: it republishes when due.
-    republisher_->start(withQueue(nh_, &inline_queue_));
-    filter_thread_ = std::thread([this] { filterLoop(); });
-    // Last: their callbacks may run at once, on roscpp's poll thread.
-    scan_inputs_.subscribe(nh_);
+        pnh, config,
+        [this](const LocalizerConfig& c) {
+          return scheduler_->withFilter([&] { return live_->reconfigure(c); });
+        },
+        "pf_node");
+    republisher_->start(tf_->onPollThread(nh));
+    scans_ = std::make_unique<ScanInputs>(
+        scanTopics(config), cloudTopics(config), tf_->buffer(), config.odom_frame, tf_->queue(),
+        [this](const sensor_msgs::LaserScanConstPtr& scan, std::size_t sensor) {
+          scheduler_->onScan({scan, ros::WallTime::now(), ros::Time::now(), sensor, nullptr});
+        },
+        [this](const sensor_msgs::PointCloud2ConstPtr& cloud, std::size_t sensor) {
+          scheduler_->onScan({nullptr, ros::WallTime::now(), ros::Time::now(), sensor, cloud});
+        },
+        // On the main spinner: it takes the filter's lock, which the thread
+        // that dropped the scan may hold (its map -> odom reached tf).
+        [this](const std_msgs::Header& header,
+               tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+          postCallback(ros::getGlobalCallbackQueue(), reinterpret_cast<uint64_t>(this), [=] {
+            scheduler_->withFilter([&] { live_->scanDropped(header, reason); });
+          });
+        });
+    scans_->subscribe(nh);  // last: their callbacks may run at once, on the poll thread
   }
 
+  // First what brings scans, then the filter thread, then what its updates use.
   ~PfNode() {
-    scan_inputs_.unsubscribe();
+    scans_.reset();
     ros::getGlobalCallbackQueue()->removeByID(reinterpret_cast<uint64_t>(this));
-    slot_.close();
-    filter_thread_.join();
-    republisher_.reset();  // before live_ goes: its onTfTick() uses live_
+    scheduler_->stop();
+    republisher_.reset();  // its tick uses the scheduler and live_
+    reconfigure_.reset();
+    odometry_.reset();
+    scheduler_.reset();
+    live_.reset();
+    tf_.reset();
   }
 
-  // The main spinner: roscpp's own loop (ros::spin() waits on the queue
-  // with the same 0.1 s of wall time), plus a look at Ctrl-C and at the
-  // periodic save after each wait, so that no timer thread has to wake for
-  // them (under simulated time a roscpp timer polls the clock every ms).
-  // Ctrl-C (and roslaunch's shutdown) saves the latest pose before the node
-  // goes: the periodic save may be up to 1 / save_pose_rate old. Wall
-  // time: a paused bag clock must not keep Ctrl-C waiting.
+  // roscpp's own loop (ros::spin() waits the same 0.1 s of wall time: a paused
+  // bag clock must not keep Ctrl-C waiting), plus a look at the periodic save
+  // and at Ctrl-C (and roslaunch's shutdown), which saves the pose, then stops.
   void spin() {
-    ros::CallbackQueue* queue = ros::getGlobalCallbackQueue();
     while (ros::ok()) {
-      queue->callAvailable(ros::WallDuration(0.1));
-      savePoseWhenDue();
+      ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.1));
+      live_->saver().saveWhenDue(ros::Time::now());
       if (!g_sigint) continue;
       // Without a master the save would block, waiting for one.
-      if (config_.save_pose_rate > 0.0 && ros::master::check()) savePose();
+      if (live_->saver().enabled() && ros::master::check()) live_->saver().saveNow();
       ros::shutdown();
     }
   }
 
  private:
   void onMap(const nav_msgs::OccupancyGridConstPtr& msg) {
-    if (config_.first_map_only && live_.haveMap()) {
+    if (config_.first_map_only && live_->haveMap()) {
       if (warn_.due("first_map_only")) {
         ROS_INFO("pf_node: first_map_only: ignoring a new map on %s (set_map still replaces it)",
                  map_sub_.getTopic().c_str());
       }
       return;
     }
-    std::lock_guard<std::mutex> lock(filter_mutex_);
-    live_.installMap(*msg);
+    scheduler_->withFilter([&] { live_->installMap(*msg); });
   }
 
-  std::string reconfigure(const LocalizerConfig& next) {
-    std::lock_guard<std::mutex> lock(filter_mutex_);
-    return live_.reconfigure(next);
-  }
-
-  // Odometry from the topic, for robots that have none on tf (OdometrySource).
-  void onOdom(const nav_msgs::OdometryConstPtr& msg) {
-    const OdometrySource::TopicMessage use = odometry_.onTopic(*msg);
-    if (!use.problem.empty()) warn_.warn(use.problem_key, use.problem);
-    if (use.transform) buffer_.setTransform(*use.transform, "odom_topic");
-    announceOdometrySource();
-  }
-
-  // Watches /tf only until it shows whether odometry travels there.
-  void onTf(const tf2_msgs::TFMessageConstPtr& msg) {
-    if (!odometry_.onTf(*msg)) return;
-    tf_watch_sub_.shutdown();
-    // Nor is the odometry topic needed any more: unsubscribed, its
-    // messages no longer wake this node (twice the scans' rate, often).
-    odom_sub_.shutdown();
-    announceOdometrySource();
-  }
-
-  void announceOdometrySource() {
-    if (const auto line = odometry_.takeAnnouncement()) ROS_INFO("pf_node: %s", line->c_str());
-  }
-
-  // Once tf has the scan's stamp, on whichever thread brought the scan or
-  // the transform that completed it (InlineCallbackQueue): a short update
-  // runs here, any other is handed to the filter thread, so that no thread
-  // waits here for an update.
-  void onScan(PendingScan pending) {
-    if (updateHere(pending)) return;
-    if (!slot_.put(std::move(pending))) return;
-    const std::uint64_t dropped = slot_.dropped();
-    warn_.warn("overload",
-               "the filter cannot keep up: a scan waiting for it was dropped for a newer one (" +
-                   std::to_string(dropped) +
-                   " since start; see dropped_scans and latency_* in the diagnostics). Lower "
-                   "max_particles, or set max_update_time");
-  }
-
-  // Runs the scan's update at once, on the thread that brought the scan
-  // (roscpp's poll thread), when it will be short (UpdatePlacement): a
-  // hand-over to the filter thread costs two wake-ups and the caches the
-  // messages warmed. Not when a scan waits or is in the filter thread's hands
-  // (it would be overtaken), when another thread holds the filter (a new map,
-  // a service), or on a thread already inside an update. It may run inside
-  // roscpp's /tf callback, which is safe only while pf_node publishes by
-  // value (docs/ros-interface.md, "Threads, latency and overload").
-  bool updateHere(const PendingScan& pending) {
-    if (t_updating) return false;
-    std::unique_lock<std::mutex> lock(filter_mutex_, std::try_to_lock);
-    if (!lock.owns_lock() || !slot_.idle() || !live_.nextUpdateOnPollThread()) return false;
-    process(pending);
-    return true;
-  }
-
-  // One scan's update, with the filter mutex held.
-  void process(const PendingScan& pending) {
-    t_updating = true;
-    live_.processScan(pending, slot_, *reconfigure_);
-    t_updating = false;
-  }
-
-  // The filter thread: the newest waiting scan, one at a time.
-  void filterLoop() {
-    // The filter yields the CPU to this node's other threads (map -> odom,
-    // odometry and tf, the clock): a lower priority for this thread, which
-    // the update's worker threads take for its jobs (worker_pool.h).
-    // Raising the nice value needs no privilege; failing, it changes
-    // nothing.
-    lowerThreadPriority(kFilterNiceIncrement);
-    // Named for the per-thread CPU in scripts/live_cpu.sh, top and perf.
-    pthread_setname_np(pthread_self(), "pf_filter");
-    // The destructor's close() wakes the wait; its time-out only bounds how
-    // long a shutdown by another way goes unseen (a shorter one would wake
-    // an idle node ten times a second for nothing).
-    while (ros::ok() && !slot_.closed()) {
-      auto pending = slot_.take(ros::WallDuration(1.0));
-      if (!pending) continue;
-      std::lock_guard<std::mutex> lock(filter_mutex_);
-      process(*pending);
-      slot_.done();
-    }
-  }
-
-  void onScanDropped(const std_msgs::Header& header,
-                     tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-    std::lock_guard<std::mutex> lock(filter_mutex_);
-    // The first scans after a bag starts over often land here as older than
-    // the buffer, which still holds the old timeline: the jump back is
-    // detected on them too, so that the filter restarts on the first scan of
-    // the new timeline. (Not on scans dropped from a full queue: those are
-    // the oldest waiting, legitimately older than the last scan used.)
-    if (ros::Time::isSimTime()) {
-      if (reason == tf2_ros::filter_failure_reasons::OutTheBack &&
-          live_.timeJumpedBack(header.stamp)) {
-        return;
-      }
-      if (!header.frame_id.empty()) live_.clearStaleBuffer(header.frame_id);
-    }
-    warn_.warn("scan dropped " + header.frame_id,
-               scanDropMessage(header, reason, config_.base_frame, config_.odom_frame));
-  }
-
-  void onInitialPose(const geometry_msgs::PoseWithCovarianceStampedConstPtr& msg) {
-    applyInitialPose(*msg);
-  }
-
-  bool applyInitialPose(geometry_msgs::PoseWithCovarianceStamped pose) {
-    if (pose.header.frame_id.empty()) {
-      warn_.warn("initialpose frame",
-                 "initial pose with an empty frame_id: taken to be in " + config_.global_frame);
-    } else if (pose.header.frame_id != config_.global_frame) {
-      if (!transformToGlobal(&pose)) return false;
-    }
-    std::lock_guard<std::mutex> lock(filter_mutex_);
-    return live_.setInitialPose(pose);
+  // An initial pose in another frame (say odom, or base_link) is moved into
+  // the global frame through tf first.
+  bool applyInitialPose(const geometry_msgs::PoseWithCovarianceStamped& pose) {
+    const auto global = initialPoseInFrame(tf_->buffer(), pose, config_.global_frame, &warn_);
+    return global && scheduler_->withFilter([&] { return live_->setInitialPose(*global); });
   }
 
   // amcl's set_map: a new map and the pose on it in one call (a robot moved
   // to another floor). The map is installed even when first_map_only is set:
   // that guards against map topic updates, not against an explicit request.
   bool onSetMap(nav_msgs::SetMap::Request& req, nav_msgs::SetMap::Response& res) {
-    bool installed = false;
-    {
-      std::lock_guard<std::mutex> lock(filter_mutex_);
-      installed = live_.installMap(req.map);
-    }
+    const bool installed = scheduler_->withFilter([&] { return live_->installMap(req.map); });
     res.success = installed && applyInitialPose(req.initial_pose);
     return true;
   }
 
-  // An initial pose given in another frame (say odom, or base_link) is moved
-  // into the global frame through tf, covariance rotated with it.
-  bool transformToGlobal(geometry_msgs::PoseWithCovarianceStamped* pose) {
-    std::string error;
-    const auto moved =
-        poseInFrame(buffer_, *pose, config_.global_frame, ros::Duration(0.5), &error);
-    if (!moved) {
-      warn_.warn("initialpose tf", "ignoring the initial pose: cannot transform it from frame '" +
-                                       pose->header.frame_id + "' to '" + config_.global_frame +
-                                       "': " + error);
-      return false;
-    }
-    *pose = *moved;
-    return true;
-  }
-
   bool onGlobalLocalization(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
-    std::lock_guard<std::mutex> lock(filter_mutex_);
-    return live_.startGlobalLocalization();
+    return scheduler_->withFilter([&] { return live_->startGlobalLocalization(); });
   }
 
   bool onNoMotionUpdate(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
-    std::lock_guard<std::mutex> lock(filter_mutex_);
-    live_.requestNoMotionUpdate();
+    scheduler_->withFilter([&] { live_->requestNoMotionUpdate(); });
     return true;
   }
 
-  // Before each timed map -> odom (under simulated time on the poll thread,
-  // from /clock). Under simulated time the clock itself shows a bag
-  // starting over, often before any scan of the new timeline gets through
-  // tf. (It lags the messages a little, hence the wider tolerance.) Never
-  // waits for the filter: while an update runs, the check waits for the
-  // next tick.
-  void onTfTick(const ros::Time& now) {
-    if (!ros::Time::isSimTime()) return;
-    std::unique_lock<std::mutex> lock(filter_mutex_, std::try_to_lock);
-    if (lock.owns_lock()) live_.timeJumpedBack(now, kSimClockLead);
-  }
-
-  // Every 1 / save_pose_rate s of the clock (amcl's timer), give or take
-  // the spinner's wait.
-  void savePoseWhenDue() {
-    if (config_.save_pose_rate <= 0.0) return;
-    const ros::Time now = ros::Time::now();
-    const ros::Duration period(1.0 / config_.save_pose_rate);
-    // The first look only starts the schedule, as a timer's first period.
-    const bool first = save_schedule_.next().isZero();
-    if (now.isZero() || !save_schedule_.due(now, period)) return;
-    save_schedule_.published(now, period);
-    if (!first) savePose();
-  }
-
-  // As amcl does, with the map it is on (saved_pose.h). Never waits for the
-  // filter: the pose is kept under a small lock of its own.
-  void savePose() {
-    if (const auto record = live_.saver().latest()) writeSavedPose(*record, pnh_);
-  }
-
+  // Made in the constructor's body and stopped in the destructor's, in the
+  // order their threads need: the members' order does not matter.
   const LocalizerConfig config_;  // as read: the live values are live_'s
-  ros::NodeHandle nh_, pnh_;
   LimitedWarn warn_{"pf_node", kLogPeriod};
-  tf2_ros::Buffer buffer_;
-  // Set while this thread runs an update (process()).
-  static inline thread_local bool t_updating = false;
-  InlineCallbackQueue inline_queue_;  // before every subscriber that uses it
-  tf2_ros::TransformListener listener_;
-  std::unique_ptr<MapToOdomRepublisher> republisher_;  // started at the end of the constructor
-  // Guards live_: taken for a whole update (by the filter thread, or by the
-  // poll thread, which only ever tries it), and by the main spinner's
-  // callbacks that touch the filter. The republisher never waits for it.
-  std::mutex filter_mutex_;
-  LiveLocalizer live_;
-  LatestScanSlot slot_;
-  ros::Subscriber odom_sub_, map_sub_, initial_pose_sub_, tf_watch_sub_;
-  OdometrySource odometry_;  // main spinner only
-  ScanInputs scan_inputs_;   // after slot_ and live_, which its callbacks use
-  ros::ServiceServer global_srv_, nomotion_srv_, set_map_srv_;
-  RepublishSchedule save_schedule_;  // main spinner only
+  std::unique_ptr<TfInput> tf_;
+  std::unique_ptr<MapToOdomRepublisher> republisher_;
+  std::unique_ptr<LiveLocalizer> live_;
+  std::unique_ptr<UpdateScheduler> scheduler_;
+  std::unique_ptr<OdometryInput> odometry_;
   std::unique_ptr<ReconfigureServer> reconfigure_;
-  std::thread filter_thread_;  // last: started when everything else exists
+  std::unique_ptr<ScanInputs> scans_;
+  ros::Subscriber map_sub_, initial_pose_sub_;
+  std::vector<ros::ServiceServer> services_;
 };
 
 }  // namespace

@@ -35,4 +35,23 @@ std::optional<geometry_msgs::PoseWithCovarianceStamped> poseInFrame(
   return out;
 }
 
+std::optional<geometry_msgs::PoseWithCovarianceStamped> initialPoseInFrame(
+    const tf2_ros::Buffer& tf, const geometry_msgs::PoseWithCovarianceStamped& pose,
+    const std::string& global_frame, LimitedWarn* warn) {
+  if (pose.header.frame_id.empty()) {
+    warn->warn("initialpose frame",
+               "initial pose with an empty frame_id: taken to be in " + global_frame);
+    return pose;
+  }
+  if (pose.header.frame_id == global_frame) return pose;
+  std::string error;
+  auto moved = poseInFrame(tf, pose, global_frame, ros::Duration(0.5), &error);
+  if (!moved) {
+    warn->warn("initialpose tf", "ignoring the initial pose: cannot transform it from frame '" +
+                                     pose.header.frame_id + "' to '" + global_frame +
+                                     "': " + error);
+  }
+  return moved;
+}
+
 }  // namespace pf_ros

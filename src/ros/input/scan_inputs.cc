@@ -40,6 +40,8 @@ ScanInputs::ScanInputs(const std::vector<std::string>& scan_topics,
   addInputs(cloud_topics, scan_topics.size(), buffer, odom_frame, on_cloud, on_drop, &clouds_);
 }
 
+ScanInputs::~ScanInputs() { unsubscribe(); }
+
 void ScanInputs::subscribe(ros::NodeHandle& nh) {
   for (const auto& input : scans_) {
     input->subscriber.subscribe(nh, input->topic, kQueueSize, ros::TransportHints(), queue_);

@@ -4,19 +4,28 @@
 #include <utility>
 
 #include "pf_localization/ros/input/conversions.h"
+#include "pf_localization/ros/input/scan_drop_message.h"
 
 namespace pf_ros {
+namespace {
+
+// ros::Time::now(), asked only under simulated time, where it matters.
+ros::Time simClockNow() { return ros::Time::isSimTime() ? ros::Time::now() : ros::Time(); }
+
+}  // namespace
 
 LiveLocalizer::LiveLocalizer(const LocalizerConfig& config, std::optional<SavedPoseMap> saved,
                              tf2_ros::Buffer* tf, MapToOdomRepublisher* republisher,
-                             LimitedWarn* warn, ros::NodeHandle& nh)
+                             LimitedWarn* warn, ros::NodeHandle& nh, PoseSaver::Write write_pose)
     : config_(config),
-      tf_(tf),
       republisher_(republisher),
       warn_(warn),
       localizer_(config, tf),
       governor_(UpdateTimeGovernorOptions{config.max_update_time}),
       output_(nh),
+      jumps_(tf, config.odom_frame, config.base_frame, warn,
+             [this](double back_s) { restartAfterJump(back_s); }),
+      saver_(config.save_pose_rate, std::move(write_pose)),
       saved_pose_(std::move(saved)) {
   logInitialPose();
 }
@@ -126,8 +135,7 @@ void LiveLocalizer::applyParticleCap(std::size_t cap) {
 void LiveLocalizer::processScan(const PendingScan& pending, const LatestScanSlot& slot,
                                 const ReconfigureServer& reconfigure) {
   const std_msgs::Header& header = pending.header();
-  if (fromBeforeTheJump(header.stamp)) return;
-  if (timeJumpedBack(header.stamp)) return;
+  if (!jumps_.admitScan(header.stamp, simClockNow(), ros::Time::isSimTime())) return;
   const std::size_t weighed = localizer_.filter().particles().size();
   const ros::WallTime start = ros::WallTime::now();
   const ScanResult result = pending.scan ? localizer_.processScan(*pending.scan, pending.sensor)
@@ -159,18 +167,15 @@ void LiveLocalizer::processScan(const PendingScan& pending, const LatestScanSlot
   }
 }
 
-// tf data and the filter's odometry reference belong to the old timeline,
-// so both start over, as tf itself does on such a jump: from the initial
-// pose, or with global localization.
-bool LiveLocalizer::timeJumpedBack(const ros::Time& stamp, double tolerance) {
-  const auto back = jumps_.jumpBack(stamp, tolerance);
-  if (!back) return false;
+// tf (cleared by then) and the filter's odometry reference belong to the old
+// timeline, so both start over, as tf itself does on such a jump: from the
+// initial pose, or with global localization.
+void LiveLocalizer::restartAfterJump(double back_s) {
   const bool from_pose = config_.initial_pose && !saved_pose_ignored_;
   ROS_WARN(
       "pf_node: time jumped back by %.1f s (a bag restarted?): clearing tf and restarting "
       "the filter %s",
-      *back, from_pose ? "from the initial pose" : "with global localization");
-  tf_->clear();
+      back_s, from_pose ? "from the initial pose" : "with global localization");
   last_odom_.reset();
   std::string error = localizer_.restart();
   // restart() goes back to the configured pose, which was a saved one not to use.
@@ -178,39 +183,19 @@ bool LiveLocalizer::timeJumpedBack(const ros::Time& stamp, double tolerance) {
     error = localizer_.startGlobalLocalization();
   }
   if (!error.empty()) ROS_WARN("pf_node: %s", error.c_str());
-  jumps_.reset();
   republisher_->reset();
   filterChanged(ros::Time());
-  return true;
 }
 
-namespace {
-// ros::Time::now(), asked only under simulated time, where it matters.
-ros::Time simClockNow() { return ros::Time::isSimTime() ? ros::Time::now() : ros::Time(); }
-}  // namespace
-
-// When a bag starts over, messages of the old timeline are still queued in
-// pf_node's subscriptions and tf's: they arrive after the jump back, stamped
-// ahead of the clock. A scan among them would restart the filter a second
-// time, at the wrong place; they are dropped instead.
-bool LiveLocalizer::fromBeforeTheJump(const ros::Time& stamp) {
-  const auto ahead = aheadOfSimClock(stamp, simClockNow(), ros::Time::isSimTime());
-  if (!ahead) return false;
-  warn_->warn("scan ahead of clock",
-              "scan ignored: stamped " + std::to_string(*ahead) +
-                  " s ahead of /clock, so it is from before time jumped back");
-  return true;
+void LiveLocalizer::scanDropped(const std_msgs::Header& header,
+                                tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
+  if (jumps_.scanDropped(header, reason, simClockNow(), ros::Time::isSimTime())) return;
+  warn_->warn("scan dropped " + header.frame_id,
+              scanDropMessage(header, reason, config_.base_frame, config_.odom_frame));
 }
 
-void LiveLocalizer::clearStaleBuffer(const std::string& laser_frame) {
-  const ros::Time latest =
-      latestChainStamp(*tf_, config_.odom_frame, config_.base_frame, laser_frame);
-  const auto ahead = aheadOfSimClock(latest, simClockNow(), ros::Time::isSimTime());
-  if (!ahead) return;
-  warn_->warn("stale tf",
-              "clearing tf again: it still held transforms from before time jumped back (" +
-                  std::to_string(*ahead) + " s ahead of /clock)");
-  tf_->clear();
+void LiveLocalizer::clockTick(const ros::Time& now) {
+  jumps_.clockTick(now, ros::Time::isSimTime());
 }
 
 // After anything that moved the filter: map -> odom goes to the republisher
@@ -219,7 +204,7 @@ void LiveLocalizer::clearStaleBuffer(const std::string& laser_frame) {
 // spinner that waited would hold back the scans and odometry queued behind it).
 void LiveLocalizer::filterChanged(const ros::Time& scan_stamp) {
   republisher_->set(localizer_.mapToOdom(ros::Time()), scan_stamp);
-  if (config_.save_pose_rate <= 0.0) return;  // nothing is ever saved
+  if (!saver_.enabled()) return;  // nothing is ever saved
   saver_.set(poseToSave(localizer_, last_odom_));
 }
 

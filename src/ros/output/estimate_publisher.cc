@@ -4,21 +4,14 @@
 #include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 
+#include "pf_localization/ros/diagnostics/diagnostic_status.h"
 #include "pf_localization/ros/input/conversions.h"
-#include "pf_localization/ros/output/diagnostics.h"
 
 namespace pf_ros {
 
 bool cloudDue(const ros::Time& last, const ros::Time& stamp, double rate, bool always) {
   const double period = rate > 0.0 ? 1.0 / rate : 0.0;
   return always || last.isZero() || stamp < last || (stamp - last).toSec() >= period;
-}
-
-std::optional<StateChangeLog::Line> StateChangeLog::onConfidence(const pf::Confidence& c) {
-  if (c.state == last_) return std::nullopt;
-  last_ = c.state;
-  if (c.state == pf::LocalizationState::kLocalized) return Line{false, "localized: " + c.reason};
-  return Line{true, std::string(pf::toString(c.state)) + ": " + c.reason};
 }
 
 EstimatePublisher::EstimatePublisher(ros::NodeHandle& nh)

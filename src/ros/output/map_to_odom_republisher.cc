@@ -27,11 +27,6 @@ constexpr double kWallClockPeriods = 1.5;
 
 }  // namespace
 
-bool RepublishSchedule::due(const ros::Time& now, const ros::Duration& period) {
-  if (next_.isZero() || now + period < next_) next_ = now;
-  return now >= next_;
-}
-
 MapToOdomRepublisher::MapToOdomRepublisher(const MapToOdomRepublisherOptions& options,
                                            TickHook hook)
     : options_(options), hook_(std::move(hook)) {}

@@ -32,5 +32,34 @@ TEST(InParentFrame, ComposesThePoseAndRotatesItsCovariance) {
   EXPECT_EQ("odom", moved.header.frame_id);  // for the caller to set
 }
 
+TEST(InitialPoseInFrame, KeptInTheGlobalFrameMovedFromAnotherOneRefusedWithoutTf) {
+  tf2_ros::Buffer tf;
+  geometry_msgs::TransformStamped odom;  // odom in map: 2 m east
+  odom.header.frame_id = "map";
+  odom.child_frame_id = "odom";
+  odom.header.stamp = ros::Time(1.0);
+  odom.transform.translation.x = 2.0;
+  odom.transform.rotation.w = 1.0;
+  tf.setTransform(odom, "test");
+  LimitedWarn warn("test", 5.0);
+  geometry_msgs::PoseWithCovarianceStamped pose;
+  pose.pose.pose = toPoseMsg(pf::Pose2{1.0, 0.5, 0.1});
+  for (const char* frame : {"", "map"}) {  // none (taken to be map), or map itself
+    pose.header.frame_id = frame;
+    const auto kept = initialPoseInFrame(tf, pose, "map", &warn);
+    ASSERT_TRUE(kept) << frame;
+    EXPECT_EQ(frame, kept->header.frame_id);
+    EXPECT_DOUBLE_EQ(1.0, kept->pose.pose.position.x);
+  }
+  pose.header.frame_id = "odom";
+  const auto moved = initialPoseInFrame(tf, pose, "map", &warn);
+  ASSERT_TRUE(moved);
+  EXPECT_EQ("map", moved->header.frame_id);
+  EXPECT_NEAR(3.0, moved->pose.pose.position.x, 1e-9);
+  EXPECT_NEAR(0.5, moved->pose.pose.position.y, 1e-9);
+  pose.header.frame_id = "base_link";  // not in tf
+  EXPECT_FALSE(initialPoseInFrame(tf, pose, "map", &warn));
+}
+
 }  // namespace
 }  // namespace pf_ros

@@ -1,6 +1,6 @@
 // One declaration per parameter, beside the options struct it fills: its
 // name, unit, one-line description, valid range, whether it may change while
-// the filter runs, and amcl's name for it. Reading (ros/localizer_config.h),
+// the filter runs, and amcl's name for it. Reading (ros/params/localizer_config.h),
 // checking (checkRanges), live reconfiguration (ros/live_params.h), the
 // diagnostics, `pf_node --help` and the generated files (config/pf.yaml,
 // cfg/PfLocalization.cfg, the README's table: ros/parameter_docs.h) all walk

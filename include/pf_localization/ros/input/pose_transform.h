@@ -10,6 +10,8 @@
 #include <optional>
 #include <string>
 
+#include "pf_localization/ros/diagnostics/limited_warn.h"
+
 namespace pf_ros {
 
 /// `pose`, given in the child frame of `frame` (a transform from tf, parent
@@ -26,5 +28,13 @@ geometry_msgs::PoseWithCovarianceStamped inParentFrame(
 std::optional<geometry_msgs::PoseWithCovarianceStamped> poseInFrame(
     const tf2_ros::Buffer& tf, const geometry_msgs::PoseWithCovarianceStamped& pose,
     const std::string& frame, const ros::Duration& timeout, std::string* error);
+
+/// An initial pose (initialpose, set_map's) in `global_frame`: as it is when
+/// given there, or with an empty frame_id (warned on `warn`: taken to be
+/// there); moved through `tf` from any other frame, waiting up to 0.5 s for
+/// the transform. Nothing, warned, when tf cannot move it.
+std::optional<geometry_msgs::PoseWithCovarianceStamped> initialPoseInFrame(
+    const tf2_ros::Buffer& tf, const geometry_msgs::PoseWithCovarianceStamped& pose,
+    const std::string& global_frame, LimitedWarn* warn);
 
 }  // namespace pf_ros

@@ -37,6 +37,11 @@ class ScanInputs {
              const std::string& odom_frame, ros::CallbackQueueInterface* queue,
              const OnScan& on_scan, const OnCloud& on_cloud, const OnDrop& on_drop);
 
+  /// Unsubscribes, then waits for the callbacks running on another thread.
+  ~ScanInputs();
+  ScanInputs(const ScanInputs&) = delete;
+  ScanInputs& operator=(const ScanInputs&) = delete;
+
   /// Subscribes every topic (relative to `nh`): callbacks may run at once.
   void subscribe(ros::NodeHandle& nh);
   void unsubscribe();

@@ -2,13 +2,13 @@
 // with it. A scan's update and what follows it (map -> odom to the
 // republisher, the pose to the saver, the estimate and the diagnostics),
 // maps, initial poses and the services, the live parameters with
-// max_update_time's particle cap, time jumping back (TimeJumpDetector:
-// tf and the filter start over) and the check of a pose saved by an earlier
-// run on the first map (saved_pose.h).
+// max_update_time's particle cap, time jumping back (TimeJumpHandler: tf
+// and the filter start over), the scans tf dropped and the check of a pose
+// saved by an earlier run on the first map (saved_pose.h).
 //
 // Threads (docs/ros-interface.md, "Threads, latency and overload"): every
-// method but saver() and haveMap() must be called with pf_node's filter mutex
-// held; an update holds it whole (on the filter thread, or on roscpp's poll
+// method but saver() and haveMap() must be called with the filter's lock
+// held (UpdateScheduler); an update holds it whole (on the filter thread, or on roscpp's poll
 // thread when it is short), the main spinner's callbacks that touch the filter
 // wait for it. What runs at a steady rate never does: the republisher and the
 // saver get their data under small locks of their own.
@@ -17,23 +17,26 @@
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <nav_msgs/OccupancyGrid.h>
 #include <ros/ros.h>
+#include <std_msgs/Header.h>
 #include <tf2_ros/buffer.h>
+#include <tf2_ros/message_filter.h>
 
 #include <cstdint>
 #include <optional>
 #include <string>
 
-#include "pf_localization/ros/input/latest_scan_slot.h"
-#include "pf_localization/ros/input/time_jump_detector.h"
-#include "pf_localization/ros/localizer/limited_log.h"
-#include "pf_localization/ros/localizer/output_latency.h"
-#include "pf_localization/ros/localizer/particle_cap_governor.h"
+#include "pf_localization/ros/diagnostics/limited_warn.h"
+#include "pf_localization/ros/diagnostics/update_timing.h"
+#include "pf_localization/ros/input/time_jump_handler.h"
 #include "pf_localization/ros/localizer/scan_localizer.h"
-#include "pf_localization/ros/localizer/update_placement.h"
 #include "pf_localization/ros/output/estimate_publisher.h"
 #include "pf_localization/ros/output/map_to_odom_republisher.h"
-#include "pf_localization/ros/output/saved_pose.h"
+#include "pf_localization/ros/output/pose_saver.h"
 #include "pf_localization/ros/params/reconfigure_server.h"
+#include "pf_localization/ros/params/saved_pose.h"
+#include "pf_localization/ros/scheduling/latest_scan_slot.h"
+#include "pf_localization/ros/scheduling/update_placement.h"
+#include "pf_localization/ros/scheduling/update_time_governor.h"
 
 namespace pf_ros {
 
@@ -41,10 +44,11 @@ class LiveLocalizer {
  public:
   /// `saved`: config.initial_pose was saved by an earlier run (isSavedPose()).
   /// `tf`, `republisher` and `warn` must outlive it; the topics are
-  /// advertised on `nh`. Logs the initial pose it will start from.
+  /// advertised on `nh`; `write_pose` saves the pose (saver()). Logs the
+  /// initial pose it will start from.
   LiveLocalizer(const LocalizerConfig& config, std::optional<SavedPoseMap> saved,
                 tf2_ros::Buffer* tf, MapToOdomRepublisher* republisher, LimitedWarn* warn,
-                ros::NodeHandle& nh);
+                ros::NodeHandle& nh, PoseSaver::Write write_pose = {});
 
   /// A new map (map topic or set_map). False when it was refused (logged).
   bool installMap(const nav_msgs::OccupancyGrid& map);
@@ -74,25 +78,28 @@ class LiveLocalizer {
   void processScan(const PendingScan& pending, const LatestScanSlot& slot,
                    const ReconfigureServer& reconfigure);
 
-  /// When `stamp` lies more than `tolerance` s before the latest scan used:
-  /// clears tf, restarts the filter and returns true.
-  bool timeJumpedBack(const ros::Time& stamp, double tolerance = TimeJumpDetector::kScanTolerance);
-  /// Clears tf again when it still holds transforms of the scan's chain from
-  /// before time jumped back (latestChainStamp()).
-  void clearStaleBuffer(const std::string& laser_frame);
+  /// A scan tf dropped for `reason`: a sign of time jumping back (then
+  /// everything starts over), or a rate-limited warning naming the
+  /// transforms the scan needs.
+  void scanDropped(const std_msgs::Header& header,
+                   tf2_ros::filter_failure_reasons::FilterFailureReason reason);
+  /// The clock at a timed map -> odom: under simulated time it may show
+  /// time jumping back, often before any scan of the new timeline gets
+  /// through tf.
+  void clockTick(const ros::Time& now);
 
-  /// What to save, under its own lock: may be used without the mutex.
-  const PoseSaver& saver() const { return saver_; }
+  /// The pose to save and its schedule (pose_saver.h): may be used without
+  /// the filter's lock.
+  PoseSaver& saver() { return saver_; }
 
  private:
   void logInitialPose() const;
   void checkSavedPose(const std::string& map_signature);
-  bool fromBeforeTheJump(const ros::Time& stamp);
+  void restartAfterJump(double back_s);
   void applyParticleCap(std::size_t cap);
   void filterChanged(const ros::Time& scan_stamp);
 
   const LocalizerConfig config_;  // as read at start-up: the live values are localizer_'s
-  tf2_ros::Buffer* tf_;
   MapToOdomRepublisher* republisher_;
   LimitedWarn* warn_;
   ScanLocalizer localizer_;
@@ -100,7 +107,7 @@ class LiveLocalizer {
   UpdateTiming timing_;
   UpdatePlacement placement_;
   EstimatePublisher output_;
-  TimeJumpDetector jumps_;
+  TimeJumpHandler jumps_;
   PoseSaver saver_;
   bool have_map_ = false;
   std::optional<SavedPoseMap> saved_pose_;  // until the first map checks it

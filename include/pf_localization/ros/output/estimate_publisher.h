@@ -4,8 +4,8 @@
 // on /diagnostics (for robot monitors) and pf_status (for anything that only
 // wants this node's verdict); and a log line for each change of the
 // localization state (localized / uncertain / lost), which is news where the
-// same state on every scan is not. Not thread-safe: pf_node calls it under
-// its filter mutex, since it reads the filter.
+// same state on every scan is not (StateChangeLog). Not thread-safe: pf_node
+// calls it with the filter's lock held, since it reads the filter.
 #pragma once
 
 #include <diagnostic_msgs/DiagnosticStatus.h>
@@ -20,7 +20,8 @@
 #include <string>
 
 #include "pf_localization/core/estimate/confidence.h"
-#include "pf_localization/ros/localizer/output_latency.h"
+#include "pf_localization/ros/diagnostics/state_change_log.h"
+#include "pf_localization/ros/diagnostics/update_timing.h"
 #include "pf_localization/ros/localizer/scan_localizer.h"
 #include "pf_localization/ros/output/latched_topic.h"
 
@@ -31,20 +32,6 @@ namespace pf_ros {
 /// `always`: a re-initialisation, shown whatever the rate. Time going back
 /// makes it due.
 bool cloudDue(const ros::Time& last, const ros::Time& stamp, double rate, bool always);
-
-/// The log line for a change of the localization state: INFO when it
-/// becomes localized, WARN otherwise; nothing while the state stays the same.
-class StateChangeLog {
- public:
-  struct Line {
-    bool warning = false;
-    std::string text;
-  };
-  std::optional<Line> onConfidence(const pf::Confidence& confidence);
-
- private:
-  std::optional<pf::LocalizationState> last_;
-};
 
 class EstimatePublisher {
  public:

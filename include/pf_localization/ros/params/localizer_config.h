@@ -19,6 +19,7 @@
 #include "pf_localization/core/filter/particle_filter.h"
 #include "pf_localization/core/sensor/cloud_scan_reducer.h"
 #include "pf_localization/core/util/parameter_table.h"
+#include "pf_localization/ros/params/param_source.h"
 
 namespace pf_ros {
 
@@ -97,27 +98,6 @@ struct ConfigNotes {
   std::vector<std::string> warnings;
   std::vector<std::string> infos;
 };
-
-/// Where parameters come from: the ROS parameter server, or a YAML file.
-/// Each getter leaves `value` alone and returns false when the key is absent.
-class ParamSource {
- public:
-  virtual ~ParamSource() = default;
-  virtual bool get(const std::string& key, double* value) const = 0;
-  virtual bool get(const std::string& key, int* value) const = 0;
-  virtual bool get(const std::string& key, bool* value) const = 0;
-  virtual bool get(const std::string& key, std::string* value) const = 0;
-  /// The names present at the top level, for the unknown-parameter warning
-  /// (a source that cannot list them returns none, and nothing is warned about).
-  virtual std::vector<std::string> keys() const { return {}; }
-};
-
-/// A ParamSource over a flat YAML mapping (config/pf.yaml's format).
-/// Throws std::runtime_error naming the file when it cannot be read.
-std::unique_ptr<ParamSource> yamlParamSource(const std::string& path);
-
-/// A ParamSource over a node's (usually private) namespace.
-std::unique_ptr<ParamSource> rosParamSource(const ros::NodeHandle& nh);
 
 /// Reads every parameter (absent ones keep their defaults) and validates the
 /// result. Throws std::invalid_argument naming the parameter and its valid range.

@@ -8,8 +8,8 @@
 
 #include <optional>
 
-#include "pf_localization/ros/output/saved_pose.h"
 #include "pf_localization/ros/params/localizer_config.h"
+#include "pf_localization/ros/params/saved_pose.h"
 
 namespace pf_ros {
 

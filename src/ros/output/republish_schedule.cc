@@ -1,0 +1,10 @@
+#include "pf_localization/ros/output/republish_schedule.h"
+
+namespace pf_ros {
+
+bool RepublishSchedule::due(const ros::Time& now, const ros::Duration& period) {
+  if (next_.isZero() || now + period < next_) next_ = now;
+  return now >= next_;
+}
+
+}  // namespace pf_ros
