@@ -69,6 +69,10 @@ class EvalError(Exception):
     """Bad or missing input; main() prints it and exits with status 2."""
 
 
+class NoReference(EvalError):
+    """The bag has no message on the reference topic: run() then reports without a reference."""
+
+
 # ----------------------------------------------------------------------------------- geometry
 def wrap(a):
     """Angle(s) wrapped to [-pi, pi)."""
@@ -115,13 +119,109 @@ def read_bag_reference(path, topic='/ground_truth'):
     with rosbag.Bag(path) as bag:
         topics = bag.get_type_and_topic_info().topics
         if topic not in topics or topics[topic].message_count == 0:
-            raise EvalError('bag %s has no %s messages (topics: %s)' % (path, topic, ', '.join(sorted(topics))))
+            raise NoReference('bag %s has no %s messages (topics: %s)' % (path, topic, ', '.join(sorted(topics))))
         rows = []
         for _, m, _ in bag.read_messages(topics=[topic]):
             p, q = m.pose.position, m.pose.orientation
             rows.append((m.header.stamp.to_sec(), p.x, p.y, quat_yaw(q.x, q.y, q.z, q.w)))
     a = np.array(rows, dtype=float)
     return a[np.argsort(a[:, 0], kind='stable')]
+
+
+def _matrix(translation, rotation):
+    """A transform's 4 x 4 homogeneous matrix (geometry_msgs Vector3 and Quaternion)."""
+    x, y, z, w = rotation.x, rotation.y, rotation.z, rotation.w
+    n = x * x + y * y + z * z + w * w
+    s = 2.0 / n if n > 0 else 0.0
+    m = np.eye(4)
+    m[:3, :3] = [[1 - s * (y * y + z * z), s * (x * y - z * w), s * (x * z + y * w)],
+                 [s * (x * y + z * w), 1 - s * (x * x + z * z), s * (y * z - x * w)],
+                 [s * (x * z - y * w), s * (y * z + x * w), 1 - s * (x * x + y * y)]]
+    m[:3, 3] = translation.x, translation.y, translation.z
+    return m
+
+
+def _mount(parents, frame, base_frame, odom_frame):
+    """The sensor frame's pose on the robot as a 4 x 4 matrix, and the robot's frame: up the
+    transforms (parents: child -> (parent, matrix)) from `frame` to base_frame when given, else to
+    the frame whose parent is odom_frame (the one odometry moves), else to the top. None when
+    base_frame is given and not above `frame`."""
+    m, f = np.eye(4), frame
+    for _ in range(32):
+        if f == base_frame or f not in parents or (base_frame is None and parents[f][0] == odom_frame):
+            break
+        parent, t = parents[f]
+        m, f = t @ m, parent
+    if base_frame is not None and f != base_frame:
+        return None, f
+    return m, f
+
+
+def _mount_resolved(parents, frame, base_frame, odom_frame):
+    m, f = _mount(parents, frame, base_frame, odom_frame)
+    return m is not None and (f == base_frame or (f in parents and parents[f][0] == odom_frame))
+
+
+def bag_scan_topics(path):
+    """The bag's sensor_msgs/LaserScan topics."""
+    import rosbag
+    with rosbag.Bag(path) as bag:
+        topics = bag.get_type_and_topic_info().topics
+    return sorted(t for t, info in topics.items() if info.msg_type == 'sensor_msgs/LaserScan')
+
+
+def read_bag_scans(path, topics, stamps, base_frame=None, odom_frame='odom'):
+    """The scan of each topic nearest (by header stamp) to each of `stamps`, as end points on the
+    robot: a list of dicts t (stamp), topic, xy ((N, 2) end points in the robot's frame: valid
+    ranges, range_min <= r < range_max, through the laser's mounting from /tf_static or /tf), base
+    (the robot's frame). The mounting is read up the transforms from the scan's frame to the
+    robot's (base_frame, or the frame odometry moves: the child of odom_frame); a frame with no
+    transform up from it is taken as the robot's own. Returns (scans, warnings)."""
+    import rosbag
+    stamps = np.sort(np.asarray(stamps, dtype=float))
+    best = {}  # (topic, k) -> (|dt|, message)
+    with rosbag.Bag(path) as bag:
+        for topic, msg, _ in bag.read_messages(topics=list(topics)):
+            if not hasattr(msg, 'ranges') or len(stamps) == 0:
+                continue
+            t = msg.header.stamp.to_sec()
+            k = int(np.clip(np.searchsorted(stamps, t), 1, len(stamps) - 1)) if len(stamps) > 1 else 0
+            if k > 0 and abs(stamps[k - 1] - t) <= abs(stamps[k] - t):
+                k -= 1
+            dt = abs(stamps[k] - t)
+            if (topic, k) not in best or dt < best[(topic, k)][0]:
+                best[(topic, k)] = (dt, msg)
+        frames = {m.header.frame_id.lstrip('/') for _, m in best.values()}
+        parents = {}
+        for tf_topic in ('/tf_static', '/tf'):
+            if all(_mount_resolved(parents, f, base_frame, odom_frame) for f in frames):
+                break
+            for _, msg, _ in bag.read_messages(topics=[tf_topic]):
+                added = False
+                for tr in getattr(msg, 'transforms', []):
+                    child, parent = tr.child_frame_id.lstrip('/'), tr.header.frame_id.lstrip('/')
+                    if child and parent and child not in parents:
+                        parents[child] = (parent, _matrix(tr.transform.translation, tr.transform.rotation))
+                        added = True
+                if added and all(_mount_resolved(parents, f, base_frame, odom_frame) for f in frames):
+                    break
+    scans, warnings = [], []
+    for (topic, k), (_, msg) in sorted(best.items(), key=lambda kv: (kv[0][1], kv[0][0])):
+        frame = msg.header.frame_id.lstrip('/')
+        mount, base = _mount(parents, frame, base_frame, odom_frame)
+        if mount is None:
+            warning = 'no transform from %s to %s in the bag: %s drawn at the robot\'s origin' % (
+                base_frame, frame, topic)
+            if warning not in warnings:
+                warnings.append(warning)
+            mount, base = np.eye(4), base_frame
+        r = np.asarray(msg.ranges, dtype=float)
+        a = msg.angle_min + msg.angle_increment * np.arange(len(r))
+        ok = np.isfinite(r) & (r >= msg.range_min) & (r < msg.range_max)
+        pts = np.c_[r[ok] * np.cos(a[ok]), r[ok] * np.sin(a[ok]), np.zeros(ok.sum()), np.ones(ok.sum())]
+        xy = (mount @ pts.T).T[:, :2]
+        scans.append({'t': msg.header.stamp.to_sec(), 'topic': topic, 'xy': xy, 'base': base})
+    return scans, warnings
 
 
 def read_update_log(path):
@@ -605,6 +705,111 @@ def missing_sensors(log):
     return out
 
 
+# What the filter itself knows (no reference needed): the beams that fit the map at the estimate,
+# the verdict, the covariance's size, the map's changes.
+STATES = ('localized', 'uncertain', 'lost')
+STATE_COLOURS = {'localized': 'tab:green', 'uncertain': 'tab:orange', 'lost': 'tab:red'}
+# The verdict's default fit thresholds (confidence_localized_hit_fraction, confidence_lost_hit_fraction):
+# drawn on the fit plot as guides; the verdict itself is the runner's.
+FIT_LOCALIZED = 0.75
+FIT_LOST = 0.5
+
+
+def _stats(v):
+    v = np.asarray(v, dtype=float)
+    v = v[np.isfinite(v)]
+    if not len(v):
+        return None
+    return {'mean': float(v.mean()), 'median': float(np.median(v)), 'p5': float(np.percentile(v, 5)),
+            'p95': float(np.percentile(v, 95)), 'min': float(v.min()), 'max': float(v.max()),
+            'last': float(v[-1])}
+
+
+def verdict_stretches(t, states, t_end=None):
+    """The verdict's runs over time: [[state, from, to], ...] with from the first update of the run
+    and to the first of the next (the last run's: t_end, or its last update)."""
+    out = []
+    for k, (tk, st) in enumerate(zip(t, states)):
+        if out and out[-1][0] == st:
+            continue
+        if out:
+            out[-1][2] = float(tk)
+        out.append([str(st), float(tk), float(tk)])
+    if out:
+        out[-1][2] = float(max(t[-1], t_end if t_end is not None else t[-1]))
+    return out
+
+
+def verdict_judgement(v):
+    """One line on the verdict's timeline (the summary's "verdict" dict)."""
+    n = v['updates']
+    if v['localized_throughout']:
+        return 'localized throughout (all %d updates)' % n
+    if v['localized_from_s'] is not None:
+        return 'localized from %.1f s to the end (the last %d of %d updates)' % (
+            v['localized_from_s'], v['localized_final_updates'], n)
+    if v['first_localized_s'] is None:
+        return 'never localized (%d updates)' % n
+    return 'not localized at the end: %s since %.1f s (localized first at %.1f s)' % (
+        v['final_state'], v['stretches_s'][-1][1], v['first_localized_s'])
+
+
+def covariance_size(log=None, cov=None):
+    """The covariance's size over time: (t, position std (m), yaw std (rad)), from the published
+    covariance (cov rows) when given: the larger semi-axis of the 1-sigma position ellipse; else
+    from the update log's estimate: the larger of std_x and std_y. None when neither has it."""
+    if cov is not None and len(cov):
+        xx, xy, yy = cov[:, 1], cov[:, 2], cov[:, 3]
+        major = 0.5 * (xx + yy) + np.sqrt(np.maximum(0.25 * (xx - yy) ** 2 + xy * xy, 0.0))
+        return cov[:, 0], np.sqrt(np.maximum(major, 0.0)), np.sqrt(np.maximum(cov[:, 4], 0.0)), \
+            'published covariance (pf_pose)'
+    if log is not None and 'std_x' in log and 'std_y' in log:
+        yaw = log['std_yaw'] if 'std_yaw' in log else np.full(len(log['t']), np.nan)
+        return log['t'], np.maximum(log['std_x'], log['std_y']), yaw, 'the estimate (update log)'
+    return None
+
+
+def self_assessment(log, t0, t_end=None, cov=None):
+    """What the filter says of itself over the run, from the runner's update log: the share of the
+    beams that fit the map at the estimate (hit_fraction), the verdict (state) over time, the
+    covariance's size (covariance_size), the share of the beams that saw a change of the map.
+    Times relative to t0. Empty when the log has none of them."""
+    t = log['t'] - t0
+    out = {'updates': int(len(t))}
+    if 'hit_fraction' in log:
+        fit = log['hit_fraction']
+        out['fit'] = _stats(fit)
+        if out['fit'] is not None:
+            ok = np.isfinite(fit)
+            out['fit'].update(below_localized_share=float(np.mean(fit[ok] < FIT_LOCALIZED)),
+                              below_lost_share=float(np.mean(fit[ok] < FIT_LOST)),
+                              localized_guide=FIT_LOCALIZED, lost_guide=FIT_LOST)
+    if 'state' in log and len(t):
+        states = log['state']
+        stretches = verdict_stretches(t, states, None if t_end is None else t_end - t0)
+        loc = states == 'localized'
+        final = stretches[-1]
+        v = {'updates': int(len(t)),
+             'shares': {s: float(np.mean(states == s)) for s in STATES},
+             'first_localized_s': float(t[np.argmax(loc)]) if loc.any() else None,
+             'localized_from_s': final[1] if final[0] == 'localized' else None,
+             'localized_final_updates': int(len(t) - np.flatnonzero(~loc)[-1] - 1) if (~loc).any()
+             else int(len(t)),
+             'localized_throughout': bool(loc.all()),
+             'left_localized': int(np.sum(loc[:-1] & ~loc[1:])),
+             'final_state': final[0], 'stretches_s': stretches}
+        v['judgement'] = verdict_judgement(v)
+        out['verdict'] = v
+    size = covariance_size(log, cov)
+    if size is not None:
+        _, pos, yaw, source = size
+        out['covariance_size'] = {'source': source, 'position_std_m': _stats(pos),
+                                  'yaw_std_deg': _stats(np.degrees(yaw))}
+    if 'map_changed_share' in log:
+        out['map_changed_beams'] = _stats(log['map_changed_share'])
+    return out
+
+
 # -------------------------------------------------------------------------------------- plots
 def _relative(t, t0):
     """Times relative to the reference start; a log on another clock is made relative to itself."""
@@ -636,15 +841,32 @@ def _show_map(ax, the_map, xs, ys, margin_frac=0.1, min_margin=0.5):
     ax.set_ylabel('y (m, map frame)')
 
 
-def plot_trajectory(path, est, ref, the_map, title):
+def plot_trajectory(path, est, ref, the_map, title, log=None):
+    """The estimate over the map, with the reference when there is one; without one, the estimate at
+    each update coloured by the verdict (the log's state)."""
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(8, 7))
-    _show_map(ax, the_map, np.r_[est[:, 1], ref[:, 1]], np.r_[est[:, 2], ref[:, 2]])
-    r, e = _break_gaps(ref), _break_gaps(est)
-    ax.plot(r[:, 1], r[:, 2], '-', color='tab:green', lw=1.6, label='reference')
-    ax.plot(e[:, 1], e[:, 2], '-', color='tab:red', lw=1.0, alpha=0.85, label='estimate')
-    ax.plot(ref[0, 1], ref[0, 2], 'o', color='tab:green', ms=7, label='reference start')
-    ax.plot(est[0, 1], est[0, 2], 'x', color='tab:red', ms=8, mew=2, label='estimate start')
+    has_ref = ref is not None and len(ref) > 0
+    both = np.r_[est, ref] if has_ref else est
+    # Without a reference, a wider view: the walls around the track are what a reader checks it by.
+    _show_map(ax, the_map, both[:, 1], both[:, 2], min_margin=0.5 if has_ref else 2.0)
+    e = _break_gaps(est)
+    if has_ref:
+        r = _break_gaps(ref)
+        ax.plot(r[:, 1], r[:, 2], '-', color='tab:green', lw=1.6, label='reference')
+        ax.plot(e[:, 1], e[:, 2], '-', color='tab:red', lw=1.0, alpha=0.85, label='estimate')
+        ax.plot(ref[0, 1], ref[0, 2], 'o', color='tab:green', ms=7, label='reference start')
+        ax.plot(est[0, 1], est[0, 2], 'x', color='tab:red', ms=8, mew=2, label='estimate start')
+    else:
+        ax.plot(e[:, 1], e[:, 2], '-', color='tab:blue', lw=1.0, alpha=0.85, label='estimate')
+        ax.plot(est[0, 1], est[0, 2], 'x', color='tab:blue', ms=8, mew=2, label='estimate start')
+        if log is not None and 'state' in log:
+            poses, kind = associate(est, log['t'])
+            for st in STATES:
+                on = (log['state'] == st) & (kind > 0)
+                if on.any():
+                    ax.plot(poses[on, 0], poses[on, 1], 'o', color=STATE_COLOURS[st], ms=3.5,
+                            label='update: %s (%d)' % (st, on.sum()))
     ax.set_title(title)
     ax.legend(loc='best', fontsize=8, framealpha=0.85)
     fig.tight_layout()
@@ -712,7 +934,11 @@ def plot_nees(path, c, samples, title):
     plt.close(fig)
 
 
-def plot_spread(path, log, t0, title):
+TIME_SINCE_REFERENCE = 'time since first reference pose (s)'
+TIME_SINCE_ESTIMATE = 'time since the first estimate (s)'
+
+
+def plot_spread(path, log, t0, title, xlabel=TIME_SINCE_REFERENCE):
     import matplotlib.pyplot as plt
     t = _relative(log['t'], t0)
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(9, 6), sharex=True)
@@ -733,7 +959,7 @@ def plot_spread(path, log, t0, title):
         else:
             a.text(0.5, 0.5, 'not in log', transform=a.transAxes, ha='center')
     a1.set_title('%s: particle spread' % title)
-    a2.set_xlabel('time since first reference pose (s)')
+    a2.set_xlabel(xlabel)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -762,6 +988,138 @@ def plot_changes(path, the_map, changes, mask, title):
                  % ('; the truth light' if mask is not None else ''), fontsize=9)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def plot_fit(path, log, t0, title, cov=None, xlabel=TIME_SINCE_ESTIMATE):
+    """What the filter knows over time: the share of the beams that fit the map at the estimate
+    (and of those that saw a change of the map), the verdict, the covariance's size."""
+    import matplotlib.pyplot as plt
+    t = _relative(log['t'], t0)
+    fig, (a1, a2, a3) = plt.subplots(3, 1, figsize=(9, 7.5), sharex=True,
+                                     gridspec_kw={'height_ratios': [3, 0.7, 2.2]})
+    if 'hit_fraction' in log:
+        a1.plot(t, log['hit_fraction'], '.-', color='tab:blue', ms=3, lw=0.8,
+                label='beams that fit the map at the estimate')
+    if 'map_changed_share' in log and np.nanmax(log['map_changed_share'], initial=0.0) > 0:
+        a1.plot(t, log['map_changed_share'], '-', color='tab:grey', lw=0.8,
+                label='beams that saw a change of the map')
+    a1.axhline(FIT_LOCALIZED, color='tab:green', ls='--', lw=1, label='%.0f %% (localized, default)'
+               % (100 * FIT_LOCALIZED))
+    a1.axhline(FIT_LOST, color='tab:red', ls='--', lw=1, label='%.0f %% (lost, default)' % (100 * FIT_LOST))
+    a1.set_ylim(-0.02, 1.05)
+    a1.set_ylabel('share of the beams')
+    a1.legend(loc='lower left', fontsize=8, framealpha=0.85)
+    a1.set_title('%s: what the filter knows (no reference needed)' % title)
+    if 'state' in log and len(t):
+        for st, t_from, t_to in verdict_stretches(t, log['state']):
+            a2.broken_barh([(t_from, max(t_to - t_from, 1e-3))], (0, 1), color=STATE_COLOURS.get(st, 'grey'))
+        from matplotlib.patches import Patch
+        a2.plot(t, np.full(len(t), 0.5), '|', color='k', ms=6, alpha=0.4)
+        a2.legend(handles=[Patch(color=STATE_COLOURS[st], label='%s %.0f %%' % (st, 100 * np.mean(log['state'] == st)))
+                           for st in STATES], loc='center left', bbox_to_anchor=(1.0, 0.5), fontsize=7,
+                  frameon=False, title='of the updates', title_fontsize=7)
+    a2.set_yticks([])
+    a2.set_ylabel('verdict', rotation=0, ha='right', va='center')
+    size = covariance_size(log, cov)
+    if size is not None:
+        ct, pos, yaw, source = size
+        ct = ct - (log['t'][0] - t[0]) if len(t) else _relative(ct, t0)  # on the log's time axis
+        h = a3.plot(ct, pos, '-', color='tab:purple', lw=1, label='position std (m)')
+        a3.set_ylabel('position std (m)')
+        v = pos[np.isfinite(pos) & (pos > 0)]
+        if len(v) and v.max() / v.min() > 30:
+            a3.set_yscale('log')
+        b = a3.twinx()
+        h += b.plot(ct, np.degrees(yaw), '-', color='tab:orange', lw=1, label='yaw std (deg)')
+        b.set_ylabel('yaw std (deg)')
+        b.set_ylim(bottom=0)
+        a3.legend(handles=h, loc='upper right', fontsize=8, title='1-sigma, %s' % source, title_fontsize=8)
+    else:
+        a3.text(0.5, 0.5, 'no covariance in the log', transform=a3.transAxes, ha='center')
+    a3.set_xlabel(xlabel)
+    for a in (a1, a3):
+        a.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def scan_moments(est, log, count=5):
+    """The moments whose scans plot_scans draws: `count` updates evenly over the run and the one
+    where the fewest beams fit (if another); without a log, `count` estimates. Dicts t, label,
+    fit, state."""
+    if log is not None and len(log['t']):
+        t = log['t']
+        idx = list(np.unique(np.linspace(0, len(t) - 1, min(count, len(t))).round().astype(int)))
+        fit = log.get('hit_fraction')
+        worst = None
+        if fit is not None and np.isfinite(fit).any():
+            worst = int(np.nanargmin(fit))
+            if worst not in idx:
+                idx.append(worst)
+        return [{'t': float(t[k]), 'label': 'fewest fit' if k == worst else '',
+                 'fit': None if fit is None else float(fit[k]),
+                 'state': str(log['state'][k]) if 'state' in log else None} for k in sorted(idx)]
+    idx = np.unique(np.linspace(0, len(est) - 1, min(count, len(est))).round().astype(int))
+    return [{'t': float(est[k, 0]), 'label': '', 'fit': None, 'state': None} for k in idx]
+
+
+def plot_scans(path, the_map, est, scans, moments, t0, title):
+    """The scans' end points placed at the estimate on the map at a few moments: on the walls when
+    the estimate is right."""
+    import matplotlib.pyplot as plt
+    n = len(moments)
+    cols = min(3, n)
+    rows = (n + cols - 1) // cols
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.3 * rows + 0.5), squeeze=False)
+    colours = ['tab:red', 'tab:blue', 'tab:purple', 'tab:brown']
+    topics = sorted({s['topic'] for s in scans})
+    for ax, mo in zip(axes.flat, moments):
+        pose, kind = associate(est, np.array([mo['t']]))
+        mine = [s for s in scans if abs(s['t'] - mo['t']) < 0.5]
+        if kind[0] == 0 or not mine:
+            ax.text(0.5, 0.5, 'no estimate or scan at %.1f s' % (mo['t'] - t0), transform=ax.transAxes,
+                    ha='center')
+            ax.set_axis_off()
+            continue
+        x, y, yaw = pose[0]
+        c, s_ = np.cos(yaw), np.sin(yaw)
+        pts = []
+        for sc in mine:
+            xy = sc['xy']
+            w = np.c_[x + c * xy[:, 0] - s_ * xy[:, 1], y + s_ * xy[:, 0] + c * xy[:, 1]]
+            pts.append((sc['topic'], w))
+        allp = np.vstack([w for _, w in pts] + [np.array([[x, y]])])
+        d = np.hypot(allp[:, 0] - x, allp[:, 1] - y)
+        half = float(np.clip(np.percentile(d, 95) if len(d) > 1 else 3.0, 2.0, 12.0)) * 1.05
+        _show_map(ax, the_map, [x - half, x + half], [y - half, y + half], margin_frac=0.0, min_margin=0.0)
+        for topic, w in pts:
+            ax.plot(w[:, 0], w[:, 1], '.', color=colours[topics.index(topic) % len(colours)], ms=2.5,
+                    label=topic if len(topics) > 1 else 'scan end points')
+        ax.arrow(x, y, 0.6 * c, 0.6 * s_, width=0.06, color='tab:green', length_includes_head=True, zorder=5)
+        ax.plot(x, y, 'o', color='tab:green', ms=5, zorder=5)
+        head = 't=%.1f s' % (mo['t'] - t0)
+        if mo['fit'] is not None:
+            head += ', %.0f %% fit' % (100 * mo['fit'])
+        if mo['state']:
+            head += ', %s' % mo['state']
+        if mo['label']:
+            head += ' (%s)' % mo['label']
+        ax.set_title(head, fontsize=9, color=STATE_COLOURS.get(mo['state'], 'k'))
+        ax.tick_params(labelsize=7)
+        ax.xaxis.label.set_size(8)
+        ax.yaxis.label.set_size(8)
+    for ax in list(axes.flat)[n:]:
+        ax.set_axis_off()
+    handles, labels = axes.flat[0].get_legend_handles_labels()
+    fig.suptitle('%s: the scans at the estimate (on the walls when it is right; green: the robot)' % title,
+                 fontsize=10)
+    if handles:
+        fig.legend(handles, labels, loc='lower center', ncol=len(handles), fontsize=8, markerscale=3,
+                   frameon=False)
+    fig.tight_layout(rect=(0, 0.03, 1, 0.97))
+    fig.savefig(path, dpi=100)
     plt.close(fig)
 
 
@@ -796,7 +1154,7 @@ def _plot_cpu_times(ax, t, c):
     return handles
 
 
-def plot_cpu(path, log, t0, title):
+def plot_cpu(path, log, t0, title, xlabel=TIME_SINCE_REFERENCE):
     import matplotlib.pyplot as plt
     t = _relative(log['t'], t0)
     fig, ax = plt.subplots(figsize=(9, 4.5))
@@ -804,7 +1162,7 @@ def plot_cpu(path, log, t0, title):
     if 'cpu_ms' in log:
         handles += _plot_cpu_times(ax, t, log['cpu_ms'])
     ax.set_ylabel('CPU time per update (ms)')
-    ax.set_xlabel('time since first reference pose (s)')
+    ax.set_xlabel(xlabel)
     ax.grid(alpha=0.3)
     if 'particles' in log:
         a2 = ax.twinx()
@@ -848,8 +1206,9 @@ def make_particle_gif(path, parts, est, ref, the_map, seconds, title, max_frames
     cloud = ax.scatter([], [], s=2.5, c='tab:blue', alpha=0.6, lw=0, label='particles')
     ref_dot, = ax.plot([], [], 'o', color='tab:green', ms=5, label='reference')
     est_dot, = ax.plot([], [], 'x', color='tab:red', ms=6, mew=2, label='estimate')
+    handles = [cloud, ref_dot, est_dot] if len(ref) else [cloud, est_dot]
     # Below the axes: inside, wherever it went, the cloud passes under it sooner or later.
-    fig.legend(handles=[cloud, ref_dot, est_dot], loc='lower center', ncol=3, fontsize=6, markerscale=1.5,
+    fig.legend(handles=handles, loc='lower center', ncol=len(handles), fontsize=6, markerscale=1.5,
                frameon=False)
     head = ax.set_title('', fontsize=8)
 
@@ -903,13 +1262,55 @@ def parse_args(argv):
     p.add_argument('--gif-seconds', type=float, default=30.0, help='length of the particle GIF (s)')
     p.add_argument('--title', help='name used in plot titles (default: the recording\'s name: the --bag '
                                    'or --ref file\'s, without its extension)')
+    p.add_argument('--scan-topic', action='append', help="LaserScan topic of --bag whose scans are drawn at the "
+                   'estimate (scans.png; once per lidar; default: /scan, else the bag\'s first LaserScan topic)')
+    p.add_argument('--base-frame', help="the robot's frame the laser's mounting is read up to (default: the frame "
+                   'odometry moves, the child of --odom-frame)')
+    p.add_argument('--odom-frame', default='odom', help='the odometry frame (default: odom)')
     p.add_argument('--no-plots', action='store_true', help='only write summary.json')
     return p.parse_args(argv)
 
 
+def reference_or_none(args):
+    """The reference trajectory, or None (with the reason) when --bag has none on --ref-topic."""
+    if args.ref:
+        return read_tum(args.ref, 'reference'), None
+    try:
+        return read_bag_reference(args.bag, args.ref_topic), None
+    except NoReference:
+        import rosbag
+        with rosbag.Bag(args.bag) as bag:
+            topics = sorted(bag.get_type_and_topic_info().topics)
+        return None, 'the bag has no %s; its topics: %s' % (args.ref_topic, ', '.join(topics))
+
+
+def draw_scans(args, out, est, log, the_map, t0, title, m):
+    """scans.png: the scans of --bag at the estimate at a few moments (scan_moments). Returns whether
+    it was drawn; what kept it from being drawn, or a mounting not found, goes to m['scans']."""
+    try:
+        topics = args.scan_topic or [t for t in bag_scan_topics(args.bag) if t == '/scan'] or \
+            bag_scan_topics(args.bag)[:1]
+    except ImportError:
+        m['scans'] = {'drawn': False, 'why': 'cannot import rosbag (run with /usr/bin/python3)'}
+        return False
+    if not topics:
+        m['scans'] = {'drawn': False, 'why': 'no sensor_msgs/LaserScan topic in the bag'}
+        return False
+    moments = scan_moments(est, log)
+    scans, warnings = read_bag_scans(args.bag, topics, [mo['t'] for mo in moments], args.base_frame,
+                                     args.odom_frame)
+    m['scans'] = {'drawn': bool(scans), 'topics': topics, 'moments_s': [mo['t'] - t0 for mo in moments],
+                  'robot_frame': sorted({s['base'] for s in scans if s['base']}), 'warnings': warnings}
+    if not scans:
+        m['scans']['why'] = 'no scan on %s' % ', '.join(topics)
+        return False
+    plot_scans(os.path.join(out, 'scans.png'), the_map, est, scans, moments, t0, title)
+    return True
+
+
 def run(args):
     est = read_tum(args.traj)
-    ref = read_bag_reference(args.bag, args.ref_topic) if args.bag else read_tum(args.ref, 'reference')
+    ref, no_ref = reference_or_none(args)
     the_map = read_map(args.map) if args.map else None
     log = read_update_log(args.log) if args.log else None
     parts = read_particles(args.particles) if args.particles else None
@@ -925,17 +1326,33 @@ def run(args):
     os.makedirs(out, exist_ok=True)
     title = args.title or os.path.splitext(os.path.basename(args.bag or args.ref))[0]
 
-    m, match = evaluate(est, ref, args.max_gap, args.lost, not args.hold)
+    if ref is not None:
+        m, match = evaluate(est, ref, args.max_gap, args.lost, not args.hold)
+        t0, xlabel = match['t0'], TIME_SINCE_REFERENCE
+    else:
+        # No reference: what the filter itself knows, on the estimates' time.
+        m, match = {'n_estimates': int(len(est)), 'duration_s': float(est[-1, 0] - est[0, 0])}, None
+        t0, xlabel = float(est[0, 0]), TIME_SINCE_ESTIMATE
+        m['reference'] = {'none': no_ref}
+    m['has_reference'] = ref is not None
     if log is not None:
         m.update(log_metrics(log))
-        count, times = confidently_wrong(log, match, args.max_gap)
-        if count is not None:
-            m.update(confidently_wrong_updates=count, confidently_wrong_times_s=times,
-                     confidently_wrong_threshold_m=WRONG_M)
-    if cov is not None:
+        m['self_assessment'] = self_assessment(log, t0, est[-1, 0], cov)
+        if match is not None:
+            count, times = confidently_wrong(log, match, args.max_gap)
+            if count is not None:
+                m.update(confidently_wrong_updates=count, confidently_wrong_times_s=times,
+                         confidently_wrong_threshold_m=WRONG_M)
+    cov_samples = None
+    if cov is not None and match is not None:
         m['covariance'], cov_samples = covariance_metrics(cov, match, args.max_gap, args.ref_std,
                                                           args.cov_aligned)
-    if hyp is not None:
+    elif cov is not None:
+        m.setdefault('self_assessment', {'updates': 0})
+        _, pos, yaw, source = covariance_size(cov=cov)
+        m['self_assessment']['covariance_size'] = {'source': source, 'position_std_m': _stats(pos),
+                                                   'yaw_std_deg': _stats(np.degrees(yaw))}
+    if hyp is not None and ref is not None:
         m['hypotheses'] = hypotheses_metrics(hyp, ref, args.max_gap, not args.hold)
     if changes is not None:
         m['map_changes'] = change_metrics(changes, mask)
@@ -947,21 +1364,28 @@ def run(args):
     if not args.no_plots:
         import matplotlib
         matplotlib.use('Agg')
-        plot_trajectory(os.path.join(out, 'trajectory.png'), est, ref, the_map, title + ': trajectory')
-        plot_errors(os.path.join(out, 'error.png'), m, match, title)
-        plots += ['trajectory.png', 'error.png']
+        plot_trajectory(os.path.join(out, 'trajectory.png'), est, ref, the_map,
+                        title + (': trajectory' if ref is not None else ': track (no reference)'), log)
+        plots.append('trajectory.png')
+        if match is not None:
+            plot_errors(os.path.join(out, 'error.png'), m, match, title)
+            plots.append('error.png')
         if log is not None:
-            plot_spread(os.path.join(out, 'spread.png'), log, match['t0'], title)
-            plot_cpu(os.path.join(out, 'cpu.png'), log, match['t0'], title)
-            plots += ['spread.png', 'cpu.png']
-        if cov is not None:
+            plot_fit(os.path.join(out, 'fit.png'), log, t0, title, cov, xlabel)
+            plot_spread(os.path.join(out, 'spread.png'), log, t0, title, xlabel)
+            plot_cpu(os.path.join(out, 'cpu.png'), log, t0, title, xlabel)
+            plots += ['fit.png', 'spread.png', 'cpu.png']
+        if args.bag and the_map is not None and draw_scans(args, out, est, log, the_map, t0, title, m):
+            plots.append('scans.png')
+        if cov_samples is not None:
             plot_nees(os.path.join(out, 'nees.png'), m['covariance'], cov_samples, title)
             plots.append('nees.png')
         if changes is not None and the_map is not None:
             plot_changes(os.path.join(out, 'changes.png'), the_map, changes, mask, title)
             plots.append('changes.png')
         if parts is not None:
-            m['gif_frames'] = make_particle_gif(os.path.join(out, 'particles.gif'), parts, est, ref, the_map,
+            m['gif_frames'] = make_particle_gif(os.path.join(out, 'particles.gif'), parts, est,
+                                                ref if ref is not None else np.zeros((0, 4)), the_map,
                                                 args.gif_seconds, title)
             plots.append('particles.gif')
     m['plots'] = plots
@@ -973,6 +1397,35 @@ def run(args):
 
 
 def describe(m, summary):
+    if m.get('has_reference', True):
+        lines = describe_reference(m)
+    else:
+        lines = ['pf_evaluate: no reference (%s): the report says what the filter itself knows'
+                 % m['reference']['none'],
+                 '  track:          %d poses over %.1f s' % (m['n_estimates'], m['duration_s'])]
+    lines += describe_self(m.get('self_assessment') or {})
+    if 'covariance' in m:
+        lines.append(describe_covariance(m['covariance']))
+    if 'hypotheses' in m:
+        lines.append(describe_hypotheses(m['hypotheses']))
+    if 'map_changes' in m:
+        lines.append(describe_changes(m['map_changes']))
+    for name, v in m.get('sensors_missing', {}).items():
+        lines.append('  sensor missing: %s in %.0f %% of the updates (%s s)' % (
+            name, 100 * v['share'], ', '.join('%.1f-%.1f' % tuple(x) for x in v['stretches_s'])))
+    if 'cpu_ms_mean' in m:
+        lines.append('  update CPU:     mean %.2f ms  p95 %.2f ms  (%d log rows)'
+                     % (m['cpu_ms_mean'], m['cpu_ms_p95'], m['n_log_rows']))
+    for w in m.get('scans', {}).get('warnings', []):
+        lines.append('  scans:          %s' % w)
+    if m.get('scans') and not m['scans']['drawn']:
+        lines.append('  scans:          not drawn: %s' % m['scans'].get('why', '?'))
+    lines.append('  report: %s' % summary + (' (+ %s)' % ', '.join(m['plots']) if m['plots'] else ''))
+    return '\n'.join(lines)
+
+
+def describe_reference(m):
+    """The text summary's lines on the error against the reference."""
     conv = m['convergence_time_s']
     lines = [
         'pf_evaluate: %d/%d reference poses matched (coverage %.1f %%: %d exact, %d interpolated, %d held)'
@@ -993,20 +1446,43 @@ def describe(m, summary):
     if 'confidently_wrong_updates' in m:
         lines.append('  confidently wrong: %d updates "localized" while more than %.0f m off'
                      % (m['confidently_wrong_updates'], m['confidently_wrong_threshold_m']))
-    if 'covariance' in m:
-        lines.append(describe_covariance(m['covariance']))
-    if 'hypotheses' in m:
-        lines.append(describe_hypotheses(m['hypotheses']))
-    if 'map_changes' in m:
-        lines.append(describe_changes(m['map_changes']))
-    for name, v in m.get('sensors_missing', {}).items():
-        lines.append('  sensor missing: %s in %.0f %% of the updates (%s s)' % (
-            name, 100 * v['share'], ', '.join('%.1f-%.1f' % tuple(x) for x in v['stretches_s'])))
-    if 'cpu_ms_mean' in m:
-        lines.append('  update CPU:     mean %.2f ms  p95 %.2f ms  (%d log rows)'
-                     % (m['cpu_ms_mean'], m['cpu_ms_p95'], m['n_log_rows']))
-    lines.append('  report: %s' % summary + (' (+ %s)' % ', '.join(m['plots']) if m['plots'] else ''))
-    return '\n'.join(lines)
+    return lines
+
+
+def describe_self(a):
+    """The text summary's lines on what the filter says of itself (self_assessment)."""
+    lines = []
+    pct = lambda v: '%.1f %%' % (100 * v)
+    f = a.get('fit')
+    if f:
+        lines.append('  beams fit:      mean %s  median %s  p5 %s  min %s of the beams at the estimate; '
+                     'below %.0f %% in %s of the updates, below %.0f %% in %s'
+                     % (pct(f['mean']), pct(f['median']), pct(f['p5']), pct(f['min']),
+                        100 * f['localized_guide'], pct(f['below_localized_share']), 100 * f['lost_guide'],
+                        pct(f['below_lost_share'])))
+    v = a.get('verdict')
+    if v:
+        sh = v['shares']
+        lines.append('  verdict:        %s; localized in %s of %d updates, uncertain %s, lost %s'
+                     % (v['judgement'], pct(sh['localized']), v['updates'], pct(sh['uncertain']),
+                        pct(sh['lost'])))
+        runs = v['stretches_s']
+        text = ', '.join('%s %.1f-%.1f s' % tuple(r) for r in runs[:8])
+        if len(runs) > 8:
+            text += ', ... (%d stretches; the last: %s %.1f-%.1f s)' % ((len(runs),) + tuple(runs[-1]))
+        lines.append('  timeline:       %s' % text)
+    c = a.get('covariance_size')
+    if c and c['position_std_m']:
+        p, y = c['position_std_m'], c['yaw_std_deg']
+        lines.append('  covariance:     1-sigma position median %.3f m, p95 %.3f, max %.3f, last %.3f m; '
+                     'yaw median %.2f deg, max %.2f deg (%s)'
+                     % (p['median'], p['p95'], p['max'], p['last'], y['median'] if y else float('nan'),
+                        y['max'] if y else float('nan'), c['source']))
+    ch = a.get('map_changed_beams')
+    if ch and ch['max'] > 0:
+        lines.append('  beams on map changes: mean %s, max %s of the beams per update'
+                     % (pct(ch['mean']), pct(ch['max'])))
+    return lines
 
 
 def describe_hypotheses(h):
