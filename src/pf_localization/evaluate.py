@@ -726,15 +726,16 @@ def _stats(v):
 
 
 def verdict_stretches(t, states, t_end=None):
-    """The verdict's runs over time: [[state, from, to], ...] with from the first update of the run
-    and to the first of the next (the last run's: t_end, or its last update)."""
+    """The verdict's runs over time: [[state, from, to, updates], ...] with from the first update of
+    the run and to the first of the next (the last run's: t_end, or its last update)."""
     out = []
-    for k, (tk, st) in enumerate(zip(t, states)):
+    for tk, st in zip(t, states):
         if out and out[-1][0] == st:
+            out[-1][3] += 1
             continue
         if out:
             out[-1][2] = float(tk)
-        out.append([str(st), float(tk), float(tk)])
+        out.append([str(st), float(tk), float(tk), 1])
     if out:
         out[-1][2] = float(max(t[-1], t_end if t_end is not None else t[-1]))
     return out
@@ -742,16 +743,28 @@ def verdict_stretches(t, states, t_end=None):
 
 def verdict_judgement(v):
     """One line on the verdict's timeline (the summary's "verdict" dict)."""
-    n = v['updates']
+    n, runs = v['updates'], v['stretches_s']
     if v['localized_throughout']:
         return 'localized throughout (all %d updates)' % n
-    if v['localized_from_s'] is not None:
-        return 'localized from %.1f s to the end (the last %d of %d updates)' % (
-            v['localized_from_s'], v['localized_final_updates'], n)
     if v['first_localized_s'] is None:
         return 'never localized (%d updates)' % n
-    return 'not localized at the end: %s since %.1f s (localized first at %.1f s)' % (
-        v['final_state'], v['stretches_s'][-1][1], v['first_localized_s'])
+    if v['localized_from_s'] is None:
+        return 'not localized at the end: %s since %.1f s (localized first at %.1f s)' % (
+            runs[-1][0], runs[-1][1], v['first_localized_s'])
+    before = runs[:-1]
+    if not any(r[0] == 'localized' for r in before):
+        if n - v['localized_final_updates'] == 1:
+            return 'localized at every update but the first (%s), from %.1f s to the end' % (
+                before[0][0], v['localized_from_s'])
+        return 'localized from %.1f s to the end (the last %d of %d updates)' % (
+            v['localized_from_s'], v['localized_final_updates'], n)
+    out = [r for r in before if r[0] != 'localized']
+    return 'localized at the end (since %.1f s); before, %d stretch%s not localized: %s' % (
+        v['localized_from_s'], len(out), 'es' if len(out) > 1 else '',
+        ', '.join('%s %.1f s (%d update%s)' % (st, sum(r[2] - r[1] for r in out if r[0] == st),
+                                              sum(r[3] for r in out if r[0] == st),
+                                              '' if sum(r[3] for r in out if r[0] == st) == 1 else 's')
+                  for st in STATES if any(r[0] == st for r in out)))
 
 
 def covariance_size(log=None, cov=None):
@@ -1012,7 +1025,7 @@ def plot_fit(path, log, t0, title, cov=None, xlabel=TIME_SINCE_ESTIMATE):
     a1.legend(loc='lower left', fontsize=8, framealpha=0.85)
     a1.set_title('%s: what the filter knows (no reference needed)' % title)
     if 'state' in log and len(t):
-        for st, t_from, t_to in verdict_stretches(t, log['state']):
+        for st, t_from, t_to, _ in verdict_stretches(t, log['state']):
             a2.broken_barh([(t_from, max(t_to - t_from, 1e-3))], (0, 1), color=STATE_COLOURS.get(st, 'grey'))
         from matplotlib.patches import Patch
         a2.plot(t, np.full(len(t), 0.5), '|', color='k', ms=6, alpha=0.4)
@@ -1467,9 +1480,10 @@ def describe_self(a):
                      % (v['judgement'], pct(sh['localized']), v['updates'], pct(sh['uncertain']),
                         pct(sh['lost'])))
         runs = v['stretches_s']
-        text = ', '.join('%s %.1f-%.1f s' % tuple(r) for r in runs[:8])
+        one = lambda r: '%s %.1f-%.1f s (%d update%s)' % (tuple(r) + ('' if r[3] == 1 else 's',))
+        text = ', '.join(one(r) for r in runs[:8])
         if len(runs) > 8:
-            text += ', ... (%d stretches; the last: %s %.1f-%.1f s)' % ((len(runs),) + tuple(runs[-1]))
+            text += ', ... (%d stretches; the last: %s)' % (len(runs), one(runs[-1]))
         lines.append('  timeline:       %s' % text)
     c = a.get('covariance_size')
     if c and c['position_std_m']:
