@@ -1085,7 +1085,7 @@ def plot_scans(path, the_map, est, scans, moments, t0, title):
     n = len(moments)
     cols = min(3, n)
     rows = (n + cols - 1) // cols
-    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.3 * rows + 0.5), squeeze=False)
+    fig, axes = plt.subplots(rows, cols, figsize=(4.2 * cols, 4.7 * rows + 0.5), squeeze=False)
     colours = ['tab:red', 'tab:blue', 'tab:purple', 'tab:brown']
     topics = sorted({s['topic'] for s in scans})
     for ax, mo in zip(axes.flat, moments):
@@ -1488,7 +1488,7 @@ def describe_self(a):
     c = a.get('covariance_size')
     if c and c['position_std_m']:
         p, y = c['position_std_m'], c['yaw_std_deg']
-        lines.append('  covariance:     1-sigma position median %.3f m, p95 %.3f, max %.3f, last %.3f m; '
+        lines.append('  covariance size: 1-sigma position median %.3f m, p95 %.3f, max %.3f, last %.3f m; '
                      'yaw median %.2f deg, max %.2f deg (%s)'
                      % (p['median'], p['p95'], p['max'], p['last'], y['median'] if y else float('nan'),
                         y['max'] if y else float('nan'), c['source']))
