@@ -3,7 +3,10 @@
 usage: pf_evaluate --traj TRAJ.tum (--bag BAG | --ref REF.tum) [--map MAP.yaml]
                    [--log UPDATES.csv] [--particles PARTICLES.csv|.bin] [--out DIR]
                    [--cov COV.csv] [--ref-std 0] [--lost 0.3] [--max-gap 0.5] [--hold]
-                   [--gif-seconds 30] [--hypotheses HYP.csv]
+                   [--gif-seconds 30] [--hypotheses HYP.csv] [--scan-topic /scan]...
+
+A bag without the reference topic (most bags of a real robot) gets a report all the same, and exit
+status 0: in place of the error against a reference, what the filter itself knows (below).
 
 Inputs
   TRAJ.tum   the filter's estimates, one line per scan: t x y z qx qy qz qw (map frame).
@@ -40,11 +43,25 @@ Metrics (DIR/summary.json)
   1 m of it, over all of them and over those with several hypotheses (while ambiguous), and how
   many hypotheses there were.
 
-Plots (PNG): trajectory.png (map, estimate, reference), error.png (position and yaw error over
-time); with --log spread.png (particle std dev) and cpu.png (update CPU time, particle count);
+What the filter itself knows (DIR/summary.json's self_assessment, with a reference or without),
+  from --log: the share of the beams that fit the map at the estimate (the log's hit_fraction:
+  mean, median, p5, min, the shares below 75 and 50 %, the verdict's default thresholds); the
+  verdict (the log's state: localized / uncertain / lost) over time: its shares of the updates,
+  its stretches [state, from, to, updates], when it was localized from to the end, and one line
+  that says so; the covariance's size: the larger semi-axis of the 1-sigma position ellipse and
+  the yaw std of the published covariance (--cov), else the log's std_x, std_y, std_yaw; the share
+  of the beams that saw a change of the map (map_changed_share).
+
+Plots (PNG): trajectory.png (map, estimate, reference; without one, the estimate at each update
+coloured by its verdict), error.png (position and yaw error over time, with a reference); with
+--log fit.png (the beams that fit, the verdict, the covariance's size over time), spread.png
+(particle std dev) and cpu.png (update CPU time, particle count); with --bag and --map scans.png
+(the scans of --scan-topic placed at the estimate on the map at five moments and the one with the
+fewest beams fitting; the laser's mounting from the bag's /tf_static or /tf, up from the scan's
+frame to --base-frame or to the frame odometry moves, the child of --odom-frame);
 with --cov nees.png (d^2 over time against the 95 % bound);
 with --particles particles.gif (the cloud over the map for the first --gif-seconds).
-Exit status: 0 on success, 2 on bad input (missing file, no reference, nothing matched).
+Exit status: 0 on success, 2 on bad input (missing file, nothing matched).
 """
 import argparse
 import csv
@@ -170,6 +187,62 @@ def bag_scan_topics(path):
     return sorted(t for t, info in topics.items() if info.msg_type == 'sensor_msgs/LaserScan')
 
 
+def _nearest_scans(bag, topics, stamps):
+    """(topic, k) -> (|dt|, message): the scan of each topic whose header stamp is nearest to
+    stamps[k] (sorted). Read in a window of bag time around each stamp first (bag time is the
+    recording's, within a few ms of the header stamps of most bags), then over the whole bag for
+    those not found."""
+    import rospy
+    best = {}
+
+    def offer(topic, msg, ks):
+        if not hasattr(msg, 'ranges'):
+            return
+        t = msg.header.stamp.to_sec()
+        for k in ks:
+            dt = abs(stamps[k] - t)
+            if (topic, k) not in best or dt < best[(topic, k)][0]:
+                best[(topic, k)] = (dt, msg)
+
+    begin, end = bag.get_start_time(), bag.get_end_time()
+    for k, t in enumerate(stamps):
+        start, stop = (rospy.Time.from_sec(v)
+                       for v in (max(begin, t - SCAN_WINDOW_S), min(end, t + SCAN_WINDOW_S)))
+        for topic, msg, _ in bag.read_messages(topics=list(topics), start_time=start, end_time=stop):
+            offer(topic, msg, [k])
+    missing = [k for k in range(len(stamps)) if any((topic, k) not in best for topic in topics)]
+    if missing:
+        for topic, msg, _ in bag.read_messages(topics=list(topics)):
+            offer(topic, msg, missing)
+    return best
+
+
+def _read_parents(bag, frames, base_frame, odom_frame):
+    """child -> (parent, 4 x 4 matrix) from /tf_static, then /tf (its first MOUNT_SEARCH_S seconds:
+    a mounting on /tf is republished often), until every frame's mounting is resolved."""
+    import rospy
+    parents = {}
+    done = lambda: all(_mount_resolved(parents, f, base_frame, odom_frame) for f in frames)
+    tf_end = rospy.Time.from_sec(bag.get_start_time() + MOUNT_SEARCH_S)
+    for tf_topic, end in (('/tf_static', None), ('/tf', tf_end)):
+        if done():
+            break
+        for _, msg, _ in bag.read_messages(topics=[tf_topic], end_time=end):
+            added = False
+            for tr in getattr(msg, 'transforms', []):
+                child, parent = tr.child_frame_id.lstrip('/'), tr.header.frame_id.lstrip('/')
+                if child and parent and child not in parents:
+                    parents[child] = (parent, _matrix(tr.transform.translation, tr.transform.rotation))
+                    added = True
+            if added and done():
+                break
+    return parents
+
+
+SCAN_WINDOW_S = 2.0
+MOUNT_SEARCH_S = 60.0
+
+
 def read_bag_scans(path, topics, stamps, base_frame=None, odom_frame='odom'):
     """The scan of each topic nearest (by header stamp) to each of `stamps`, as end points on the
     robot: a list of dicts t (stamp), topic, xy ((N, 2) end points in the robot's frame: valid
@@ -179,32 +252,10 @@ def read_bag_scans(path, topics, stamps, base_frame=None, odom_frame='odom'):
     transform up from it is taken as the robot's own. Returns (scans, warnings)."""
     import rosbag
     stamps = np.sort(np.asarray(stamps, dtype=float))
-    best = {}  # (topic, k) -> (|dt|, message)
     with rosbag.Bag(path) as bag:
-        for topic, msg, _ in bag.read_messages(topics=list(topics)):
-            if not hasattr(msg, 'ranges') or len(stamps) == 0:
-                continue
-            t = msg.header.stamp.to_sec()
-            k = int(np.clip(np.searchsorted(stamps, t), 1, len(stamps) - 1)) if len(stamps) > 1 else 0
-            if k > 0 and abs(stamps[k - 1] - t) <= abs(stamps[k] - t):
-                k -= 1
-            dt = abs(stamps[k] - t)
-            if (topic, k) not in best or dt < best[(topic, k)][0]:
-                best[(topic, k)] = (dt, msg)
+        best = _nearest_scans(bag, topics, stamps) if len(stamps) else {}
         frames = {m.header.frame_id.lstrip('/') for _, m in best.values()}
-        parents = {}
-        for tf_topic in ('/tf_static', '/tf'):
-            if all(_mount_resolved(parents, f, base_frame, odom_frame) for f in frames):
-                break
-            for _, msg, _ in bag.read_messages(topics=[tf_topic]):
-                added = False
-                for tr in getattr(msg, 'transforms', []):
-                    child, parent = tr.child_frame_id.lstrip('/'), tr.header.frame_id.lstrip('/')
-                    if child and parent and child not in parents:
-                        parents[child] = (parent, _matrix(tr.transform.translation, tr.transform.rotation))
-                        added = True
-                if added and all(_mount_resolved(parents, f, base_frame, odom_frame) for f in frames):
-                    break
+        parents = _read_parents(bag, frames, base_frame, odom_frame)
     scans, warnings = [], []
     for (topic, k), (_, msg) in sorted(best.items(), key=lambda kv: (kv[0][1], kv[0][0])):
         frame = msg.header.frame_id.lstrip('/')
@@ -1029,9 +1080,10 @@ def plot_fit(path, log, t0, title, cov=None, xlabel=TIME_SINCE_ESTIMATE):
             a2.broken_barh([(t_from, max(t_to - t_from, 1e-3))], (0, 1), color=STATE_COLOURS.get(st, 'grey'))
         from matplotlib.patches import Patch
         a2.plot(t, np.full(len(t), 0.5), '|', color='k', ms=6, alpha=0.4)
-        a2.legend(handles=[Patch(color=STATE_COLOURS[st], label='%s %.0f %%' % (st, 100 * np.mean(log['state'] == st)))
-                           for st in STATES], loc='center left', bbox_to_anchor=(1.0, 0.5), fontsize=7,
-                  frameon=False, title='of the updates', title_fontsize=7)
+        share = lambda st: 100 * np.mean(log['state'] == st)
+        a2.legend(handles=[Patch(color=STATE_COLOURS[st], label='%s %.0f %%' % (st, share(st))) for st in STATES],
+                  loc='center left', bbox_to_anchor=(1.0, 0.5), fontsize=7, frameon=False,
+                  title='of the updates', title_fontsize=7)
     a2.set_yticks([])
     a2.set_ylabel('verdict', rotation=0, ha='right', va='center')
     size = covariance_size(log, cov)

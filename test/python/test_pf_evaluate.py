@@ -396,12 +396,14 @@ class SelfAssessmentTest(unittest.TestCase):
         v = a['verdict']
         self.assertEqual(v['stretches_s'], [['lost', 0.0, 1.0, 1], ['uncertain', 1.0, 3.0, 2],
                                             ['localized', 3.0, 4.0, 2]])
-        self.assertEqual((v['first_localized_s'], v['localized_from_s'], v['final_state']), (3.0, 3.0, 'localized'))
+        self.assertEqual((v['first_localized_s'], v['localized_from_s'], v['final_state']),
+                         (3.0, 3.0, 'localized'))
         self.assertEqual(v['judgement'], 'localized from 3.0 s to the end (the last 2 of 5 updates)')
         self.assertAlmostEqual(v['shares']['uncertain'], 0.4)
 
     def test_judgements(self):
-        j = lambda states: pfe.self_assessment(self.log(states, [1.0] * len(states)), 100.0)['verdict']['judgement']
+        j = lambda states: pfe.self_assessment(self.log(states, [1.0] * len(states)),
+                                               100.0)['verdict']['judgement']
         self.assertEqual(j(['uncertain', 'localized', 'localized']),
                          'localized at every update but the first (uncertain), from 1.0 s to the end')
         self.assertEqual(j(['localized', 'uncertain', 'localized', 'lost', 'lost', 'localized']),
@@ -442,7 +444,8 @@ class SelfAssessmentTest(unittest.TestCase):
         text = pfe.describe(m, 'S')
         self.assertIn('pf_evaluate: no reference (the bag has no /ground_truth; its topics: /scan)', text)
         self.assertIn('beams fit:      mean 65.0 %  median 65.0 %', text)
-        self.assertIn('verdict:        localized at every update but the first (lost), from 1.0 s to the end', text)
+        self.assertIn('verdict:        localized at every update but the first (lost), from 1.0 s to the end',
+                      text)
         self.assertIn('timeline:       lost 0.0-1.0 s (1 update), localized 1.0-1.0 s (1 update)', text)
 
 
