@@ -10,8 +10,11 @@
 #               of its own); exit 0 and a report with summary.json and its
 #               plots. (`bash scripts/test.sh`, the other command, is what
 #               runs this walkthrough.)
-#   own_bag     "Localizing a bag of your own": both `bash scripts/demo.sh
-#               --bag ...` commands; exit 0 and a summary.json each.
+#   own_bag     "Localizing a bag of your own": its `bash scripts/demo.sh
+#               --bag ...` commands; exit 0 and a summary.json each. The
+#               real robot's bag without a reference (../shared/data, skipped
+#               with a message when absent): fit.png, scans.png and a
+#               verdict of localized, as the README says.
 #   bag_demo    "Live, with roslaunch and rviz": `export PATH=...`, `source
 #               "$(bash scripts/build.sh --where)/devel/setup.bash"` and
 #               `roslaunch pf_localization bag_demo.launch` with rviz:=false
@@ -138,14 +141,31 @@ demo() {
 # --- "Localizing a bag of your own" -----------------------------------------------
 own_bag() {
   local prefix cmd log report n=0
-  for prefix in 'bash scripts/demo.sh --bag bags/crowd.bag' 'bash scripts/demo.sh --bag bags/two_lidar.bag'; do
+  local real=../shared/data/comprobo_mac_first_floor_take_2
+  for prefix in 'bash scripts/demo.sh --bag bags/crowd.bag' 'bash scripts/demo.sh --bag bags/two_lidar.bag' \
+    "bash scripts/demo.sh --bag $real/"; do
     n=$((n + 1))
     log=$tmp/own_bag_$n.log
     cmd=$(readme_cmd "$prefix") || return 1
+    if [ "$prefix" = "bash scripts/demo.sh --bag $real/" ] && [ ! -d "$repo/$real" ]; then
+      echo "    $real is not beside the repository: its example skipped"
+      continue
+    fi
     as_user "$cmd" >"$log" 2>&1 || { show_log "$log"; return 1; }
     report=$(sed -n 's/^demo: report in //p' "$log")
     [ -s "$report/summary.json" ] || { echo "    no $report/summary.json"; show_log "$log"; return 1; }
-    echo "    $(head -n 1 <<<"$cmd" | cut -c1-70)...: $(grep -E '^ +position error' "$log" | sed 's/^ *//')"
+    if grep -q '^pf_evaluate: no reference' "$log"; then
+      # Without a reference: what the filter itself knows, with its pictures.
+      for f in fit.png scans.png trajectory.png; do
+        [ -s "$report/$f" ] || { echo "    no $report/$f"; show_log "$log"; return 1; }
+      done
+      echo "    $(head -n 1 <<<"$cmd" | cut -c1-70)...:"
+      grep -E '^ +(beams fit|verdict):' "$log" | sed 's/^ */      /'
+      # The README says it was localized (at every update but the first).
+      grep -qE '^ +verdict: +localized' "$log" || { echo "    not localized"; return 1; }
+    else
+      echo "    $(head -n 1 <<<"$cmd" | cut -c1-70)...: $(grep -E '^ +position error' "$log" | sed 's/^ *//')"
+    fi
   done
 }
 
@@ -300,7 +320,7 @@ user_ws() {
 }
 
 wanted demo && check "demo: bash scripts/demo.sh builds every node and writes the report" demo
-wanted own_bag && check "own_bag: the README's two demo.sh --bag commands write their reports" own_bag
+wanted own_bag && check "own_bag: the README's demo.sh --bag commands write their reports, with a reference or without" own_bag
 wanted bag_demo &&
   check "bag_demo: roslaunch bag_demo.launch rviz:=false: map -> odom on /tf, pf_status localized" bag_demo
 wanted live &&

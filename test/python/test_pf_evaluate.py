@@ -365,6 +365,90 @@ class HypothesesTest(unittest.TestCase):
                           'mean 1.50)', pfe.describe(m, summary))
 
 
+class SelfAssessmentTest(unittest.TestCase):
+    """What the report says without a reference: the fit, the verdict over time, the covariance."""
+
+    @staticmethod
+    def log(states, fits, t0=100.0):
+        n = len(states)
+        return {'t': t0 + np.arange(n, dtype=float), 'state': np.array(states), 'hit_fraction': np.array(fits),
+                'std_x': np.full(n, 0.02), 'std_y': np.full(n, 0.05), 'std_yaw': np.full(n, 0.01),
+                'map_changed_share': np.zeros(n)}
+
+    def test_localized_throughout(self):
+        a = pfe.self_assessment(self.log(['localized'] * 4, [1.0, 0.9, 0.95, 1.0]), 100.0, 104.5)
+        self.assertAlmostEqual(a['fit']['mean'], 0.9625)
+        self.assertEqual(a['fit']['min'], 0.9)
+        self.assertEqual(a['fit']['below_localized_share'], 0.0)
+        v = a['verdict']
+        self.assertTrue(v['localized_throughout'])
+        self.assertEqual(v['stretches_s'], [['localized', 0.0, 4.5, 4]])
+        self.assertEqual(v['judgement'], 'localized throughout (all 4 updates)')
+        # without the published covariance, the larger of the estimate's std_x and std_y
+        self.assertEqual(a['covariance_size']['source'], 'the estimate (update log)')
+        self.assertAlmostEqual(a['covariance_size']['position_std_m']['max'], 0.05)
+
+    def test_a_wrong_start_then_recovered(self):
+        a = pfe.self_assessment(self.log(['lost', 'uncertain', 'uncertain', 'localized', 'localized'],
+                                         [0.3, 0.7, 0.8, 0.95, 1.0]), 100.0)
+        self.assertAlmostEqual(a['fit']['below_localized_share'], 0.4)
+        self.assertAlmostEqual(a['fit']['below_lost_share'], 0.2)
+        v = a['verdict']
+        self.assertEqual(v['stretches_s'], [['lost', 0.0, 1.0, 1], ['uncertain', 1.0, 3.0, 2],
+                                            ['localized', 3.0, 4.0, 2]])
+        self.assertEqual((v['first_localized_s'], v['localized_from_s'], v['final_state']),
+                         (3.0, 3.0, 'localized'))
+        self.assertEqual(v['judgement'], 'localized from 3.0 s to the end (the last 2 of 5 updates)')
+        self.assertAlmostEqual(v['shares']['uncertain'], 0.4)
+
+    def test_judgements(self):
+        j = lambda states: pfe.self_assessment(self.log(states, [1.0] * len(states)),
+                                               100.0)['verdict']['judgement']
+        self.assertEqual(j(['uncertain', 'localized', 'localized']),
+                         'localized at every update but the first (uncertain), from 1.0 s to the end')
+        self.assertEqual(j(['localized', 'uncertain', 'localized', 'lost', 'lost', 'localized']),
+                         'localized at the end (since 5.0 s); before, 2 stretches not localized: '
+                         'uncertain 1.0 s (1 update), lost 2.0 s (2 updates)')
+        self.assertEqual(j(['localized', 'lost', 'lost']),
+                         'not localized at the end: lost since 1.0 s (localized first at 0.0 s)')
+        self.assertEqual(j(['uncertain', 'lost']), 'never localized (2 updates)')
+
+    def test_published_covariance_size_is_the_ellipse_s_larger_semi_axis(self):
+        # xx = yy = 0.05, xy = 0.04: eigenvalues 0.09 and 0.01, so 0.3 m; yaw 0.0004 rad^2: 1.15 deg
+        cov = np.array([[100.0, 0.05, 0.04, 0.05, 0.0004, 0.0, 0.0]])
+        _, pos, yaw, source = pfe.covariance_size(cov=cov)
+        self.assertAlmostEqual(pos[0], 0.3)
+        self.assertAlmostEqual(np.degrees(yaw[0]), np.degrees(0.02))
+        self.assertEqual(source, 'published covariance (pf_pose)')
+
+    def test_the_laser_mounting_is_read_up_to_the_frame_odometry_moves(self):
+        def tr(x, y, yaw):
+            m = np.eye(4)
+            m[:2, :2] = [[math.cos(yaw), -math.sin(yaw)], [math.sin(yaw), math.cos(yaw)]]
+            m[:2, 3] = x, y
+            return m
+        # laser <- plate <- base_link <- odom: the laser 0.1 m ahead of a plate turned by pi, 0.2 m
+        # behind base_link
+        parents = {'laser': ('plate', tr(0.1, 0.0, 0.0)), 'plate': ('base_link', tr(-0.2, 0.0, math.pi)),
+                   'base_link': ('odom', tr(5.0, 5.0, 1.0))}
+        mount, base = pfe._mount(parents, 'laser', None, 'odom')
+        self.assertEqual(base, 'base_link')
+        np.testing.assert_allclose(mount @ [1.0, 0.0, 0.0, 1.0], [-1.3, 0.0, 0.0, 1.0], atol=1e-12)
+        self.assertEqual(pfe._mount(parents, 'laser', 'plate', 'odom')[1], 'plate')
+        self.assertIsNone(pfe._mount(parents, 'laser', 'base_footprint', 'odom')[0])
+
+    def test_describe_without_reference(self):
+        m = {'has_reference': False, 'reference': {'none': 'the bag has no /ground_truth; its topics: /scan'},
+             'n_estimates': 5, 'duration_s': 4.0, 'plots': [],
+             'self_assessment': pfe.self_assessment(self.log(['lost', 'localized'], [0.3, 1.0]), 100.0)}
+        text = pfe.describe(m, 'S')
+        self.assertIn('pf_evaluate: no reference (the bag has no /ground_truth; its topics: /scan)', text)
+        self.assertIn('beams fit:      mean 65.0 %  median 65.0 %', text)
+        self.assertIn('verdict:        localized at every update but the first (lost), from 1.0 s to the end',
+                      text)
+        self.assertIn('timeline:       lost 0.0-1.0 s (1 update), localized 1.0-1.0 s (1 update)', text)
+
+
 class AlignedAteTest(unittest.TestCase):
     def test_rotation_and_translation_are_recovered(self):
         rng = np.random.default_rng(6)
