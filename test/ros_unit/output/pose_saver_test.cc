@@ -8,26 +8,12 @@
 #include <cmath>
 #include <vector>
 
+#include "ros_unit/test_messages.h"
+
 namespace pf_ros {
 namespace {
 
-// 4 x 3 m at 0.05 m: walls around, an unknown 0.5 x 0.5 m patch at (3, 2) m.
-nav_msgs::OccupancyGrid room() {
-  nav_msgs::OccupancyGrid map;
-  map.header.frame_id = "map";
-  map.info.width = 80;
-  map.info.height = 60;
-  map.info.resolution = 0.05f;
-  map.info.origin.orientation.w = 1.0;
-  map.data.assign(80 * 60, 0);
-  for (int y = 0; y < 60; ++y) {
-    for (int x = 0; x < 80; ++x) {
-      if (x == 0 || y == 0 || x == 79 || y == 59) map.data[y * 80 + x] = 100;
-      if (x >= 60 && x < 70 && y >= 40 && y < 50) map.data[y * 80 + x] = -1;
-    }
-  }
-  return map;
-}
+using test::room;
 
 TEST(PoseSaver, NothingToSaveBeforeAPoseOnTheCurrentMap) {
   PoseSaver saver;

@@ -12,15 +12,12 @@
 #include "pf_localization/ros/input/conversions.h"
 #include "pf_localization/ros/scheduling/latest_scan_slot.h"
 #include "pf_localization/ros/scheduling/update_time_governor.h"
+#include "ros_unit/test_messages.h"
 
 namespace pf_ros {
 namespace {
 
-PendingScan scanStamped(double t, std::size_t sensor = 0) {
-  auto scan = boost::make_shared<sensor_msgs::LaserScan>();
-  scan->header.stamp = ros::Time(t);
-  return PendingScan{scan, ros::WallTime(t), ros::Time(t), sensor, nullptr};
-}
+using test::scanStamped;
 
 TEST(LatestScanSlot, TheNewestScanWinsAndTheOlderOneIsCounted) {
   LatestScanSlot slot;

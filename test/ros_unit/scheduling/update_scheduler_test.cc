@@ -14,14 +14,12 @@
 #include <thread>
 #include <vector>
 
+#include "ros_unit/test_messages.h"
+
 namespace pf_ros {
 namespace {
 
-PendingScan scanStamped(double t, std::size_t sensor = 0) {
-  auto scan = boost::make_shared<sensor_msgs::LaserScan>();
-  scan->header.stamp = ros::Time(t);
-  return PendingScan{scan, ros::WallTime(t), ros::Time(t), sensor, nullptr};
-}
+using test::scanStamped;
 
 // Records each update: the scan's stamp and the thread it ran on. An update
 // may be held until release() (an update longer than a scan period).
