@@ -66,18 +66,24 @@ mkdir -p "$logs"
 # The workspace for the tools and tests this run starts (test/replay, benchmark_datasets).
 export PF_WS=$ws
 
-# cpu_seconds: the CPU time (user + system) of this shell's finished children, from `times`.
+# cpu_seconds: sets CPU_S to the CPU time (user + system, s) of this shell's finished
+# children, from `times` (which must run in this shell: a pipe or $(...) would ask a
+# fresh subshell, whose children have used nothing yet).
 cpu_seconds() {
-  times | awk 'NR == 2 {
-    for (i = 1; i <= 2; i++) { split($i, t, /[ms]/); s += t[1] * 60 + t[2] }
-    printf "%.0f", s }'
+  local f=$logs/cpu_$BASHPID user sys
+  times >"$f"
+  { read -r _ _; read -r user sys; } <"$f"
+  rm -f "$f"
+  CPU_S=$(awk -v u="$user" -v s="$sys" \
+    'function sec(x, p) { split(x, p, /[ms]/); return p[1] * 60 + p[2] } BEGIN { printf "%.0f", sec(u) + sec(s) }')
 }
 
 if ! bash scripts/build.sh all tests -j2 >"$logs/build.log" 2>&1; then
   tail -n 40 "$logs/build.log"
   echo "build failed (log: $logs/build.log)"; echo "0 passed, 1 failed"; exit 1
 fi
-echo "built in $(awk -v a="$start" -v b="$EPOCHREALTIME" 'BEGIN {printf "%.0f", b - a}') s ($(cpu_seconds) s of CPU)"
+cpu_seconds
+echo "built in $(awk -v a="$start" -v b="$EPOCHREALTIME" 'BEGIN {printf "%.0f", b - a}') s ($CPU_S s of CPU)"
 mkdir -p "$results/pf_localization"
 pf_source_workspace "$ws" test || { echo "0 passed, 1 failed"; exit 1; }
 
@@ -90,7 +96,7 @@ job() {
   local kind=$1 name=$2 t0=$EPOCHREALTIME rc secs log cpu
   shift 2
   log=$logs/${kind}_${name//[^A-Za-z0-9_.-]/_}.log
-  cpu=$( ("$@" </dev/null >"$log" 2>&1; rc=$?; cpu_seconds; exit "$rc") )
+  cpu=$( ("$@" </dev/null >"$log" 2>&1; rc=$?; cpu_seconds; echo "$CPU_S"; exit "$rc") )
   rc=$?
   secs=$(awk -v a="$t0" -v b="$EPOCHREALTIME" 'BEGIN {printf "%.1f", b - a}')
   printf '%s\t%s\t%d\t%s\t%s\n' "$kind" "$name" "$rc" "$secs" "$cpu" >>"$logs/times"
@@ -267,6 +273,7 @@ checks_bad=$(awk -F'\t' '$1 == "check" && $3 != 0' "$logs/times" | wc -l)
 passed=$((${ok:-0} + checks_ok))
 failed=$((${bad:-1} + checks_bad))
 [ "${ok:-0}" -eq 0 ] && { echo "no gtest or rostest result found"; failed=$((failed + 1)); }
-echo "$total s in all, $(cpu_seconds) s of CPU"
+cpu_seconds
+echo "$total s in all, $CPU_S s of CPU"
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ] && [ "$passed" -gt 0 ]
