@@ -18,8 +18,8 @@ tests=(pf_core_test pf_sim_test pf_ros_test pf_fuzz_replay_test)
 start=$(date +%s)
 
 # Compiled by clang (scripts/install_deps.sh installs clang-14 for the fuzzers), which
-# compiles these sources instrumented at -O1 in half to two thirds of gcc's CPU time
-# (docs/contributing.md, "What the full run runs"); gcc when there is no clang-14.
+# compiles these sources instrumented at -O1 in about two thirds of gcc's CPU time
+# (docs/contributing.md, "Where the full run's time goes"); gcc when there is no clang-14.
 compilers="" compiler="the default compiler"
 if [ -x /usr/bin/clang++-14 ] && [ -x /usr/bin/clang-14 ]; then
   # (-Wno-unknown-attributes: clang has no noipa, which only steers gcc's optimiser.)
