@@ -4,7 +4,8 @@
 catkin_test_results adds up the "tests" attributes of every file, which counts
 each gtest case twice (its suite and the whole run both carry it) and each
 rostest twice (once in rostest-*.xml, once in the test node's rosunit-*.xml).
-Here every gtest case and every rostest's test node counts once.
+Here every gtest case, every rostest's test node and every pytest case
+(pytest-*.xml, scripts/test.sh's) counts once; skipped ones count in neither.
 usage: count_test_results.py RESULTS_DIR      prints "PASSED FAILED"
 """
 import glob
@@ -17,10 +18,10 @@ def count(results_dir):
     passed = failed = 0
     for path in sorted(glob.glob(os.path.join(results_dir, '**', '*.xml'), recursive=True)):
         name = os.path.basename(path)
-        # gtest-*: one case per test. rosunit-*: the test node of a rostest,
-        # which holds its verdict. rostest-*: only the launch itself (it says
-        # "passed" even when its test node failed), so only its failures count.
-        if not name.startswith(('gtest-', 'rosunit-', 'rostest-')):
+        # gtest-*, pytest-*: one case per test. rosunit-*: the test node of a
+        # rostest, which holds its verdict. rostest-*: only the launch itself (it
+        # says "passed" even when its test node failed), so only its failures count.
+        if not name.startswith(('gtest-', 'pytest-', 'rosunit-', 'rostest-')):
             continue
         try:
             cases = list(ET.parse(path).getroot().iter('testcase'))

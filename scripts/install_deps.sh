@@ -31,9 +31,11 @@ packages=(
   libeigen3-dev libyaml-cpp-dev
   # tests and benchmarks
   libgtest-dev libgmock-dev librostest-dev python3-rostest python3-rosunit libbenchmark-dev
+  # the Python and replay tests (test/python, test/replay), which scripts/test.sh runs with pytest
+  python3-pytest
   # test/rostest/odom_topic.test: relay and transform
   topic-tools python3-topic-tools
-  # fuzzing (scripts/fuzz.sh): clang with libFuzzer
+  # fuzzing (scripts/fuzz.sh): clang with libFuzzer; clang also builds the sanitizer tier (scripts/sanitize.sh)
   clang-14 libclang-rt-14-dev
   python3-std-srvs python3-geometry-msgs python3-nav-msgs python3-sensor-msgs python3-tf2-msgs
   python3-diagnostic-msgs

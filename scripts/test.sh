@@ -1,10 +1,14 @@
 #!/usr/bin/env bash
-# The project's tests, in two tiers.
+# The project's tests, in two tiers. This script only builds and schedules them: what each
+# test asserts, and its thresholds, live in the test files (test/core, test/sim,
+# test/ros_unit, test/fuzz: GoogleTest; test/rostest: rostest; test/python, test/replay:
+# pytest); the few checks of the sources and of the package as catkin and Debian see it
+# are the functions of scripts/test_checks.bash and scripts/space_checks.bash.
 #
-#   bash scripts/test.sh           every check: what .ci/run runs, and what a change must pass
+#   bash scripts/test.sh           every test: what .ci/run runs, and what a change must pass
 #   bash scripts/test.sh --quick   the edit-test loop: build what changed, then the unit tests
-#                                  (GoogleTest, Python) and the source checks; no bag replay,
-#                                  no second build
+#                                  (GoogleTest, test/python) and the source checks; no bag
+#                                  replay, no second build
 #
 # Both install the dependencies (scripts/install_deps.sh; nothing when they are there)
 # and build the package and its test binaries on both cores, through ccache
@@ -16,20 +20,19 @@
 #     rostests (each starts its own master on a free port and mostly waits for its
 #     bag's clock: about 0.15 of a core each; the longest first, by the last run's
 #     times) and the rviz click test; then, one at a time, the rostests that bound
-#     time on the wall clock;
-#   - one after another at the lowest priority (nice 19), so that the rostests'
-#     clocks keep their pace: the unit tests built and run under ASan + UBSan
-#     (scripts/sanitize.sh), the Debian package (scripts/make_deb.sh) and the
-#     replays whose figures do not depend on the machine's load (pf_bag_runner is
-#     deterministic for a seed: test_checks.bash);
-# then the install space and its demo.
+#     time on the wall clock; then the install space and its demo;
+#   - two at a time at the lowest priority (nice 19), so that the rostests' clocks keep
+#     their pace: the unit tests built and run under ASan + UBSan (scripts/sanitize.sh,
+#     the longest), the Debian package (scripts/make_deb.sh) and the replays of
+#     test/replay, whose figures do not depend on the machine's load (pf_bag_runner is
+#     deterministic for a seed).
 #
 # Every check's output goes to a log in <workspace>/test_logs/ (its tail is shown when
-# it fails); each prints one line with its time, and the end lists the ten slowest,
-# the total, and last one line "N passed, N failed": every GoogleTest case, every
-# rostest's test node, every Python test and every other check count one. Exits
-# non-zero when anything failed or nothing ran; the full run also fails when it took
-# longer than PF_TEST_BUDGET_S (1500 s).
+# it fails); each prints one line with its time, <workspace>/test_times keeps each one's
+# wall and CPU seconds, and the end lists the ten slowest, the total, and last one line
+# "N passed, N failed": every GoogleTest case, every rostest's test node, every pytest
+# case and every other check count one. Exits non-zero when anything failed or nothing
+# ran; the full run also fails when it took longer than PF_TEST_BUDGET_S (1500 s).
 set -uo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 quick=0
@@ -60,27 +63,43 @@ logs=$ws/test_logs
 results=$ws/build/test_results
 rm -rf "$logs" "$results"
 mkdir -p "$logs"
+# The workspace for the tools and tests this run starts (test/replay, benchmark_datasets).
+export PF_WS=$ws
+
+# cpu_seconds: sets CPU_S to the CPU time (user + system, s) of this shell's finished
+# children, from `times` (which must run in this shell: a pipe or $(...) would ask a
+# fresh subshell, whose children have used nothing yet).
+cpu_seconds() {
+  local f=$logs/cpu_$BASHPID user sys
+  times >"$f"
+  { read -r _ _; read -r user sys; } <"$f"
+  rm -f "$f"
+  CPU_S=$(awk -v u="$user" -v s="$sys" \
+    'function sec(x, p) { split(x, p, /[ms]/); return p[1] * 60 + p[2] } BEGIN { printf "%.0f", sec(u) + sec(s) }')
+}
+
 if ! bash scripts/build.sh all tests -j2 >"$logs/build.log" 2>&1; then
   tail -n 40 "$logs/build.log"
   echo "build failed (log: $logs/build.log)"; echo "0 passed, 1 failed"; exit 1
 fi
-echo "built in $(awk -v a="$start" -v b="$EPOCHREALTIME" 'BEGIN {printf "%.0f", b - a}') s"
+cpu_seconds
+echo "built in $(awk -v a="$start" -v b="$EPOCHREALTIME" 'BEGIN {printf "%.0f", b - a}') s ($CPU_S s of CPU)"
 mkdir -p "$results/pf_localization"
 pf_source_workspace "$ws" test || { echo "0 passed, 1 failed"; exit 1; }
 
 # --- Jobs ----------------------------------------------------------------------------
 # job KIND NAME COMMAND...: runs COMMAND with its output in $logs/KIND_NAME.log and
-# appends "KIND NAME EXIT SECONDS" to $logs/times. KIND check: COMMAND's exit
-# status is the verdict (one test); for the others (gtest, rostest, python) their
-# cases are counted.
+# appends "KIND NAME EXIT SECONDS CPU_SECONDS" to $logs/times. KIND check: COMMAND's
+# exit status is the verdict (one test); for the others (gtest, rostest, pytest) their
+# cases are counted from their result files.
 job() {
-  local kind=$1 name=$2 t0=$EPOCHREALTIME rc secs log
+  local kind=$1 name=$2 t0=$EPOCHREALTIME rc secs log cpu
   shift 2
   log=$logs/${kind}_${name//[^A-Za-z0-9_.-]/_}.log
-  "$@" </dev/null >"$log" 2>&1
+  cpu=$( ("$@" </dev/null >"$log" 2>&1; rc=$?; cpu_seconds; echo "$CPU_S"; exit "$rc") )
   rc=$?
   secs=$(awk -v a="$t0" -v b="$EPOCHREALTIME" 'BEGIN {printf "%.1f", b - a}')
-  printf '%s\t%s\t%d\t%s\n' "$kind" "$name" "$rc" "$secs" >>"$logs/times"
+  printf '%s\t%s\t%d\t%s\t%s\n' "$kind" "$name" "$rc" "$secs" "$cpu" >>"$logs/times"
   if [ "$rc" -eq 0 ]; then
     printf '[%s] %s: ok (%s s)\n' "$kind" "$name" "$secs"
   else
@@ -91,12 +110,12 @@ job() {
 }
 
 # Jobs queued with `queue KIND NAME COMMAND...` run by run_queue N, N at a time,
-# in the order queued.
+# in the order queued. KIND group: COMMAND runs jobs of its own (it is not one).
 queued=()
 queue() { queued+=("$(printf '%q ' "$@")"); }
 run_queue() {
   local n=$1 spec pid finished
-  local -a running=() still
+  local -a running=() still words
   for spec in "${queued[@]}"; do
     while [ ${#running[@]} -ge "$n" ]; do
       wait -n -p finished "${running[@]}"
@@ -104,7 +123,8 @@ run_queue() {
       for pid in "${running[@]}"; do [ "$pid" = "$finished" ] || still+=("$pid"); done
       running=("${still[@]}")
     done
-    eval "job $spec" &
+    eval "words=($spec)"
+    if [ "${words[0]}" = group ]; then "${words[@]:2}" & else job "${words[@]}" & fi
     running+=("$!")
   done
   for pid in "${running[@]}"; do wait "$pid"; done
@@ -118,6 +138,22 @@ gtest() {
   local xml=$results/pf_localization/gtest-$1.xml
   /usr/bin/python3 /usr/share/catkin/cmake/test/run_tests.py "$xml" \
     "timeout -k 10 600 $ws/devel/lib/pf_localization/$1 --gtest_output=xml:$xml" --return-code
+}
+# pytest_run NAME DIR PYTEST_ARGS...: the pytest tests of DIR (test_*.py, unittest's
+# classes among them), each case one test, in pytest-NAME.xml; a run that ends without
+# its verdicts (exit 2-5: interrupted, an internal or usage error, nothing collected)
+# adds a failure of its own. No cache or bytecode is written into the repository.
+pytest_run() {
+  local name=$1 dir=$2 xml=$results/pf_localization/pytest-$1.xml rc
+  shift 2
+  PYTHONDONTWRITEBYTECODE=1 /usr/bin/python3 -m pytest -p no:cacheprovider -v -rfE \
+    --junitxml="$xml" "$@" "$dir"
+  rc=$?
+  if [ "$rc" -gt 1 ]; then
+    printf '<testsuite><testcase classname="pytest" name="%s"><failure message="pytest exited %d"/></testcase></testsuite>\n' \
+      "$dir" "$rc" >"$results/pf_localization/pytest-$name-exit.xml"
+  fi
+  return "$rc"
 }
 # rostest FILE ARGS...: one rostest as catkin's run_tests target runs it (run_tests.py
 # writes a failure when the test left no result file).
@@ -133,7 +169,7 @@ rostest_run() {
 
 queue_unit_tier() {  # the unit tests and the source checks
   local t
-  queue python "Python unit tests (test/python)" python_unit_tests "$logs/python_counts"
+  queue pytest "the Python package's tests (test/python)" pytest_run python test/python
   for t in pf_core_test pf_sim_test pf_ros_test pf_fuzz_replay_test; do queue gtest "$t" gtest "$t"; done
   queue check "catkin_lint -W1 clean" catkin_lint_clean
   queue check "the core and the simulator include no ROS header" core_is_ros_free
@@ -142,31 +178,24 @@ queue_unit_tier() {  # the unit tests and the source checks
   queue check "the manual builds (mkdocs --strict), its links and anchors resolve" docs_build
 }
 
-# The low-priority lane: what needs a core for long but no clock.
+# The Debian package, then what is checked of it.
+deb_checks() {
+  job check "make_deb.sh builds ros-pf-localization_VERSION_ARCH.deb" make_deb || return 1
+  job check "the .deb: fields, files under /usr, Depends cover its libraries and nodes" \
+    pf_check_deb "$(built_deb)" package.xml
+  job check "bag_demo.launch from the .deb unpacked with dpkg -x: pf_node publishes pf_pose" \
+    pf_check_deb_demo "$(built_deb)"
+}
+
+# The low-priority lane: what needs a core for long but no clock, two at a time, the
+# sanitizer build (the longest) first.
 background_lane() {
-  job check "unit tests under ASan + UBSan (scripts/sanitize.sh)" bash scripts/sanitize.sh
-  if job check "make_deb.sh builds ros-pf-localization_VERSION_ARCH.deb" make_deb; then
-    job check "the .deb: fields, files under /usr, Depends cover its libraries and nodes" \
-      pf_check_deb "$(built_deb)" package.xml
-    job check "bag_demo.launch from the .deb unpacked with dpkg -x: pf_node publishes pf_pose" \
-      pf_check_deb_demo "$(built_deb)"
-  fi
-  job check "warehouse global localization, 1M particles: never localized wrong, the truth listed" \
-    warehouse_global
-  job check "warehouse global localization, default budget, 10 seeds: never localized wrong, the truth listed, localized by 44.1 s, an honest covariance" \
-    warehouse_global_default
-  job check "warehouse kidnap into the twin aisle, 10 seeds: found within 10 s of the first distinguishing scans" \
-    warehouse_kidnap
-  job check "pf_bag_runner --pace 20: the trajectory back to back, at the bag's pace" \
-    paced_runner_same
-  job check "corridor.bag at 5000 particles, 10 seeds: within 0.05 m RMSE and 0.15 m max" \
-    corridor_small_budget
-  job check "crowd.bag with updates every 0.05 m or 0.1 rad, 16 seeds: never confidently wrong, 15 tracked as with the defaults" \
-    close_updates
-  job check "worlds that no longer match their maps, 8 seeds: tracked, never wrong, their changes found" \
-    changed_worlds_check
-  job check "the real recordings (intel_lab, fr079, neato_ac109_1): their precision" real_recordings
-  job check "the results tables of README.md and docs/results.md match a fresh benchmark run" results_tables_current
+  [ "${PF_SKIP_SANITIZE:-0}" = 1 ] ||
+    queue check "unit tests under ASan + UBSan (scripts/sanitize.sh)" bash scripts/sanitize.sh
+  queue group "the Debian package" deb_checks
+  queue pytest "replays of the bundled bags and the real recordings (test/replay)" \
+    pytest_run replay test/replay -s
+  run_queue 2
 }
 
 # The rostests, the longest first when an earlier run left their times.
@@ -235,15 +264,16 @@ if [ "$quick" -eq 0 ]; then
   job check "the whole run within its budget of $budget s (it took $total s)" test "$total" -le "$budget"
   cp "$logs/times" "$ws/test_times"
 fi
-echo "the ten slowest (s):"
-sort -t$'\t' -k4,4nr "$logs/times" | head -n 10 | awk -F'\t' '{printf "  %7.1f  %s %s\n", $4, $1, $2}'
+echo "the ten slowest (wall s, CPU s):"
+sort -t$'\t' -k4,4nr "$logs/times" | head -n 10 |
+  awk -F'\t' '{printf "  %7.1f %6s  %s %s\n", $4, $5, $1, $2}'
 read -r ok bad < <(/usr/bin/python3 scripts/count_test_results.py "$results")
-read -r py_ok py_bad < <(cat "$logs/python_counts" 2>/dev/null || echo "0 1")
 checks_ok=$(awk -F'\t' '$1 == "check" && $3 == 0' "$logs/times" | wc -l)
 checks_bad=$(awk -F'\t' '$1 == "check" && $3 != 0' "$logs/times" | wc -l)
-passed=$((${ok:-0} + py_ok + checks_ok))
-failed=$((${bad:-1} + py_bad + checks_bad))
+passed=$((${ok:-0} + checks_ok))
+failed=$((${bad:-1} + checks_bad))
 [ "${ok:-0}" -eq 0 ] && { echo "no gtest or rostest result found"; failed=$((failed + 1)); }
-echo "$total s in all"
+cpu_seconds
+echo "$total s in all, $CPU_S s of CPU"
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ] && [ "$passed" -gt 0 ]

@@ -88,7 +88,7 @@ class GlobalSearchTest : public ::testing::Test {
   }
 
   const OccupancyGrid grid_ = test::tenMetreRoom();
-  const LikelihoodFieldModelParams params_;
+  const LikelihoodFieldModelParams params_{};
   const LikelihoodFieldModel model_{grid_, params_};
   const std::vector<PreparedScan> scans_{
       model_.prepare(small_world::castScan(grid_, {5.0, 5.0, 0.0}))};
