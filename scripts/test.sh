@@ -174,8 +174,13 @@ queue_unit_tier() {  # the unit tests and the source checks
   queue check "catkin_lint -W1 clean" catkin_lint_clean
   queue check "the core and the simulator include no ROS header" core_is_ros_free
   queue check "no function in src/ longer than 80 lines" no_long_functions
+  queue check "no source file longer than 600 lines" no_long_files
   queue check "clang-format clean" clang_format_clean
   queue check "the manual builds (mkdocs --strict), its links and anchors resolve" docs_build
+  queue check "every code name the manual gives in backticks exists in the code" \
+    /usr/bin/python3 "$repo/scripts/check_doc_names.py" "$repo"
+  queue check "each file is named after its main type, or holds free functions" \
+    /usr/bin/python3 "$repo/scripts/check_file_names.py" "$repo"
 }
 
 # The Debian package, then what is checked of it.

@@ -6,7 +6,7 @@
 # The package as catkin and Debian see it:
 #   catkin_lint_clean install_space make_deb (and scripts/space_checks.bash)
 # The sources:
-#   core_is_ros_free clang_format_clean no_long_functions
+#   core_is_ros_free clang_format_clean no_long_functions no_long_files
 # The documentation:
 #   docs_build (the manual, strict, its links and anchors)
 
@@ -48,6 +48,11 @@ clang_format_clean() {
   [ -z "$out" ] && return 0
   echo "$out" | head -n 20
   return 1
+}
+# No source file over 600 lines: one that long holds more than one idea.
+no_long_files() {
+  (cd "$repo" && git ls-files '*.cc' '*.h' '*.py' '*.sh' '*.bash' 'scripts/*' | sort -u |
+    xargs wc -l | awk '$2 != "total" && $1 > 600 {print "over 600 lines:", $2, $1; n++} END {exit n > 0}')
 }
 no_long_functions() {
   local sources
