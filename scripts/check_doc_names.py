@@ -18,8 +18,8 @@ What is checked, in inline `code` outside fenced blocks:
   - an environment variable or constant (PF_WS): a word of the code, as above;
   - a command (a span with spaces): its repository paths and source file names, as above, and its
     program when it is this package's (pf_*, or the one after `rosrun pf_localization`).
-Not checked: options (-x, --x), absolute or home paths (/x, ~x, ../x), placeholders (<x>, $X, a
-part in capitals such as X.sh), a span with = or :, numbers, a name starting with _ (a suffix
+Not checked: options (-x, --x), absolute or home paths (/x, ~x, ../x), patterns (x_*.py),
+placeholders (<x>, $X, a part in capitals such as X.sh), a span with = or :, numbers, a name starting with _ (a suffix
 such as `_yaw`), file names of data or outputs (.bag, .yaml, .png, ...), and other libraries' and
 tools' names (EXTERNAL, EXTERNAL_NAMESPACES).
 
@@ -111,8 +111,10 @@ def is_path(word):
 
 
 def placeholder(word):
-    """A made-up part such as X.sh, FILE or <workspace>: nothing to look up."""
-    return any(re.fullmatch(r'[A-Z][A-Z0-9_]*', part) for part in re.split(r'[/.]', word)) or '<' in word
+    """A made-up part such as X.sh, FILE or <workspace>, or a pattern such as test_*.py: nothing to
+    look up."""
+    return (any(re.fullmatch(r'[A-Z][A-Z0-9_]*', part) for part in re.split(r'[/.]', word)) or
+            '<' in word or '*' in word)
 
 
 def missing_in_command(words, code):
