@@ -19,9 +19,9 @@ What is checked, in inline `code` outside fenced blocks:
   - a command (a span with spaces): its repository paths and source file names, as above, and its
     program when it is this package's (pf_*, or the one after `rosrun pf_localization`).
 Not checked: options (-x, --x), absolute or home paths (/x, ~x, ../x), patterns (x_*.py),
-placeholders (<x>, $X, a part in capitals such as X.sh), a span with = or :, numbers, a name starting with _ (a suffix
-such as `_yaw`), file names of data or outputs (.bag, .yaml, .png, ...), and other libraries' and
-tools' names (EXTERNAL, EXTERNAL_NAMESPACES).
+placeholders (<x>, $X, a part in capitals such as X.sh), a span with = or :, numbers, a name
+starting with _ (a suffix such as `_yaw`), file names of data or outputs (.bag, .yaml, .png, ...),
+and other libraries' and tools' names (EXTERNAL, EXTERNAL_NAMESPACES).
 
 Prints each missing name as DOC:LINE; exit 1 if any, else 0 with a one-line summary.
 """
