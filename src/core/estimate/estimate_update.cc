@@ -65,16 +65,16 @@ void EstimateUpdate::listLookAlikes(const SensorModel& model,
 ScanRefinement EstimateUpdate::refine(const SensorModel& model, const ScanGroup& scans,
                                       const Pose2& odom, const std::optional<Pose2>& predicted,
                                       const ParticleFilterParams& params) {
-  fit_ = refinement_.atUpdate(model, scans, odom, predicted, confidence_.confidence().state, params,
-                              &estimate_);
-  if (fit_.accepted) confidence_.addFit(fit_.covariance);
-  return fit_;
+  const ScanRefinement fit = refinement_.atUpdate(
+      model, scans, odom, predicted, confidence_.confidence().state, params, &estimate_);
+  if (fit.accepted) confidence_.addFit(fit.covariance);
+  return fit;
 }
 
-bool EstimateUpdate::fitPinsAlongTrack(double margin) const {
-  if (!fit_.accepted) return true;
+bool EstimateUpdate::fitPinsAlongTrack(const ScanRefinement& fit, double margin) const {
+  if (!fit.accepted) return true;
   const Eigen::Vector3d u(std::cos(estimate_.pose.yaw), std::sin(estimate_.pose.yaw), 0.0);
-  return u.dot(fitInformation(fit_.covariance).information * u) * margin * margin >= 1.0;
+  return u.dot(fitInformation(fit.covariance).information * u) * margin * margin >= 1.0;
 }
 
 ScanRefinement EstimateUpdate::refitBetweenUpdates(const SensorModel& model, const ScanGroup& scans,

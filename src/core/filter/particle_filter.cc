@@ -204,7 +204,8 @@ UpdateReport ParticleFilter::update(const Pose2& odom, const ScanGroup& measured
   gate_.recordFit(sensor_.model(), beams.steady(), estimate_.pose(), params_);
   sensor_.observePlaces(judged.places);
   report.refinement = estimate_.refine(sensor_.model(), scan.fitting, odom, predicted, params_);
-  motion_.setAlongTrackObservable(estimate_.fitPinsAlongTrack(params_.motion.fault_margin));
+  motion_.setAlongTrackObservable(
+      estimate_.fitPinsAlongTrack(report.refinement, params_.motion.fault_margin));
   report.recovery() = resampleAndRecover(report, gate.view, std::move(judged.better));
   estimate_.demoteAfterLowFit(recovery_.lowFitViews(), params_.recovery.patience);
   screen_.learn(scan.measured, estimate_.pose(), confidence().state == LocalizationState::kLost);

@@ -75,11 +75,11 @@ class EstimateUpdate {
   /// adds to the published covariance.
   ScanRefinement refine(const SensorModel& model, const ScanGroup& scans, const Pose2& odom,
                         const std::optional<Pose2>& predicted, const ParticleFilterParams& params);
-  /// Whether the last refine() pinned the position along the estimate's
-  /// heading to within `margin` (m): the fit's information along it, with
-  /// the other directions given. Without an accepted fit nothing says what
-  /// the scan pinned: true, so that the odometry faults keep hedging.
-  bool fitPinsAlongTrack(double margin) const;
+  /// Whether the scan fit `fit` (refine()'s) pinned the position along the
+  /// estimate's heading to within `margin` (m): the fit's information along
+  /// it, with the other directions given. Without an accepted fit nothing
+  /// says what the scan pinned: true, so that the odometry faults keep hedging.
+  bool fitPinsAlongTrack(const ScanRefinement& fit, double margin) const;
   /// The scan fit between updates (EstimateRefinement::betweenUpdates).
   ScanRefinement refitBetweenUpdates(const SensorModel& model, const ScanGroup& scans,
                                      const Pose2& odom, const Pose2& odom_at_update,
@@ -125,7 +125,6 @@ class EstimateUpdate {
   std::vector<LookAlikePlace> look_alike_places_;
   std::size_t places_ = 0;  // the places the last update's cloud holds (hypothesesOf)
   EstimateRefinement refinement_;
-  ScanRefinement fit_;  // the last refine()'s
 };
 
 }  // namespace pf
