@@ -78,9 +78,8 @@ export CCACHE_DIR=${CCACHE_DIR:-${XDG_CACHE_HOME:-${HOME:-/tmp}/.cache}/ccache}
 export XDG_CACHE_HOME=$tmp/cache
 ws=$(pf_default_ws "$repo")
 export ROS_HOME=$tmp/ros_home ROS_LOG_DIR=$tmp/ros_log
-free_port() { /usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("localhost", 0)); print(s.getsockname()[1])'; }
 # No master listens here: a tool that needs one fails (or hangs until its timeout).
-no_master_port=$(free_port)
+no_master_port=$(pf_free_port)
 export ROS_MASTER_URI=http://localhost:$no_master_port
 
 passed=0 failed=0
@@ -235,7 +234,7 @@ live_run() {
   [ -f "$setup" ] || { echo "    no $setup"; return 1; }
   prelude="$(readme_cmd 'export PATH=/usr/bin:$PATH')"$'\n'"$(readme_cmd 'source "$(bash scripts/build.sh --where)')" ||
     return 1
-  port=$(free_port)
+  port=$(pf_free_port)
   printf '%s\nexec timeout -s TERM 300 %s\n' "$prelude" "$launch" >"$tmp/$name.sh"
   ROS_MASTER_URI=http://localhost:$port user_session "$tmp/$name.sh" >"$log" 2>&1 &
   pid=$!

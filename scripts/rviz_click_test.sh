@@ -283,7 +283,7 @@ exec 3>&-
 wait_for 10 "Xvfb did not start" test -s "$tmp/display"
 export DISPLAY=:$(head -n 1 "$tmp/display")
 
-port=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("localhost", 0)); print(s.getsockname()[1])')
+port=$(pf_free_port) || exit 2
 export ROS_MASTER_URI=http://localhost:$port
 start roscore roscore -p "$port"
 wait_for 30 "roscore did not start" rosparam get /rosdistro

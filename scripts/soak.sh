@@ -3,7 +3,7 @@
 #
 #   bash scripts/soak.sh [SIM_SECONDS]        # default 3600 s of simulated time
 #
-# Starts a private roscore (random port, its own ROS_LOG_DIR), then
+# Starts a private roscore (a free port, its own ROS_LOG_DIR), then
 # `roslaunch pf_localization localization.launch` (map_publisher + pf_node,
 # use_sim_time) with the bag's map and start pose, and plays the bag with
 # `rosbag play --clock --loop -r RATE` until SIM_SECONDS of simulated time
@@ -44,7 +44,7 @@ export PATH=/usr/bin:$PATH
 pf_source_workspace "$ws" soak || exit 2
 
 tmp=$(mktemp -d /tmp/pf_soak.XXXXXX)
-port=$((20000 + RANDOM % 20000))
+port=$(pf_free_port) || exit 2
 export ROS_MASTER_URI=http://localhost:$port
 export ROS_LOG_DIR=$tmp/log ROS_HOME=$tmp/home
 echo "soak: bag $bag (rate x$rate, looped), map $map, start ($px, $py, $pa)"

@@ -47,7 +47,7 @@ pf_check_rosrun() {
   fi
 }
 
-# bag_demo.launch from the install space alone (a private roscore on a random
+# bag_demo.launch from the install space alone (a private roscore on a free
 # port, the bundled bag at 2x, 66 s long): pf_node must publish pf_pose within 60 s,
 # and pf_hypotheses (latched), which rostopic must read with the space's own
 # generated Python message.
@@ -59,7 +59,7 @@ pf_check_demo() {
   local setup=$1 share=$2 tmp port launch_pid rc out hyp
   if [ ! -f "$setup" ]; then echo "no $setup"; return 1; fi
   tmp=$(mktemp -d /tmp/pf_install_demo.XXXXXX)
-  port=$((20000 + RANDOM % 20000))
+  port=$(pf_free_port) || return 1
   (
     export ROS_MASTER_URI=http://localhost:$port ROS_HOME=$tmp/home ROS_LOG_DIR=$tmp/log
     # The package found must be the installed one, not a source folder.

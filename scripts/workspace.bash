@@ -19,6 +19,7 @@
 #   pf_default_ws REPO [KIND]       prints $PF_WS (or $PF_ASAN_WS, ...) or the default;
 #                                   KIND is ws (default), asan, fuzz or bench
 #   pf_source_workspace WS NAME     loads WS's devel space (NAME prefixes the error message)
+#   pf_free_port                    prints a TCP port for a private ROS master
 pf_cache_dir() {
   local real hash
   real=$(cd "$1" && pwd -P) || return 1
@@ -60,4 +61,27 @@ pf_source_workspace() {
   source "$ws/devel/setup.bash"
   [ "$had_nounset" = 1 ] && set -u
   return 0
+}
+
+# A port for a private roscore: one below the kernel's ephemeral range, which
+# nothing listens on now. A port drawn from the ephemeral range (bind to port 0,
+# or a random number above 32767) can be taken between the draw and roscore's
+# start by the XML-RPC server of any ROS node, or by rostest's own master, which
+# binds port 0: in a test run that starts dozens of nodes this happens.
+pf_free_port() {
+  /usr/bin/python3 - <<'PY'
+import random, socket
+low = int(open('/proc/sys/net/ipv4/ip_local_port_range').read().split()[0])
+high = low if low > 21000 else 65536  # no range below it: any port will do
+for port in random.sample(range(20000, high), 200):
+    with socket.socket() as s:
+        try:
+            s.bind(('localhost', port))
+        except OSError:
+            continue
+    print(port)
+    break
+else:
+    raise SystemExit('pf_free_port: no free port in 20000-%d' % (high - 1))
+PY
 }
