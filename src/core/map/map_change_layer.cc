@@ -15,8 +15,29 @@ void bump(std::uint16_t* n) {
 
 }  // namespace
 
+std::size_t MapChangeLayer::tileOf(std::size_t i, std::size_t* in_tile) const {
+  const std::size_t w = static_cast<std::size_t>(width_);
+  const std::size_t x = i % w, y = i / w;
+  *in_tile = ((y & (kTileSize - 1)) << kTileBits) | (x & (kTileSize - 1));
+  return (y >> kTileBits) * static_cast<std::size_t>(tiles_x_) + (x >> kTileBits);
+}
+
+MapChangeLayer::Counts& MapChangeLayer::countsAt(std::size_t i) {
+  std::size_t in_tile;
+  std::unique_ptr<Counts[]>& tile = tiles_[tileOf(i, &in_tile)];
+  if (!tile) tile = std::make_unique<Counts[]>(kTileSize * kTileSize);
+  return tile[in_tile];
+}
+
+const MapChangeLayer::Counts& MapChangeLayer::countsAt(std::size_t i) const {
+  static const Counts kNone;
+  std::size_t in_tile;
+  const std::unique_ptr<Counts[]>& tile = tiles_[tileOf(i, &in_tile)];
+  return tile ? tile[in_tile] : kNone;
+}
+
 void MapChangeLayer::count(std::size_t i, Kind kind) {
-  Counts& c = counts_[i];
+  Counts& c = countsAt(i);
   const auto scan = static_cast<std::uint16_t>(scans_);
   if (c.scan != scan) {
     c.scan = scan;
@@ -70,7 +91,10 @@ void MapChangeLayer::see(std::size_t i) {
 }
 
 MapChangeLayer::MapChangeLayer(const DistanceField& field)
-    : width_(field.grid().width()), height_(field.grid().height()), frame_(field.grid()) {
+    : width_(field.grid().width()),
+      height_(field.grid().height()),
+      frame_(field.grid()),
+      tiles_x_((width_ + kTileSize - 1) >> kTileBits) {
   const OccupancyGrid& grid = field.grid();
   const std::vector<float>& distance = field.distances();
   cells_.resize(grid.data().size());
@@ -87,8 +111,7 @@ MapChangeLayer::MapChangeLayer(const DistanceField& field)
         break;
     }
   }
-  // counts_ waits for the first scan: a warehouse's map is millions of
-  // cells, and pf_node builds this while the bag has started.
+  tiles_.resize(static_cast<std::size_t>(tiles_x_) * ((height_ + kTileSize - 1) >> kTileBits));
   values_.assign(cells_.size(), valueOf(Cell::kUnseen));
 }
 
@@ -96,7 +119,7 @@ void MapChangeLayer::clear() {
   for (std::size_t i = 0; i < values_.size(); ++i) {
     if (removed(i) || added(i)) changed_cells_.push_back(i);
   }
-  counts_.clear();
+  for (std::unique_ptr<Counts[]>& tile : tiles_) tile.reset();
   for (std::uint8_t& c : cells_) c &= kMapBits;
   std::fill(values_.begin(), values_.end(), valueOf(Cell::kUnseen));
   summary_ = Summary();
@@ -109,7 +132,6 @@ bool MapChangeLayer::wants(const Pose2& robot) const {
 }
 
 void MapChangeLayer::add(const ScanGroup& scans, const Pose2& robot) {
-  if (counts_.empty()) counts_.resize(cells_.size());
   for (const LaserScan& scan : scans) {
     const std::size_t n = scan.ranges.size();
     const Pose2 base = compose(robot, scan.robot_offset);
@@ -195,7 +217,7 @@ void MapChangeLayer::end(double x, double y) {
 
 MapChangeLayer::Cell MapChangeLayer::classify(std::size_t i) const {
   if (!(cells_[i] & kSeen)) return Cell::kUnseen;
-  const Counts& c = counts_[i];
+  const Counts& c = countsAt(i);
   const int hits = c.hits, passes = c.passes;
   const int stopped = hits + c.free, reached = passes + c.ends;
   if (hits >= kMinScans && hits >= kChangedShare * stopped) return Cell::kAdded;

@@ -19,6 +19,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "pf_localization/core/map/distance_field.h"
@@ -119,6 +120,17 @@ class MapChangeLayer {
   enum MapCell : std::uint8_t { kMapFree, kMapBeside, kMapOccupied, kMapUnknown, kMapBits = 3 };
   enum Flag : std::uint8_t { kSeen = 4, kWasHit = 8 };
 
+  // Square tiles of kTileSize cells a side hold the counts, each made when a
+  // beam first counts in it: a beam reaches kMaxRange at most, so a run
+  // touches the tiles along its path, not a warehouse's millions of cells.
+  static constexpr int kTileBits = 5;
+  static constexpr int kTileSize = 1 << kTileBits;
+  // Cell i's counts (its tile made if it was not); zeros in a tile not made.
+  Counts& countsAt(std::size_t i);
+  const Counts& countsAt(std::size_t i) const;
+  // The index in tiles_ of cell i's tile, and of the cell in its tile.
+  std::size_t tileOf(std::size_t i, std::size_t* in_tile) const;
+
   Cell classify(std::size_t i) const;
   // Counts `kind` in cell i, once per scan.
   void count(std::size_t i, Kind kind);
@@ -132,12 +144,13 @@ class MapChangeLayer {
   void end(double x, double y);
 
   int width_, height_;
-  GridFrame frame_;                  // to walk in cells
-  std::vector<std::uint8_t> cells_;  // MapCell | Flag
-  std::vector<Counts> counts_;
-  std::vector<std::int8_t> values_;         // occupancy()
-  Summary summary_;                         // of values_
-  std::vector<std::size_t> changed_cells_;  // takeChangedCells()
+  GridFrame frame_;                               // to walk in cells
+  std::vector<std::uint8_t> cells_;               // MapCell | Flag
+  int tiles_x_;                                   // tiles per row
+  std::vector<std::unique_ptr<Counts[]>> tiles_;  // row-major; null: no count yet
+  std::vector<std::int8_t> values_;               // occupancy()
+  Summary summary_;                               // of values_
+  std::vector<std::size_t> changed_cells_;        // takeChangedCells()
   std::size_t scans_ = 0;
   Pose2 last_;  // the robot pose of the last scan added
 };
