@@ -21,41 +21,20 @@ DistanceFieldRayCaster::DistanceFieldRayCaster(const OccupancyGrid& grid)
     }
   }
   const std::vector<float> d2 = squaredDistanceTransform(occupied, w, h);
-  fill(grid, [&d2, w](int x, int y) { return std::sqrt(d2[static_cast<std::size_t>(y) * w + x]); });
-}
-
-DistanceFieldRayCaster::DistanceFieldRayCaster(const DistanceField& field)
-    : stride_(field.grid().width() + 2),
-      rows_(field.grid().height() + 2),
-      resolution_(field.grid().resolution()),
-      origin_(field.grid().origin()) {
-  const int w = field.grid().width();
-  const float inv = static_cast<float>(1.0 / resolution_);
-  const std::vector<float>& d = field.distances();
-  fill(field.grid(),
-       [&d, w, inv](int x, int y) { return d[static_cast<std::size_t>(y) * w + x] * inv; });
-}
-
-template <typename Cells>
-void DistanceFieldRayCaster::fill(const OccupancyGrid& grid, Cells cells) {
-  const int w = grid.width(), h = grid.height();
   skip_.assign(static_cast<std::size_t>(stride_) * rows_, kOutside);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * w + x;
       float& s = skip_[static_cast<std::size_t>(y + 1) * stride_ + x + 1];
-      if (grid.state({x, y}) == CellState::kOccupied) {
+      if (occupied[i]) {
         s = kOccupied;
       } else {
         // No obstacle at all: infinity, and any ray runs to max_range or the border.
-        const float d = cells(x, y);
+        const float d = std::sqrt(d2[i]);
         s = d > 1.5f ? d - 1.5f : 0.0f;
       }
     }
   }
-}
-
-void DistanceFieldRayCaster::setOpen(int x, int y, bool open) {
-  skip_[static_cast<std::size_t>(y + 1) * stride_ + x + 1] = open ? 0.0f : kOccupied;
 }
 
 double DistanceFieldRayCaster::cast(double x, double y, double angle, double max_range) const {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace pf {
 
@@ -42,21 +43,60 @@ void add(BeamEvidence e, EvidenceCounts* c) {
 }  // namespace
 
 MapEvidence::MapEvidence(const DistanceField& field)
-    : field_(&field), caster_(field), frame_(field.grid()) {}
+    : field_(&field),
+      frame_(field.grid()),
+      cells_per_metre_(static_cast<float>(1.0 / field.grid().resolution())) {}
 
 void MapEvidence::setGone(std::size_t cell, bool gone) {
-  const OccupancyGrid& grid = field_->grid();
-  const CellIndex c = grid.cellOf(static_cast<int>(cell));
   // Only a mapped obstacle can be gone.
-  if (grid.state(c) == CellState::kOccupied) caster_.setOpen(c.x, c.y, gone);
+  if (!gone) {
+    gone_.erase(cell);
+  } else if (OccupancyGrid::classify(field_->grid().data()[cell]) == CellState::kOccupied) {
+    gone_.insert(cell);
+  }
 }
 
 void MapEvidence::setAdded(std::size_t cell, bool added) {
-  if (added_.empty()) {
-    if (!added) return;
-    added_.assign(field_->grid().data().size(), 0);
+  if (added) {
+    added_.insert(cell);
+  } else {
+    added_.erase(cell);
   }
-  added_[cell] = added ? 1 : 0;
+}
+
+double MapEvidence::cast(double cx, double cy, double dx, double dy, double max_range) const {
+  // The arithmetic of DistanceFieldRayCaster::castInCells on a table with a
+  // one-cell border (cell (0, 0) of the map is (1, 1) there), each cell's
+  // jump worked out when the ray reaches it.
+  constexpr double kNudge = 1e-6;
+  const OccupancyGrid& grid = field_->grid();
+  const std::vector<float>& distance = field_->distances();
+  const int w = grid.width(), h = grid.height();
+  const double resolution = grid.resolution();
+  const double limit = max_range / resolution;
+  const double sx = cx + 1.0, sy = cy + 1.0;
+  const double inf = std::numeric_limits<double>::infinity();
+  double t = 0.0;
+  while (t < limit) {
+    const double fx = sx + t * dx, fy = sy + t * dy;
+    if (!(fx >= 0.0 && fy >= 0.0 && fx < w + 2 && fy < h + 2)) return max_range;
+    const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
+    if (ix == 0 || iy == 0 || ix > w || iy > h) return max_range;  // the border
+    const std::size_t i = static_cast<std::size_t>(iy - 1) * w + (ix - 1);
+    // An occupied cell is 0 from the nearest occupied cell: never a jump.
+    const float cells = distance[i] * cells_per_metre_;
+    if (cells > 1.5f) {
+      t += cells - 1.5f;
+      continue;
+    }
+    if (OccupancyGrid::classify(grid.data()[i]) == CellState::kOccupied && gone_.count(i) == 0) {
+      return t * resolution;
+    }
+    const double tx = dx > 0.0 ? (ix + 1 - fx) / dx : dx < 0.0 ? (ix - fx) / dx : inf;
+    const double ty = dy > 0.0 ? (iy + 1 - fy) / dy : dy < 0.0 ? (iy - fy) / dy : inf;
+    t += std::min(tx, ty) + kNudge;
+  }
+  return max_range;
 }
 
 bool MapEvidence::endsOnAdded(double x, double y) const {
@@ -68,7 +108,9 @@ bool MapEvidence::endsOnAdded(double x, double y) const {
   for (int dy = -1; dy <= 1; ++dy) {
     for (int dx = -1; dx <= 1; ++dx) {
       const CellIndex n{c.x + dx, c.y + dy};
-      if (grid.contains(n) && added_[static_cast<std::size_t>(grid.linearIndex(n))]) return true;
+      if (grid.contains(n) && added_.count(static_cast<std::size_t>(grid.linearIndex(n)))) {
+        return true;
+      }
     }
   }
   return false;
@@ -100,7 +142,7 @@ BeamEvidence MapEvidence::judgeRay(double sx, double sy, double ux, double uy, d
   // obstacle before it matters, and the cast stops there (the last cells
   // before a wall are the ones it crosses one at a time).
   const double reach = d <= kBesideObstacle ? range - kThroughMargin : range + kShortMargin;
-  const double expected = caster_.castInCells(cx, cy, gx, gy, reach);
+  const double expected = cast(cx, cy, gx, gy, reach);
   // An end clear of the map's obstacles, on an object learned added (an
   // object moved a little behind where the map has it), is a change of the
   // map however near the map's obstacle it lies.

@@ -24,7 +24,6 @@
 
 #include <vector>
 
-#include "pf_localization/core/map/distance_field.h"
 #include "pf_localization/core/map/occupancy_grid.h"
 #include "pf_localization/core/util/pose2.h"
 
@@ -33,10 +32,6 @@ namespace pf {
 class DistanceFieldRayCaster {
  public:
   explicit DistanceFieldRayCaster(const OccupancyGrid& grid);
-  /// The same from a likelihood field's distances, without a transform of
-  /// its own: capped at the field's max_distance, they only shorten the jumps
-  /// through open space, and every range is the same.
-  explicit DistanceFieldRayCaster(const DistanceField& field);
 
   /// The range in metres from (x, y) along `angle` (world frame) to the first
   /// occupied cell, or max_range when there is none within max_range on the map.
@@ -46,21 +41,10 @@ class DistanceFieldRayCaster {
   /// (max_range too): the form the beam model's inner loop uses.
   double castInCells(double cx, double cy, double dx, double dy, double max_range) const;
 
-  /// Lets rays through the map's occupied cell (x, y) (`open`: the obstacle
-  /// is gone), or stops them there again. The skip distances around it stay:
-  /// measured to an obstacle that no longer stops rays, they are only shorter
-  /// than they could be, and every range is still exact.
-  void setOpen(int x, int y, bool open);
-
   double resolution() const { return resolution_; }
   const Pose2& origin() const { return origin_; }
 
  private:
-  // The skip table from each cell's distance in cells to the nearest occupied
-  // cell's centre (`cells(x, y)`).
-  template <typename Cells>
-  void fill(const OccupancyGrid& grid, Cells cells);
-
   // Per cell of the bordered table: kOccupied, kOutside, or the distance in
   // cells the ray may jump from anywhere in the cell (0: walk to the next cell).
   static constexpr float kOccupied = -1.0f;

@@ -14,8 +14,9 @@
 // "Lifelong localization in changing environments", IJRR 2013), and the
 // beam model's short and max readings (Thrun et al., "Probabilistic
 // Robotics", 2005, sec. 6.3) judged once per beam at one pose instead of per
-// particle. The ray is cast on the occupancy grid with the beam model's ray
-// caster (distance_field_ray_caster.h), on the map as the change layer has
+// particle. The ray is cast on the occupancy grid by sphere tracing on the
+// likelihood field's own distances, as the beam model's ray caster does on
+// its table (distance_field_ray_caster.h), on the map as the change layer has
 // learned it (map_change_layer.h; the temporary map of Meyer-Delius et al.
 // used for the judging): rays pass the obstacles it has seen gone, and a
 // beam that ends on an object it has seen added sees a change. See
@@ -24,10 +25,10 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <unordered_set>
 #include <vector>
 
 #include "pf_localization/core/map/distance_field.h"
-#include "pf_localization/core/map/distance_field_ray_caster.h"
 #include "pf_localization/core/sensor/laser_scan.h"
 #include "pf_localization/core/sensor/sensor_model.h"
 #include "pf_localization/core/util/pose2.h"
@@ -92,8 +93,8 @@ class MapEvidence {
   static constexpr double kShortMargin = 0.25;
   static constexpr double kBesideObstacle = 0.1;
 
-  /// Casts rays on `field`'s grid (builds the ray caster: one distance
-  /// transform of the map).
+  /// Casts rays on `field`'s grid, through its distances: nothing per cell
+  /// of its own.
   explicit MapEvidence(const DistanceField& field);
 
   const DistanceField& field() const { return *field_; }
@@ -133,11 +134,19 @@ class MapEvidence {
   bool endsOnAdded(double x, double y) const;
   // judge() along the unit vector (ux, uy).
   BeamEvidence judgeRay(double sx, double sy, double ux, double uy, double range) const;
+  // The range from (cx, cy) along (dx, dy), both in cells of the grid's frame,
+  // to the first occupied cell not gone, or max_range when there is none
+  // within it on the map: DistanceFieldRayCaster::castInCells's sphere
+  // tracing, its jumps taken from the field's distances as it goes rather
+  // than from a table of the map's size, range for range the same.
+  double cast(double cx, double cy, double dx, double dy, double max_range) const;
 
   const DistanceField* field_;
-  DistanceFieldRayCaster caster_;
-  GridFrame frame_;                  // to cast in cells
-  std::vector<std::uint8_t> added_;  // per cell: setAdded() (empty until one is)
+  GridFrame frame_;  // to cast in cells
+  float cells_per_metre_;
+  // Cells (row-major indices) learned gone (setGone) and added (setAdded):
+  // a few hundred where a map of millions of cells is out of date.
+  std::unordered_set<std::size_t> gone_, added_;
 };
 
 }  // namespace pf
