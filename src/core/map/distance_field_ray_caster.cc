@@ -21,13 +21,13 @@ DistanceFieldRayCaster::DistanceFieldRayCaster(const OccupancyGrid& grid)
     }
   }
   const std::vector<float> d2 = squaredDistanceTransform(occupied, w, h);
-  skip_.assign(static_cast<std::size_t>(stride_) * rows_, kOutside);
+  skip_.assign(static_cast<std::size_t>(stride_) * rows_, kTraceLeaves);
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * w + x;
       float& s = skip_[static_cast<std::size_t>(y + 1) * stride_ + x + 1];
       if (occupied[i]) {
-        s = kOccupied;
+        s = kTraceStops;
       } else {
         // No obstacle at all: infinity, and any ray runs to max_range or the border.
         const float d = std::sqrt(d2[i]);
@@ -47,31 +47,9 @@ double DistanceFieldRayCaster::cast(double x, double y, double angle, double max
 
 double DistanceFieldRayCaster::castInCells(double cx, double cy, double dx, double dy,
                                            double max_range) const {
-  // Past a cell boundary by this much (in cells), so that the next lookup is
-  // in the next cell; 1e-6 cells is far below any range resolution.
-  constexpr double kNudge = 1e-6;
-  const double limit = max_range / resolution_;
-  // Bordered coordinates: cell (0, 0) of the map is (1, 1) of the table.
-  const double sx = cx + 1.0, sy = cy + 1.0;
-  const double inf = std::numeric_limits<double>::infinity();
-  double t = 0.0;
-  while (t < limit) {
-    const double fx = sx + t * dx, fy = sy + t * dy;
-    // Compared as doubles first: a point far outside must not become an undefined int.
-    if (!(fx >= 0.0 && fy >= 0.0 && fx < stride_ && fy < rows_)) return max_range;
-    const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
-    const float v = skip_[static_cast<std::size_t>(iy) * stride_ + ix];
-    if (v == kOccupied) return t * resolution_;
-    if (v == kOutside) return max_range;
-    if (v > 0.0f) {
-      t += v;
-      continue;
-    }
-    const double tx = dx > 0.0 ? (ix + 1 - fx) / dx : dx < 0.0 ? (ix - fx) / dx : inf;
-    const double ty = dy > 0.0 ? (iy + 1 - fy) / dy : dy < 0.0 ? (iy - fy) / dy : inf;
-    t += std::min(tx, ty) + kNudge;
-  }
-  return max_range;
+  return sphereTrace(cx, cy, dx, dy, max_range, resolution_, stride_, rows_, [this](int x, int y) {
+    return skip_[static_cast<std::size_t>(y) * stride_ + x];
+  });
 }
 
 }  // namespace pf

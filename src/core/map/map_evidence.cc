@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
+
+#include "pf_localization/core/map/distance_field_ray_caster.h"
 
 namespace pf {
 
@@ -65,38 +66,21 @@ void MapEvidence::setAdded(std::size_t cell, bool added) {
 }
 
 double MapEvidence::cast(double cx, double cy, double dx, double dy, double max_range) const {
-  // The arithmetic of DistanceFieldRayCaster::castInCells on a table with a
-  // one-cell border (cell (0, 0) of the map is (1, 1) there), each cell's
-  // jump worked out when the ray reaches it.
-  constexpr double kNudge = 1e-6;
+  // DistanceFieldRayCaster's trace, each cell's jump worked out from the
+  // field's distance as the ray reaches it rather than read from a table.
   const OccupancyGrid& grid = field_->grid();
   const std::vector<float>& distance = field_->distances();
   const int w = grid.width(), h = grid.height();
-  const double resolution = grid.resolution();
-  const double limit = max_range / resolution;
-  const double sx = cx + 1.0, sy = cy + 1.0;
-  const double inf = std::numeric_limits<double>::infinity();
-  double t = 0.0;
-  while (t < limit) {
-    const double fx = sx + t * dx, fy = sy + t * dy;
-    if (!(fx >= 0.0 && fy >= 0.0 && fx < w + 2 && fy < h + 2)) return max_range;
-    const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
-    if (ix == 0 || iy == 0 || ix > w || iy > h) return max_range;  // the border
-    const std::size_t i = static_cast<std::size_t>(iy - 1) * w + (ix - 1);
+  return sphereTrace(cx, cy, dx, dy, max_range, grid.resolution(), w + 2, h + 2, [&](int x, int y) {
+    if (x == 0 || y == 0 || x > w || y > h) return kTraceLeaves;  // the border
+    const std::size_t i = static_cast<std::size_t>(y - 1) * w + (x - 1);
     // An occupied cell is 0 from the nearest occupied cell: never a jump.
     const float cells = distance[i] * cells_per_metre_;
-    if (cells > 1.5f) {
-      t += cells - 1.5f;
-      continue;
-    }
-    if (OccupancyGrid::classify(grid.data()[i]) == CellState::kOccupied && gone_.count(i) == 0) {
-      return t * resolution;
-    }
-    const double tx = dx > 0.0 ? (ix + 1 - fx) / dx : dx < 0.0 ? (ix - fx) / dx : inf;
-    const double ty = dy > 0.0 ? (iy + 1 - fy) / dy : dy < 0.0 ? (iy - fy) / dy : inf;
-    t += std::min(tx, ty) + kNudge;
-  }
-  return max_range;
+    if (cells > 1.5f) return cells - 1.5f;
+    const bool stops =
+        OccupancyGrid::classify(grid.data()[i]) == CellState::kOccupied && gone_.count(i) == 0;
+    return stops ? kTraceStops : 0.0f;
+  });
 }
 
 bool MapEvidence::endsOnAdded(double x, double y) const {

@@ -22,12 +22,55 @@
 // max_range.
 #pragma once
 
+#include <algorithm>
+#include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "pf_localization/core/map/occupancy_grid.h"
 #include "pf_localization/core/util/pose2.h"
 
 namespace pf {
+
+/// What a sphere trace's lookup says of a cell besides how far to jump.
+constexpr float kTraceStops = -1.0f;   // an obstacle: the range is where the ray enters it
+constexpr float kTraceLeaves = -2.0f;  // outside the map: max_range
+
+/// Sphere tracing on a grid of `columns` x `rows` cells with a one-cell
+/// border (the map's cell (0, 0) is (1, 1) here) from (cx, cy) along the
+/// unit vector (dx, dy), both in the map's cells: `skip(ix, iy)` says of a
+/// bordered cell kTraceStops, kTraceLeaves, or how many cells the ray may
+/// jump from anywhere in it (0: walk to the next cell). The range in metres
+/// (`resolution` a cell) where the ray enters the first cell that stops it,
+/// or max_range when none does within max_range.
+template <typename Skip>
+double sphereTrace(double cx, double cy, double dx, double dy, double max_range, double resolution,
+                   int columns, int rows, const Skip& skip) {
+  // Past a cell boundary by this much (in cells), so that the next lookup is
+  // in the next cell; 1e-6 cells is far below any range resolution.
+  constexpr double kNudge = 1e-6;
+  const double limit = max_range / resolution;
+  const double sx = cx + 1.0, sy = cy + 1.0;
+  const double inf = std::numeric_limits<double>::infinity();
+  double t = 0.0;
+  while (t < limit) {
+    const double fx = sx + t * dx, fy = sy + t * dy;
+    // Compared as doubles first: a point far outside must not become an undefined int.
+    if (!(fx >= 0.0 && fy >= 0.0 && fx < columns && fy < rows)) return max_range;
+    const int ix = static_cast<int>(fx), iy = static_cast<int>(fy);
+    const float v = skip(ix, iy);
+    if (v == kTraceStops) return t * resolution;
+    if (v == kTraceLeaves) return max_range;
+    if (v > 0.0f) {
+      t += v;
+      continue;
+    }
+    const double tx = dx > 0.0 ? (ix + 1 - fx) / dx : dx < 0.0 ? (ix - fx) / dx : inf;
+    const double ty = dy > 0.0 ? (iy + 1 - fy) / dy : dy < 0.0 ? (iy - fy) / dy : inf;
+    t += std::min(tx, ty) + kNudge;
+  }
+  return max_range;
+}
 
 class DistanceFieldRayCaster {
  public:
@@ -45,10 +88,7 @@ class DistanceFieldRayCaster {
   const Pose2& origin() const { return origin_; }
 
  private:
-  // Per cell of the bordered table: kOccupied, kOutside, or the distance in
-  // cells the ray may jump from anywhere in the cell (0: walk to the next cell).
-  static constexpr float kOccupied = -1.0f;
-  static constexpr float kOutside = -2.0f;
+  // Per cell of the bordered table: what sphereTrace's lookup says of it.
   std::vector<float> skip_;
   int stride_ = 0;
   int rows_ = 0;
