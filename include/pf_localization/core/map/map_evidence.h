@@ -136,9 +136,9 @@ class MapEvidence {
   BeamEvidence judgeRay(double sx, double sy, double ux, double uy, double range) const;
   // The range from (cx, cy) along (dx, dy), both in cells of the grid's frame,
   // to the first occupied cell not gone, or max_range when there is none
-  // within it on the map: DistanceFieldRayCaster::castInCells's sphere
-  // tracing, its jumps taken from the field's distances as it goes rather
-  // than from a table of the map's size, range for range the same.
+  // within it on the map: sphereTrace (distance_field_ray_caster.h), each
+  // cell's jump worked out from the field's distance as the ray reaches it
+  // rather than read from a table of the map's size.
   double cast(double cx, double cy, double dx, double dy, double max_range) const;
 
   const DistanceField* field_;
