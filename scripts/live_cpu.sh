@@ -17,6 +17,8 @@
 #   runner_p10, runner_kld, runner_fixed5000  pf_bag_runner on the same bag
 #              with the same particles, at the replay's pace: the filter's own
 #              work (its updates and the map's set-up)
+#   runner_fixed500, runner_fixed2000, runner_fixed10000  the same with 500,
+#              2 000 and 10 000 fixed particles: how that work grows
 # Prints a line per run: whole-process CPU s, the ATE RMSE for pf_node, and
 # the CPU of each thread (pf_* are pf_node's own, named; main is the main
 # spinner; the unnamed others are roscpp's: the poll thread is the busiest),
@@ -32,7 +34,7 @@ set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 rounds=${1:-3}
 modes=${LIVE_CPU_MODES:-wall sim}
-runs=${LIVE_CPU_RUNS:-floor p10 kld fixed5000 runner_p10 runner_kld runner_fixed5000}
+runs=${LIVE_CPU_RUNS:-floor p10 kld fixed5000 runner_p10 runner_kld runner_fixed5000 runner_fixed500 runner_fixed2000 runner_fixed10000}
 shared=$(cd "$repo/.." && pwd)/shared
 data=$shared/data/neato_ac109_1
 if [ ! -f "$data/ac109_1.bag" ] || [ ! -x "$shared/tools/run_localizer.sh" ]; then
@@ -177,7 +179,9 @@ for r in $(seq "$rounds"); do
   done
   if has runner_p10; then runner runner_p10 "max_particles: 10" "min_particles: 10"; fi
   if has runner_kld; then runner runner_kld "max_particles: 5000"; fi
-  if has runner_fixed5000; then runner runner_fixed5000 "max_particles: 5000" "min_particles: 5000"; fi
+  for n in 500 2000 5000 10000; do
+    if has runner_fixed$n; then runner runner_fixed$n "max_particles: $n" "min_particles: $n"; fi
+  done
 done | tee "$out/runs.txt"
 
 median() {
@@ -199,5 +203,14 @@ for mode in $modes; do
     fi
     echo "$line"
   done
+done
+echo "the filter's own work at the replay's pace, fixed particles (pf_bag_runner, CPU s):"
+for mode in $modes; do
+  line=$(printf '  %-5s' "$mode")
+  for n in 500 2000 5000 10000; do
+    m=$(median "$mode" runner_fixed$n)
+    if [ -n "$m" ]; then line+=$(printf "   %5d: %s s" "$n" "$m"); fi
+  done
+  echo "$line"
 done
 echo "runs in $out"
