@@ -68,12 +68,17 @@ pf_source_workspace() {
 # or a random number above 32767) can be taken between the draw and roscore's
 # start by the XML-RPC server of any ROS node, or by rostest's own master, which
 # binds port 0: in a test run that starts dozens of nodes this happens.
+# PF_FREE_PORT_RANGE="LOW HIGH" draws from [LOW, HIGH) instead (for its test,
+# which holds ports of a range no other script draws from).
 pf_free_port() {
   /usr/bin/python3 - <<'PY'
-import random, socket
-low = int(open('/proc/sys/net/ipv4/ip_local_port_range').read().split()[0])
-high = low if low > 21000 else 65536  # no range below it: any port will do
-for port in random.sample(range(20000, high), 200):
+import os, random, socket
+if os.environ.get('PF_FREE_PORT_RANGE'):
+    first, high = (int(v) for v in os.environ['PF_FREE_PORT_RANGE'].split())
+else:
+    low = int(open('/proc/sys/net/ipv4/ip_local_port_range').read().split()[0])
+    first, high = 20000, low if low > 21000 else 65536  # no range below it: any port will do
+for port in random.sample(range(first, high), min(200, high - first)):
     with socket.socket() as s:
         try:
             s.bind(('localhost', port))
@@ -82,6 +87,6 @@ for port in random.sample(range(20000, high), 200):
     print(port)
     break
 else:
-    raise SystemExit('pf_free_port: no free port in 20000-%d' % (high - 1))
+    raise SystemExit('pf_free_port: no free port in %d-%d' % (first, high - 1))
 PY
 }
