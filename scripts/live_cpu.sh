@@ -34,7 +34,9 @@ set -euo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
 rounds=${1:-3}
 modes=${LIVE_CPU_MODES:-wall sim}
-runs=${LIVE_CPU_RUNS:-floor p10 kld fixed5000 runner_p10 runner_kld runner_fixed5000 runner_fixed500 runner_fixed2000 runner_fixed10000}
+fixed_counts="500 2000 5000 10000"  # the runner_fixedN runs' particles
+# shellcheck disable=SC2086 # the counts are words
+runs=${LIVE_CPU_RUNS:-floor p10 kld fixed5000 runner_p10 runner_kld $(printf 'runner_fixed%s ' $fixed_counts)}
 shared=$(cd "$repo/.." && pwd)/shared
 data=$shared/data/neato_ac109_1
 if [ ! -f "$data/ac109_1.bag" ] || [ ! -x "$shared/tools/run_localizer.sh" ]; then
@@ -179,8 +181,8 @@ for r in $(seq "$rounds"); do
   done
   if has runner_p10; then runner runner_p10 "max_particles: 10" "min_particles: 10"; fi
   if has runner_kld; then runner runner_kld "max_particles: 5000"; fi
-  for n in 500 2000 5000 10000; do
-    if has runner_fixed$n; then runner runner_fixed$n "max_particles: $n" "min_particles: $n"; fi
+  for n in $fixed_counts; do
+    if has "runner_fixed$n"; then runner "runner_fixed$n" "max_particles: $n" "min_particles: $n"; fi
   done
 done | tee "$out/runs.txt"
 
@@ -207,8 +209,8 @@ done
 echo "the filter's own work at the replay's pace, fixed particles (pf_bag_runner, CPU s):"
 for mode in $modes; do
   line=$(printf '  %-5s' "$mode")
-  for n in 500 2000 5000 10000; do
-    m=$(median "$mode" runner_fixed$n)
+  for n in $fixed_counts; do
+    m=$(median "$mode" "runner_fixed$n")
     if [ -n "$m" ]; then line+=$(printf "   %5d: %s s" "$n" "$m"); fi
   done
   echo "$line"
