@@ -28,9 +28,8 @@ OccupancyGrid::OccupancyGrid(int width, int height, double resolution, const Pos
                                 " cell values for a " + std::to_string(width) + " x " +
                                 std::to_string(height) + " grid");
   }
-  for (int i = 0; i < static_cast<int>(data_.size()); ++i) {
-    if (classify(data_[i]) == CellState::kFree) free_cells_.push_back(i);
-  }
+  free_cells_ = FreeCells(data_.size(),
+                          [this](std::size_t i) { return classify(data_[i]) == CellState::kFree; });
 }
 
 CellState OccupancyGrid::classify(int8_t value) {

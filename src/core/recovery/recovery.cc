@@ -186,7 +186,7 @@ void Recovery::reserve(std::size_t n) {
 }
 
 Pose2 randomFreePose(const OccupancyGrid& grid, Random* random) {
-  const std::vector<int>& free = grid.freeCells();
+  const FreeCells& free = grid.freeCells();
   const int cell = free[random->index(free.size())];
   const CellIndex c = grid.cellOf(cell);
   // Anywhere inside the cell, not only its centre.

@@ -156,7 +156,10 @@ TEST(ConversionsTest, GridToCore) {
   EXPECT_EQ(g.origin().y, 4.0);
   EXPECT_EQ(g.origin().yaw, 0.0);
   EXPECT_EQ(g.data(), std::vector<int8_t>({0, 100, -1, 50, 0, 0}));
-  EXPECT_EQ(g.freeCells(), std::vector<int>({0, 4, 5}));
+  ASSERT_EQ(3u, g.freeCells().size());
+  EXPECT_EQ(0, g.freeCells()[0]);
+  EXPECT_EQ(4, g.freeCells()[1]);
+  EXPECT_EQ(5, g.freeCells()[2]);
 }
 
 TEST(ConversionsTest, GridToCoreRejectsMalformedGrids) {

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "pf_localization/core/map/free_cells.h"
 #include "pf_localization/core/util/pose2.h"
 
 namespace pf {
@@ -67,8 +68,9 @@ class OccupancyGrid {
   /// True when the world point lies in a free cell of the map.
   bool isFreeAt(double wx, double wy) const;
 
-  /// Linear indices of all free cells, in increasing order.
-  const std::vector<int>& freeCells() const { return free_cells_; }
+  /// The free cells: their count, and the k-th one's linear index in
+  /// increasing order.
+  const FreeCells& freeCells() const { return free_cells_; }
 
  private:
   int width_ = 0;
@@ -76,7 +78,7 @@ class OccupancyGrid {
   double resolution_ = 0.0;
   Pose2 origin_;
   std::vector<int8_t> data_;
-  std::vector<int> free_cells_;
+  FreeCells free_cells_;
 };
 
 /// A grid's frame in cells, for walking rays cell by cell: world points and
