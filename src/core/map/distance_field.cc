@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include "pf_localization/core/map/distance_transform.h"
 
@@ -28,7 +29,6 @@ DistanceField::DistanceField(const OccupancyGrid& grid, double max_distance)
   // map whose obstacles are all that thin (a real map's walls) needs no second
   // transform: its surface distances are its distances.
   if (!hasDeepCells(occupied, grid.width(), grid.height())) return;
-  surface_distances_ = distances_;
   addDepths(occupied, grid.width(), grid.height(), res, cap);
 }
 
@@ -60,13 +60,25 @@ void DistanceField::addDepths(const std::vector<bool>& occupied, int width, int 
           !occupied[static_cast<std::size_t>(y + y0) * width + x + x0];
     }
   }
-  const std::vector<float> depth = squaredDistanceTransform(open, w, h);
+  std::vector<float> depth = squaredDistanceTransform(open, w, h);
+  const auto surface = [&](float squared) {
+    return std::min(std::max(std::sqrt(squared) - 1.0f - kFreeDepth, 0.0f) * res, cap);
+  };
+  if (w == width && h == height) {
+    // The box is the whole map (walls round it): the depths' own array
+    // becomes the surface distances, and no third array of the map's size
+    // is held at once.
+    for (std::size_t i = 0; i < depth.size(); ++i) {
+      depth[i] = occupied[i] ? surface(depth[i]) : distances_[i];
+    }
+    surface_distances_ = std::move(depth);
+    return;
+  }
+  surface_distances_ = distances_;
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       const std::size_t i = static_cast<std::size_t>(y + y0) * width + x + x0;
-      if (!occupied[i]) continue;
-      const float d = std::sqrt(depth[static_cast<std::size_t>(y) * w + x]);
-      surface_distances_[i] = std::min(std::max(d - 1.0f - kFreeDepth, 0.0f) * res, cap);
+      if (occupied[i]) surface_distances_[i] = surface(depth[static_cast<std::size_t>(y) * w + x]);
     }
   }
 }

@@ -48,8 +48,8 @@ class DistanceField {
   // Whether any occupied cell lies deeper than 1 + kFreeDepth cells inside
   // its obstacle (the only cells whose surface distance is not 0).
   static bool hasDeepCells(const std::vector<bool>& occupied, int width, int height);
-  // Writes into surface_distances_ each occupied cell's depth past the
-  // surface (res: metres per cell; cap: max_distance).
+  // Makes surface_distances_: distances_, with each occupied cell's depth
+  // past the surface (res: metres per cell; cap: max_distance).
   void addDepths(const std::vector<bool>& occupied, int width, int height, float res, float cap);
 
   OccupancyGrid grid_;
