@@ -14,7 +14,7 @@
 
 namespace pf {
 
-std::unique_ptr<SensorModel> makeSensorModel(const OccupancyGrid& grid,
+std::unique_ptr<SensorModel> makeSensorModel(OccupancyGrid grid,
                                              const ParticleFilterParams& params) {
   LikelihoodFieldModelParams sensor = params.sensor;
   sensor.threads = resolvedThreads(params.threads);
@@ -22,13 +22,13 @@ std::unique_ptr<SensorModel> makeSensorModel(const OccupancyGrid& grid,
     case LaserModelType::kBeam:
       return std::make_unique<BeamModel>(grid, sensor, params.beam);
     case LaserModelType::kLikelihoodFieldProb:
-      return std::make_unique<LikelihoodFieldModel>(grid, sensor);
+      return std::make_unique<LikelihoodFieldModel>(std::move(grid), sensor);
     case LaserModelType::kLikelihoodField:
       break;
   }
   // amcl's likelihood_field never skips beams.
   sensor.beam_skip = false;
-  return std::make_unique<LikelihoodFieldModel>(grid, sensor);
+  return std::make_unique<LikelihoodFieldModel>(std::move(grid), sensor);
 }
 
 ParticleFilter::ParticleFilter(const ParticleFilterParams& params)
@@ -96,12 +96,13 @@ void ParticleFilter::setParams(const ParticleFilterParams& params) {
   }
 }
 
-bool ParticleFilter::setMap(const OccupancyGrid& grid) {
+bool ParticleFilter::setMap(OccupancyGrid grid) {
   if (grid.empty()) throw std::invalid_argument("the map is empty");
-  sensor_.setModel(makeSensorModel(grid, params_));
+  sensor_.setModel(makeSensorModel(std::move(grid), params_));
+  const OccupancyGrid& map = sensor_.model().field().grid();
   screen_.setMap(sensor_.model().field());
   estimate_.setMap(sensor_.model().field());
-  if (isInitialized() && grid.isFreeAt(estimate_.pose().x, estimate_.pose().y)) return true;
+  if (isInitialized() && map.isFreeAt(estimate_.pose().x, estimate_.pose().y)) return true;
   particles_.resize(0);  // keeps the reserved storage
   sensor_.stopSearch();
   estimate_.forget();

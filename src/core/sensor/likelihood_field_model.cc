@@ -6,6 +6,7 @@
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #if defined(__x86_64__)
 #include <immintrin.h>
 #endif
@@ -97,19 +98,20 @@ void validate(const LikelihoodFieldModelParams& params) {
                    params.z_hit + params.z_rand);
 }
 
-LikelihoodFieldModel::LikelihoodFieldModel(const OccupancyGrid& grid,
+LikelihoodFieldModel::LikelihoodFieldModel(OccupancyGrid grid,
                                            const LikelihoodFieldModelParams& params)
     : params_((validate(params), params)),
-      field_(std::make_shared<const DistanceField>(grid, params.max_distance)) {
+      field_(std::make_shared<const DistanceField>(std::move(grid), params.max_distance)) {
   if (!params.beam_skip) return;
-  const int stride = grid.width() + 2;
-  near_.assign(static_cast<std::size_t>(stride) * (grid.height() + 2), 0);
+  const OccupancyGrid& map = field_->grid();
+  const int stride = map.width() + 2;
+  near_.assign(static_cast<std::size_t>(stride) * (map.height() + 2), 0);
   const std::vector<float>& dist = field_->distances();
-  for (int y = 0; y < grid.height(); ++y) {
-    for (int x = 0; x < grid.width(); ++x) {
+  for (int y = 0; y < map.height(); ++y) {
+    for (int x = 0; x < map.width(); ++x) {
       // amcl's test: occ_dist < beam_skip_distance.
       near_[static_cast<std::size_t>(y + 1) * stride + x + 1] =
-          dist[static_cast<std::size_t>(y) * grid.width() + x] < params.beam_skip_distance ? 1 : 0;
+          dist[static_cast<std::size_t>(y) * map.width() + x] < params.beam_skip_distance ? 1 : 0;
     }
   }
 }

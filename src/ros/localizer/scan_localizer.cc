@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <utility>
 
 #include "pf_localization/ros/input/conversions.h"
 #include "pf_localization/ros/input/point_cloud.h"
@@ -70,7 +71,7 @@ std::string ScanLocalizer::setMap(const nav_msgs::OccupancyGrid& map) {
     return "ignoring the map: its frame '" + map.header.frame_id + "' is not the global frame '" +
            config_.global_frame + "'";
   }
-  const bool kept = filter_.setMap(grid);
+  const bool kept = filter_.setMap(std::move(grid));
   map_info_ = map.info;
   const bool first = !had_map_;
   had_map_ = true;

@@ -51,9 +51,9 @@
 
 namespace pf {
 
-/// The sensor model `params` names, on `grid`. Throws std::invalid_argument
-/// for an out-of-range parameter.
-std::unique_ptr<SensorModel> makeSensorModel(const OccupancyGrid& grid,
+/// The sensor model `params` names, on `grid` (moved into its field).
+/// Throws std::invalid_argument for an out-of-range parameter.
+std::unique_ptr<SensorModel> makeSensorModel(OccupancyGrid grid,
                                              const ParticleFilterParams& params);
 
 /// What one call to ParticleFilter::update did: each stage's part (the
@@ -97,8 +97,9 @@ class ParticleFilter {
   /// Installs a map (rebuilding the likelihood field). If particles exist and
   /// the current estimate lies in free space of the new map they are kept;
   /// otherwise the filter becomes uninitialised. Returns whether they were kept.
-  /// Throws std::invalid_argument for an empty map.
-  bool setMap(const OccupancyGrid& grid);
+  /// Throws std::invalid_argument for an empty map. The filter keeps `grid`
+  /// (moved in: a large map is not held twice).
+  bool setMap(OccupancyGrid grid);
   bool hasMap() const { return sensor_.hasModel(); }
   /// The sensor model on the map; null without a map.
   const SensorModel* sensorModel() const { return sensor_.get(); }

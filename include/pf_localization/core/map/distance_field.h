@@ -25,8 +25,9 @@ class DistanceField {
   /// real map's walls are blurred over two or three cells).
   static constexpr float kFreeDepth = 1.0f;
 
-  /// Throws std::invalid_argument when max_distance is not positive and finite.
-  DistanceField(const OccupancyGrid& grid, double max_distance);
+  /// Throws std::invalid_argument when max_distance is not positive and
+  /// finite. Keeps `grid` (moved in: a large map is not held twice).
+  DistanceField(OccupancyGrid grid, double max_distance);
 
   double maxDistance() const { return max_distance_; }
   const OccupancyGrid& grid() const { return grid_; }

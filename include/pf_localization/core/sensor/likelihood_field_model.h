@@ -76,8 +76,9 @@ void validate(const LikelihoodFieldModelParams& params);
 
 class LikelihoodFieldModel : public SensorModel {
  public:
-  /// Throws std::invalid_argument naming the parameter when one is out of range.
-  LikelihoodFieldModel(const OccupancyGrid& grid, const LikelihoodFieldModelParams& params);
+  /// Throws std::invalid_argument naming the parameter when one is out of
+  /// range. Its field keeps `grid` (moved in).
+  LikelihoodFieldModel(OccupancyGrid grid, const LikelihoodFieldModelParams& params);
 
   const LikelihoodFieldModelParams& params() const { return params_; }
   const DistanceField& field() const override { return *field_; }
