@@ -137,13 +137,16 @@ PreparedScan LikelihoodFieldModel::prepare(const LaserScan& scan, int max_beams)
                      field_->grid().resolution());
 }
 
-void LikelihoodFieldModel::buildTable(double range_max) const {
-  if (range_max == table_range_max_) return;
+const std::vector<float>& LikelihoodFieldModel::table(double range_max) const {
+  return tables_.get(range_max, [this](double r, std::vector<float>* out) { buildTable(r, out); });
+}
+
+void LikelihoodFieldModel::buildTable(double range_max, std::vector<float>* out) const {
   const OccupancyGrid& grid = field_->grid();
   const int stride = grid.width() + 2;
   const double k = params_.likelihood_exponent;
   const float outside = static_cast<float>(k * beamLogLikelihood(field_->maxDistance(), range_max));
-  table_.assign(static_cast<std::size_t>(stride) * (grid.height() + 2), outside);
+  out->assign(static_cast<std::size_t>(stride) * (grid.height() + 2), outside);
   // The distances take few values (square roots of whole numbers of cells,
   // and the cap), so each value's exp and log are computed once, not once per
   // cell: a direct-mapped memo keyed by the float's bits (a distance is never
@@ -162,17 +165,16 @@ void LikelihoodFieldModel::buildTable(double range_max) const {
       std::memcpy(&bits, &d, sizeof bits);
       Memo& m = memo[(bits * 2654435761u) >> (32 - kMemoBits)];
       if (m.bits != bits) m = {bits, static_cast<float>(k * beamLogLikelihood(d, range_max))};
-      table_[static_cast<std::size_t>(y + 1) * stride + x + 1] = m.value;
+      (*out)[static_cast<std::size_t>(y + 1) * stride + x + 1] = m.value;
     }
   }
-  table_range_max_ = range_max;
 }
 
 double LikelihoodFieldModel::logLikelihood(const PreparedScan& scan, const Pose2& pose) const {
   ParticleSet one;
   one.resize(1);
   one.setPose(0, pose);
-  buildTable(scan.range_max);
+  const float* lookup = table(scan.range_max).data();
   const float inv_res = static_cast<float>(1.0 / field_->grid().resolution());
   std::vector<float> bx(scan.size()), by(scan.size());
   for (std::size_t b = 0; b < scan.size(); ++b) {
@@ -180,7 +182,7 @@ double LikelihoodFieldModel::logLikelihood(const PreparedScan& scan, const Pose2
     by[b] = scan.y[b] * inv_res;
   }
   std::vector<double> out;
-  score(bx.data(), by.data(), scan.size(), one, &out);
+  score(lookup, bx.data(), by.data(), scan.size(), one, &out);
   return out[0];
 }
 
@@ -340,10 +342,10 @@ ScoringFrame scoringFrame(const OccupancyGrid& grid, const float* table, const f
 
 }  // namespace
 
-void LikelihoodFieldModel::score(const float* bx, const float* by, std::size_t beams,
-                                 const ParticleSet& particles,
+void LikelihoodFieldModel::score(const float* table, const float* bx, const float* by,
+                                 std::size_t beams, const ParticleSet& particles,
                                  std::vector<double>* log_likelihood) const {
-  const ScoringFrame frame = scoringFrame(field_->grid(), table_.data(), bx, by, beams);
+  const ScoringFrame frame = scoringFrame(field_->grid(), table, bx, by, beams);
   log_likelihood->resize(particles.size());
   // The headings' sines and cosines for the whole cloud at once (sinCos
   // vectorises), not one C library call per particle. Kept per thread: no
@@ -407,7 +409,7 @@ std::vector<uint8_t> LikelihoodFieldModel::keptBeams(const float* bx, const floa
 std::size_t LikelihoodFieldModel::logLikelihoods(const PreparedScan& scan,
                                                  const ParticleSet& particles,
                                                  std::vector<double>* log_likelihood) const {
-  buildTable(scan.range_max);
+  const float* lookup = table(scan.range_max).data();
   const float inv_res = static_cast<float>(1.0 / field_->grid().resolution());
   // End points in cell units, so the inner loop needs no division.
   const std::size_t n = scan.size();
@@ -427,10 +429,10 @@ std::size_t LikelihoodFieldModel::logLikelihoods(const PreparedScan& scan,
       by[used] = by[b];
       ++used;
     }
-    score(bx.data(), by.data(), used, particles, log_likelihood);
+    score(lookup, bx.data(), by.data(), used, particles, log_likelihood);
     return used;
   }
-  score(bx.data(), by.data(), n, particles, log_likelihood);
+  score(lookup, bx.data(), by.data(), n, particles, log_likelihood);
   return n;
 }
 

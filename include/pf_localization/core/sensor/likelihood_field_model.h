@@ -32,6 +32,7 @@
 #include "pf_localization/core/filter/particle_set.h"
 #include "pf_localization/core/map/distance_field.h"
 #include "pf_localization/core/sensor/laser_scan.h"
+#include "pf_localization/core/sensor/likelihood_tables.h"
 #include "pf_localization/core/sensor/sensor_model.h"
 #include "pf_localization/core/util/parameter_table.h"
 
@@ -109,18 +110,19 @@ class LikelihoodFieldModel : public SensorModel {
 
  private:
   LikelihoodFieldModel(const LikelihoodFieldModel& model, double sigma_hit);
-  void buildTable(double range_max) const;
-  void score(const float* bx, const float* by, std::size_t beams, const ParticleSet& particles,
-             std::vector<double>* log_likelihood) const;
+  // The table for scans of `range_max` (built on first use).
+  const std::vector<float>& table(double range_max) const;
+  void buildTable(double range_max, std::vector<float>* out) const;
+  void score(const float* table, const float* bx, const float* by, std::size_t beams,
+             const ParticleSet& particles, std::vector<double>* log_likelihood) const;
   std::vector<uint8_t> keptBeams(const float* bx, const float* by, std::size_t beams,
                                  const ParticleSet& particles) const;
 
   LikelihoodFieldModelParams params_;
   std::shared_ptr<const DistanceField> field_;
-  // The precomputed table: (width + 2) x (height + 2) with a border of
-  // "outside the map" cells, rebuilt only when range_max changes.
-  mutable std::vector<float> table_;
-  mutable double table_range_max_ = -1.0;
+  // The precomputed tables, one per range_max: (width + 2) x (height + 2)
+  // with a border of "outside the map" cells.
+  mutable LikelihoodTables tables_;
   // For beam skipping: 1 where a cell lies within beam_skip_distance of an
   // obstacle, with the same border (0: outside the map agrees with nothing).
   std::vector<uint8_t> near_;
