@@ -110,6 +110,11 @@ bool ParticleFilter::setMap(OccupancyGrid grid) {
   return false;
 }
 
+void ParticleFilter::expectScanRange(double range_max) {
+  if (!std::isfinite(range_max) || !(range_max > 0.0)) return;
+  sensor_.expectRange(scoredRangeMax(range_max, params_.sensor.range_max));
+}
+
 void ParticleFilter::initializeGaussian(const Pose2& mean, const Eigen::Matrix3d& cov) {
   if (!mean.isFinite()) throw std::invalid_argument("initial pose is not finite");
   if (!cov.allFinite() || !cov.isApprox(cov.transpose(), 1e-9)) {

@@ -10,7 +10,7 @@ PreparedScan prepareScan(const LaserScan& scan, int max_beams, double range_min,
   std::size_t valid = 0;
   const std::vector<Beam> beams = selectBeams(scan, max_beams, range_min, range_max, &valid);
   PreparedScan out;
-  out.range_max = range_max > 0.0 ? std::min(range_max, scan.range_max) : scan.range_max;
+  out.range_max = scoredRangeMax(scan.range_max, range_max);
   out.dropped = static_cast<int>(scan.ranges.size() - valid);
   out.weight = scan.weight;
   // A scan of another sensor taken before the update: every beam from where

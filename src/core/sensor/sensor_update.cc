@@ -1,6 +1,7 @@
 #include "pf_localization/core/sensor/sensor_update.h"
 
 #include <algorithm>
+#include <cmath>
 
 #include "pf_localization/core/filter/particle_blocks.h"
 #include "pf_localization/core/sensor/scan_group.h"
@@ -51,9 +52,26 @@ Weighing SensorUpdate::weigh(const SensorModel& model, const std::vector<Prepare
                 threads, evidence_share);
 }
 
+void SensorUpdate::setModel(std::unique_ptr<SensorModel> model) {
+  model_ = std::move(model);
+  search_.forgetModel();
+  if (model_) {
+    for (double range_max : ranges_) model_->warmUp(range_max);
+  }
+}
+
+void SensorUpdate::expectRange(double range_max) {
+  if (!std::isfinite(range_max) || !(range_max > 0.0)) return;
+  if (std::find(ranges_.begin(), ranges_.end(), range_max) != ranges_.end()) return;
+  if (ranges_.size() == LikelihoodTables::kMaxTables) ranges_.erase(ranges_.begin());
+  ranges_.push_back(range_max);
+  if (model_) model_->warmUp(range_max);
+}
+
 Weighing SensorUpdate::weighCloud(const std::vector<PreparedScan>& scans, double view,
                                   double min_ess_fraction, const LikelihoodFieldModelParams& sensor,
                                   const KldParams& kld, ParticleSet* particles, int threads) {
+  for (const PreparedScan& scan : scans) expectRange(scan.range_max);
   const double ess_fraction = std::max(min_ess_fraction, search_.minEssFraction());
   const SensorModel* smoothed = search_.model(*model_, sensor.sigma_hit, sensor.max_distance, scans,
                                               *particles, kld, threads);

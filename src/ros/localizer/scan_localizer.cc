@@ -176,6 +176,7 @@ std::optional<geometry_msgs::TransformStamped> ScanLocalizer::lookUp(const std::
 }
 
 ScanResult ScanLocalizer::processScan(const sensor_msgs::LaserScan& scan, std::size_t sensor) {
+  filter_.expectScanRange(scan.range_max);  // the table for it, with the map even before one
   ScanResult result;
   const auto laser = lookUp(scan.header.frame_id, scan.header.stamp, &result);
   if (!laser) return result;

@@ -6,6 +6,7 @@
 
 #include "core/filter/particle_filter_world.h"
 #include "pf_localization/core/filter/particle_filter.h"
+#include "pf_localization/core/sensor/likelihood_field_model.h"
 
 namespace pf {
 namespace {
@@ -18,6 +19,25 @@ using filter_world::room;
 using filter_world::simulateScan;
 
 // --- Map changes -------------------------------------------------------------------
+
+TEST(ParticleFilter, ANewMapsTableIsBuiltWithItNotByTheNextUpdate) {
+  const OccupancyGrid grid = asymmetricRoom();
+  ParticleFilterParams params = baseParams();
+  params.sensor.range_max = 4.0;  // laser_max_range, tighter than the laser's
+  ParticleFilter filter(params);
+  filter.expectScanRange(8.0);  // a scan seen before the map: scored at 4 m
+  filter.setMap(grid);
+  const auto& model = dynamic_cast<const LikelihoodFieldModel&>(*filter.sensorModel());
+  EXPECT_EQ(1u, model.tablesBuilt());
+  filter.initializeGaussian({1.0, 1.5, 0.0}, diag(0.05, 0.05, 0.05));
+  LaserScan scan = simulateScan(grid, {1.0, 1.5, 0.0});
+  scan.range_max = 8.0;
+  ASSERT_TRUE(filter.update(odomOf({1.0, 1.5, 0.0}), scan).updated);
+  EXPECT_EQ(1u, model.tablesBuilt());
+  // A replaced map's model has the table of the scans weighed before it.
+  filter.setMap(room(4.0, 3.0, {{2.5, 0.5, 3.0, 1.2}}));
+  EXPECT_EQ(1u, dynamic_cast<const LikelihoodFieldModel&>(*filter.sensorModel()).tablesBuilt());
+}
 
 TEST(ParticleFilter, SetMapKeepsParticlesWhenTheEstimateIsStillFree) {
   const OccupancyGrid grid = asymmetricRoom();

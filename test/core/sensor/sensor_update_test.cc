@@ -16,6 +16,49 @@
 namespace pf {
 namespace {
 
+const LikelihoodFieldModel& fieldModel(const SensorUpdate& sensor) {
+  return dynamic_cast<const LikelihoodFieldModel&>(sensor.model());
+}
+
+TEST(SensorUpdate, TheTablesOfTheRangesExpectedAreBuiltWithTheModel) {
+  const OccupancyGrid grid = small_world::room();
+  SensorUpdate sensor;
+  // Seen before there is a map: a front lidar of 25 m and a rear one of
+  // 12 m, and what is not a range at all.
+  sensor.expectRange(25.0);
+  sensor.expectRange(12.0);
+  sensor.expectRange(25.0);
+  sensor.expectRange(std::nan(""));
+  sensor.expectRange(0.0);
+  sensor.setModel(std::make_unique<LikelihoodFieldModel>(grid, LikelihoodFieldModelParams()));
+  EXPECT_EQ(2u, fieldModel(sensor).tablesBuilt());
+  // Weighing their scans builds nothing more.
+  ParticleSet particles;
+  particles.resize(1);
+  particles.setPose(0, small_world::kTruth);
+  particles.setUniformWeights();
+  LaserScan scan = small_world::castScan(grid, small_world::kTruth);
+  for (double range_max : {25.0, 12.0}) {
+    scan.range_max = range_max;
+    sensor.weigh(sensor.model().prepare(scan), 0.0, 1.0, &particles);
+  }
+  EXPECT_EQ(2u, fieldModel(sensor).tablesBuilt());
+  // A new map's model is warmed up for the same two.
+  sensor.setModel(std::make_unique<LikelihoodFieldModel>(grid, LikelihoodFieldModelParams()));
+  EXPECT_EQ(2u, fieldModel(sensor).tablesBuilt());
+  // A third range, with a model: built at once.
+  sensor.expectRange(8.0);
+  EXPECT_EQ(3u, fieldModel(sensor).tablesBuilt());
+}
+
+TEST(SensorUpdate, OnlyTheLatestRangesAreKeptForTheNextModel) {
+  const OccupancyGrid grid = small_world::room();
+  SensorUpdate sensor;
+  for (int r = 1; r <= 6; ++r) sensor.expectRange(4.0 * r);
+  sensor.setModel(std::make_unique<LikelihoodFieldModel>(grid, LikelihoodFieldModelParams()));
+  EXPECT_EQ(LikelihoodTables::kMaxTables, fieldModel(sensor).tablesBuilt());
+}
+
 TEST(SensorUpdate, TheParticleAtTheTruthWinsAndTheWeightsAreNormalised) {
   const OccupancyGrid grid = small_world::room();
   SensorUpdate sensor;

@@ -101,6 +101,11 @@ class ParticleFilter {
   /// (moved in: a large map is not held twice).
   bool setMap(OccupancyGrid grid);
   bool hasMap() const { return sensor_.hasModel(); }
+  /// Scans from a sensor whose range_max is `range_max` (as it reports it)
+  /// are to come: what weighing them needs (the likelihood table) is built
+  /// with the map, now or when one is set, not by the update that first
+  /// weighs one. Non-finite or non-positive values are ignored.
+  void expectScanRange(double range_max);
   /// The sensor model on the map; null without a map.
   const SensorModel* sensorModel() const { return sensor_.get(); }
   const OccupancyGrid* map() const {

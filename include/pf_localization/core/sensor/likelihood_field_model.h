@@ -105,6 +105,11 @@ class LikelihoodFieldModel : public SensorModel {
   std::size_t logLikelihoods(const PreparedScan& scan, const ParticleSet& particles,
                              std::vector<double>* log_likelihood) const override;
 
+  /// Builds the table for scans of `range_max` (likelihood_tables.h).
+  void warmUp(double range_max) const override { table(range_max); }
+  /// Tables built so far, one per range_max scored (likelihood_tables.h).
+  std::size_t tablesBuilt() const { return tables_.builds(); }
+
   /// log p of one beam whose end point is `distance` metres from an obstacle.
   double beamLogLikelihood(double distance, double range_max) const;
 

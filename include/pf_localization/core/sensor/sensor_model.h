@@ -11,6 +11,7 @@
 // (hitFraction), and the scan refiner fits to its distances.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <memory>
 #include <vector>
@@ -42,6 +43,12 @@ struct PreparedScan {
 PreparedScan prepareScan(const LaserScan& scan, int max_beams, double range_min, double range_max,
                          double resolution);
 
+/// The range_max a scan is scored with: the scan's own, or `range_max` where
+/// that is positive and tighter (laser_max_range).
+inline double scoredRangeMax(double scan_range_max, double range_max) {
+  return range_max > 0.0 ? std::min(range_max, scan_range_max) : scan_range_max;
+}
+
 class SensorModel {
  public:
   virtual ~SensorModel() = default;
@@ -65,6 +72,10 @@ class SensorModel {
   /// The fraction of the scan's beams whose end point, placed from `pose`,
   /// lies within `distance` metres of an obstacle (0 for an empty scan).
   virtual double hitFraction(const PreparedScan& scan, const Pose2& pose, double distance) const;
+
+  /// Builds now what scoring scans of `range_max` needs (the likelihood
+  /// field's table), so that the update that first scores one does not.
+  virtual void warmUp(double /*range_max*/) const {}
 
   /// The same model with its hit component widened to the std dev
   /// `sigma_hit` (m), for a sparse cloud (global_search.h); null when the

@@ -42,11 +42,15 @@ std::size_t groupLogLikelihoods(const SensorModel& model, const std::vector<Prep
 class SensorUpdate {
  public:
   /// A new model (a new map or new sensor parameters): a smoothed copy of
-  /// the old one is dropped.
-  void setModel(std::unique_ptr<SensorModel> model) {
-    model_ = std::move(model);
-    search_.forgetModel();
-  }
+  /// the old one is dropped, and the new one is warmed up for every scan
+  /// range expected (expectRange), so that the next update does not build
+  /// its tables.
+  void setModel(std::unique_ptr<SensorModel> model);
+  /// Scans of `range_max` are to be weighed (a sensor's, seen before the
+  /// map or with the last one): the model, and every later one, builds what
+  /// they need now. Up to LikelihoodTables::kMaxTables ranges are kept, the
+  /// latest.
+  void expectRange(double range_max);
   bool hasModel() const { return static_cast<bool>(model_); }
   /// Null without a model.
   const SensorModel* get() const { return model_.get(); }
@@ -105,6 +109,7 @@ class SensorUpdate {
                   double evidence_share = 1.0);
 
   std::unique_ptr<SensorModel> model_;
+  std::vector<double> ranges_;  // the scans' range_max values expected, oldest first
   GlobalSearch search_;  // the smoothed model while a global initialisation's cloud is sparse
   std::vector<double> log_likelihood_;
   std::vector<double> sensor_log_likelihood_;  // one sensor's, while a group is summed
