@@ -15,7 +15,6 @@
 #include <nav_msgs/OccupancyGrid.h>
 #include <rosbag/bag.h>
 #include <rosbag/view.h>
-#include <sensor_msgs/LaserScan.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2/buffer_core.h>
 #include <tf2_msgs/TFMessage.h>
@@ -232,23 +231,6 @@ void openBag(const Options& opt, rosbag::Bag* bag) {
     pf_ros::checkSensorTopics(*bag, bagTopics(opt));
   } catch (const pf_ros::BagContentError& e) {
     fail(opt.bag + ": " + e.what());
-  }
-}
-
-// Each scan topic's range_max, from its first message (among the first
-// kScansLooked of the bag's scans): the likelihood tables for them are then
-// built with the map, in its set-up, not by the first update.
-void expectScanRanges(const Options& opt, const rosbag::Bag& bag,
-                      pf_ros::ScanLocalizer* localizer) {
-  constexpr int kScansLooked = 100;
-  std::set<std::string> seen;
-  int looked = 0;
-  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(opt.scan_topics))) {
-    if (++looked > kScansLooked || seen.size() == opt.scan_topics.size()) break;
-    if (!seen.insert(m.getTopic()).second) continue;
-    if (const auto scan = m.instantiate<sensor_msgs::LaserScan>()) {
-      localizer->filter().expectScanRange(scan->range_max);
-    }
   }
 }
 
@@ -592,7 +574,9 @@ int main(int argc, char** argv) {
   }
   tf2::BufferCore tf(ros::Duration(600.0));
   pf_ros::ScanLocalizer localizer(config, &tf);
-  expectScanRanges(opt, bag, &localizer);
+  // The likelihood tables for the scans are built with the map, not by the first update.
+  for (double r : pf_ros::firstScanRanges(bag, bagTopics(opt)))
+    localizer.filter().expectScanRange(r);
   const double setup_cpu0 = threadCpuSeconds();
   loadMap(opt, &localizer);
   const double setup_cpu = threadCpuSeconds() - setup_cpu0;

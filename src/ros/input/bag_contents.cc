@@ -214,4 +214,19 @@ bool odometryOnTf(const rosbag::Bag& bag, const LocalizerConfig& config) {
   return odom_on_tf;
 }
 
+std::vector<double> firstScanRanges(const rosbag::Bag& bag, const BagTopics& topics) {
+  constexpr int kScansLooked = 100;
+  std::vector<double> ranges;
+  std::set<std::string> seen;
+  int looked = 0;
+  for (const rosbag::MessageInstance& m :
+       rosbag::View(bag, rosbag::TopicQuery(topics.scan_topics))) {
+    if (++looked > kScansLooked || seen.size() == topics.scan_topics.size()) break;
+    if (!seen.insert(m.getTopic()).second) continue;
+    if (const auto scan = m.instantiate<sensor_msgs::LaserScan>())
+      ranges.push_back(scan->range_max);
+  }
+  return ranges;
+}
+
 }  // namespace pf_ros

@@ -38,6 +38,11 @@ void checkSensorTopics(const rosbag::Bag& bag, const BagTopics& topics);
 /// or tf2 would see every odometry stamp twice.
 bool odometryOnTf(const rosbag::Bag& bag, const LocalizerConfig& config);
 
+/// The range_max of each laser topic's first message in `bag` (among its
+/// first 100 scans), in the order found: what the filter builds likelihood
+/// tables for with the map (ParticleFilter::expectScanRange).
+std::vector<double> firstScanRanges(const rosbag::Bag& bag, const BagTopics& topics);
+
 /// Throws BagContentError when odometry from config.odom_frame to
 /// config.base_frame, or a chain of transforms from a sensor's frame to the
 /// base frame, is not in `bag` (`odom_on_tf`: odometryOnTf).
