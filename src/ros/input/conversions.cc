@@ -104,12 +104,18 @@ pf::OccupancyGrid toCore(const nav_msgs::OccupancyGrid& msg) {
                            std::vector<int8_t>(msg.data.begin(), msg.data.end()));
 }
 
+nav_msgs::MapMetaData toMapInfo(const pf::OccupancyGrid& grid) {
+  nav_msgs::MapMetaData info;
+  info.width = static_cast<uint32_t>(grid.width());
+  info.height = static_cast<uint32_t>(grid.height());
+  info.resolution = static_cast<float>(grid.resolution());
+  info.origin = toPoseMsg(grid.origin());
+  return info;
+}
+
 nav_msgs::OccupancyGrid toMsg(const pf::OccupancyGrid& grid) {
   nav_msgs::OccupancyGrid msg;
-  msg.info.width = static_cast<uint32_t>(grid.width());
-  msg.info.height = static_cast<uint32_t>(grid.height());
-  msg.info.resolution = static_cast<float>(grid.resolution());
-  msg.info.origin = toPoseMsg(grid.origin());
+  msg.info = toMapInfo(grid);
   msg.data.assign(grid.data().begin(), grid.data().end());
   return msg;
 }

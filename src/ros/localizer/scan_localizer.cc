@@ -64,15 +64,25 @@ std::string ScanLocalizer::setMap(const nav_msgs::OccupancyGrid& map) {
   } catch (const std::invalid_argument& e) {
     return std::string("ignoring the map: ") + e.what();
   }
+  return install(std::move(grid), map.header.frame_id, map.info);
+}
+
+std::string ScanLocalizer::setMap(pf::OccupancyGrid grid, const std::string& frame_id) {
+  const nav_msgs::MapMetaData info = toMapInfo(grid);
+  return install(std::move(grid), frame_id, info);
+}
+
+std::string ScanLocalizer::install(pf::OccupancyGrid grid, const std::string& frame_id,
+                                   const nav_msgs::MapMetaData& info) {
   if (grid.freeCells().empty()) {
     return "ignoring the map: it has no free cell, so no pose on it is possible";
   }
-  if (!map.header.frame_id.empty() && map.header.frame_id != config_.global_frame) {
-    return "ignoring the map: its frame '" + map.header.frame_id + "' is not the global frame '" +
+  if (!frame_id.empty() && frame_id != config_.global_frame) {
+    return "ignoring the map: its frame '" + frame_id + "' is not the global frame '" +
            config_.global_frame + "'";
   }
   const bool kept = filter_.setMap(std::move(grid));
-  map_info_ = map.info;
+  map_info_ = info;
   const bool first = !had_map_;
   had_map_ = true;
   if (kept) return "";

@@ -193,6 +193,25 @@ TEST_F(ScanLocalizerTest, MalformedMapIsRejected) {
   EXPECT_NE(localizer.setMap(bad).find("ignoring the map"), std::string::npos);
 }
 
+TEST_F(ScanLocalizerTest, AMapInTheCoresFormIsTheMessagesMap) {
+  // A map loaded from a file goes in without a message: the same grid, the
+  // same map-change grid's info, the same checks.
+  ScanLocalizer from_msg(config_, &tf_), from_grid(config_, &tf_);
+  ASSERT_EQ(from_msg.setMap(map_), "");
+  ASSERT_EQ(from_grid.setMap(room()), "");
+  EXPECT_EQ(from_msg.filter().map()->data(), from_grid.filter().map()->data());
+  EXPECT_EQ(from_msg.filter().map()->resolution(), from_grid.filter().map()->resolution());
+  const auto a = from_msg.mapChangesMsg(ros::Time(1.0)),
+             b = from_grid.mapChangesMsg(ros::Time(1.0));
+  ASSERT_TRUE(a && b);
+  EXPECT_EQ(a->info, b->info);
+  ScanLocalizer elsewhere(config_, &tf_);
+  EXPECT_NE(elsewhere.setMap(room(), "odom").find("not the global frame"), std::string::npos);
+  EXPECT_FALSE(elsewhere.filter().hasMap());
+  pf::OccupancyGrid full(4, 4, 0.05, {}, std::vector<int8_t>(16, 100));
+  EXPECT_NE(elsewhere.setMap(full).find("no free cell"), std::string::npos);
+}
+
 TEST(ScanInconsistency, ConsistentScanHasNone) {
   sensor_msgs::LaserScan scan;
   scan.angle_min = -1.0;

@@ -36,6 +36,9 @@ pf::LaserScan toCore(const sensor_msgs::LaserScan& msg, const pf::Pose2& sensor_
 pf::OccupancyGrid toCore(const nav_msgs::OccupancyGrid& msg);
 /// Info and data only: the caller fills the header and map_load_time.
 nav_msgs::OccupancyGrid toMsg(const pf::OccupancyGrid& grid);
+/// The grid's size, resolution and origin, as toMsg gives them
+/// (map_load_time unset).
+nav_msgs::MapMetaData toMapInfo(const pf::OccupancyGrid& grid);
 
 /// The 6x6 ROS covariance (x, y, z, roll, pitch, yaw) from the 3x3 (x, y, yaw)
 /// one; z, roll and pitch get zero variance.

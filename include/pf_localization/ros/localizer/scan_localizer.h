@@ -65,6 +65,10 @@ class ScanLocalizer {
   /// from the configured initial pose, or globally when there is none.
   /// Returns an error message (empty on success).
   std::string setMap(const nav_msgs::OccupancyGrid& map);
+  /// The same for a map already in the core's form, in `frame_id` (empty:
+  /// the global frame), moved into the filter: a map loaded from a file
+  /// needs no message (pf_bag_runner).
+  std::string setMap(pf::OccupancyGrid grid, const std::string& frame_id = "");
 
   /// Re-initialises around a pose given in the global frame. A pose in
   /// another frame must be transformed by the caller (pf_node does, via tf).
@@ -117,6 +121,10 @@ class ScanLocalizer {
   geometry_msgs::PoseArray particleCloud(const ros::Time& stamp, std::size_t max_poses) const;
 
  private:
+  // setMap's checks and the filter's new map; `info` is what map-change
+  // messages carry as their grid's.
+  std::string install(pf::OccupancyGrid grid, const std::string& frame_id,
+                      const nav_msgs::MapMetaData& info);
   // tf's mounting of `frame` on the base and the odometry at `stamp`, into
   // `result` (its error when either is missing).
   std::optional<geometry_msgs::TransformStamped> lookUp(const std::string& frame,
