@@ -105,14 +105,21 @@ struct FrameGraph {
   }
 };
 
+// The first message of `topic` readable as M; null when there is none.
+template <typename M>
+boost::shared_ptr<M> firstMessage(const rosbag::Bag& bag, const std::string& topic) {
+  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(topic))) {
+    if (auto msg = m.instantiate<M>()) return msg;
+  }
+  return nullptr;
+}
+
 // The frame of a sensor's messages (of type M), from its topic's first one;
 // empty when none is readable (the replay reports those).
 template <typename M>
 std::string sensorFrame(const rosbag::Bag& bag, const std::string& topic) {
-  for (const rosbag::MessageInstance& m : rosbag::View(bag, rosbag::TopicQuery(topic))) {
-    if (const auto msg = m.instantiate<M>()) return frameId(msg->header.frame_id);
-  }
-  return "";
+  const auto msg = firstMessage<M>(bag, topic);
+  return msg ? frameId(msg->header.frame_id) : "";
 }
 
 // Every sensor's frame, in the order of pf_ros::sensorTopics.
@@ -215,16 +222,11 @@ bool odometryOnTf(const rosbag::Bag& bag, const LocalizerConfig& config) {
 }
 
 std::vector<double> firstScanRanges(const rosbag::Bag& bag, const BagTopics& topics) {
-  constexpr int kScansLooked = 100;
   std::vector<double> ranges;
-  std::set<std::string> seen;
-  int looked = 0;
-  for (const rosbag::MessageInstance& m :
-       rosbag::View(bag, rosbag::TopicQuery(topics.scan_topics))) {
-    if (++looked > kScansLooked || seen.size() == topics.scan_topics.size()) break;
-    if (!seen.insert(m.getTopic()).second) continue;
-    if (const auto scan = m.instantiate<sensor_msgs::LaserScan>())
+  for (const std::string& t : topics.scan_topics) {
+    if (const auto scan = firstMessage<sensor_msgs::LaserScan>(bag, t)) {
       ranges.push_back(scan->range_max);
+    }
   }
   return ranges;
 }

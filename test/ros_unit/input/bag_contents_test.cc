@@ -23,8 +23,9 @@ TEST(FirstScanRanges, EachLaserTopicsFirstRangeMax) {
   const std::string path = testing::TempDir() + "first_scan_ranges.bag";
   {
     rosbag::Bag bag(path, rosbag::bagmode::Write);
-    // The rear lidar speaks first; the front one changes its range_max
-    // later, which is not read; an unlisted topic is not looked at.
+    // In the order of the topics asked for, not of the bag: the rear lidar
+    // speaks first. The front one changes its range_max later, which is not
+    // read; an unlisted topic is not looked at, a missing one gives nothing.
     bag.write("/scan_rear", ros::Time(1.0), scanOf(12.0f));
     bag.write("/other", ros::Time(1.5), scanOf(40.0f));
     bag.write("/scan_front", ros::Time(2.0), scanOf(25.0f));
@@ -33,7 +34,7 @@ TEST(FirstScanRanges, EachLaserTopicsFirstRangeMax) {
   rosbag::Bag bag(path, rosbag::bagmode::Read);
   BagTopics topics;
   topics.scan_topics = {"/scan_front", "/scan_rear", "/scan_missing"};
-  EXPECT_EQ(std::vector<double>({12.0, 25.0}), firstScanRanges(bag, topics));
+  EXPECT_EQ(std::vector<double>({25.0, 12.0}), firstScanRanges(bag, topics));
   bag.close();
   std::remove(path.c_str());
 }

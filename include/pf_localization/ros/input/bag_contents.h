@@ -38,9 +38,9 @@ void checkSensorTopics(const rosbag::Bag& bag, const BagTopics& topics);
 /// or tf2 would see every odometry stamp twice.
 bool odometryOnTf(const rosbag::Bag& bag, const LocalizerConfig& config);
 
-/// The range_max of each laser topic's first message in `bag` (among its
-/// first 100 scans), in the order found: what the filter builds likelihood
-/// tables for with the map (ParticleFilter::expectScanRange).
+/// The range_max of each laser topic's first message in `bag`, in the order
+/// of topics.scan_topics (none for a topic without one): what the filter
+/// builds likelihood tables for with the map (ParticleFilter::expectScanRange).
 std::vector<double> firstScanRanges(const rosbag::Bag& bag, const BagTopics& topics);
 
 /// Throws BagContentError when odometry from config.odom_frame to
