@@ -134,7 +134,7 @@ class PfNode {
       }
       return;
     }
-    scheduler_->withFilter([&] { live_->installMap(*msg); });
+    live_->installMap(*msg, *scheduler_);
   }
 
   // An initial pose in another frame (say odom, or base_link) is moved into
@@ -148,7 +148,7 @@ class PfNode {
   // to another floor). The map is installed even when first_map_only is set:
   // that guards against map topic updates, not against an explicit request.
   bool onSetMap(nav_msgs::SetMap::Request& req, nav_msgs::SetMap::Response& res) {
-    const bool installed = scheduler_->withFilter([&] { return live_->installMap(req.map); });
+    const bool installed = live_->installMap(req.map, *scheduler_);
     res.success = installed && applyInitialPose(req.initial_pose);
     return true;
   }

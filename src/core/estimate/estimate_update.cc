@@ -5,8 +5,8 @@
 
 namespace pf {
 
-void EstimateUpdate::setMap(const DistanceField& field) {
-  look_alikes_.setMap(field);
+void EstimateUpdate::setMap(std::vector<MapSymmetry> symmetries) {
+  look_alikes_.setSymmetries(std::move(symmetries));
   look_alike_places_.clear();
   refinement_.reset();  // fitted to the old map
 }

@@ -18,9 +18,13 @@ PreparedBeams::PreparedBeams(const SensorModel& model, const ScreenedScan& scan,
   if (scan.report.beams_changed > 0) fitting_ = prepareScans(model, scan.fitting);
 }
 
-void BeamScreen::setMap(const DistanceField& field) {
-  evidence_.emplace(field);
-  layer_.emplace(field);
+BeamScreen::MapParts BeamScreen::prepare(const DistanceField& field) {
+  return {MapEvidence(field), MapChangeLayer(field)};
+}
+
+void BeamScreen::setMap(MapParts parts) {
+  evidence_.emplace(std::move(parts.evidence));
+  layer_.emplace(std::move(parts.layer));
 }
 
 void BeamScreen::setField(const DistanceField& field) {

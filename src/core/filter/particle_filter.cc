@@ -96,13 +96,15 @@ void ParticleFilter::setParams(const ParticleFilterParams& params) {
   }
 }
 
-bool ParticleFilter::setMap(OccupancyGrid grid) {
-  if (grid.empty()) throw std::invalid_argument("the map is empty");
-  sensor_.setModel(makeSensorModel(std::move(grid), params_));
-  const OccupancyGrid& map = sensor_.model().field().grid();
-  screen_.setMap(sensor_.model().field());
-  estimate_.setMap(sensor_.model().field());
-  if (isInitialized() && map.isFreeAt(estimate_.pose().x, estimate_.pose().y)) return true;
+bool ParticleFilter::setMap(PreparedMap map) {
+  if (!sameSensor(map.params, params_)) {  // reconfigured while it was built
+    map = PreparedMap::build(map.model->field().grid(), mapRecipe());
+  }
+  sensor_.setModel(std::move(map.model));  // builds the tables of ranges expected since
+  screen_.setMap(std::move(map.screen));
+  estimate_.setMap(std::move(map.symmetries));
+  const OccupancyGrid& grid = sensor_.model().field().grid();
+  if (isInitialized() && grid.isFreeAt(estimate_.pose().x, estimate_.pose().y)) return true;
   particles_.resize(0);  // keeps the reserved storage
   sensor_.stopSearch();
   estimate_.forget();

@@ -243,8 +243,8 @@ std::vector<MapSymmetry> findMapSymmetries(const DistanceField& field) {
   return out;
 }
 
-void LookAlikes::setMap(const DistanceField& field) {
-  symmetries_ = findMapSymmetries(field);
+void LookAlikes::setSymmetries(std::vector<MapSymmetry> symmetries) {
+  symmetries_ = std::move(symmetries);
   restart();
 }
 

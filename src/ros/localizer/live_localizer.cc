@@ -41,9 +41,17 @@ void LiveLocalizer::logInitialPose() const {
            saved_pose_ ? ", saved by an earlier run: used only on the map it was saved on" : "");
 }
 
-bool LiveLocalizer::installMap(const nav_msgs::OccupancyGrid& map) {
+bool LiveLocalizer::installMap(const nav_msgs::OccupancyGrid& map, UpdateScheduler& scheduler) {
+  const auto recipe = scheduler.withFilter([&] { return localizer_.mapRecipe(); });
+  ScanLocalizer::ReadyMap ready = ScanLocalizer::prepareMap(map, recipe);
+  const std::string signature = ready.map ? mapSignature(map) : "";
+  return scheduler.withFilter([&] { return install(std::move(ready), map, signature); });
+}
+
+bool LiveLocalizer::install(ScanLocalizer::ReadyMap ready, const nav_msgs::OccupancyGrid& map,
+                            const std::string& signature) {
   const bool first = !have_map_;
-  const std::string error = localizer_.setMap(map);
+  const std::string error = localizer_.setMap(std::move(ready));
   if (!error.empty()) {
     ROS_ERROR("pf_node: %s", error.c_str());
     return false;
@@ -51,7 +59,6 @@ bool LiveLocalizer::installMap(const nav_msgs::OccupancyGrid& map) {
   have_map_ = true;
   placement_.reset();
   if (config_.save_pose_rate > 0.0 || (first && saved_pose_)) {
-    const std::string signature = mapSignature(map);
     saver_.setMap(signature);
     if (first && saved_pose_) checkSavedPose(signature);
   }

@@ -58,31 +58,46 @@ ScanLocalizer::ScanLocalizer(const LocalizerConfig& config, const tf2::BufferCor
       weights_(scanWeights(config)) {}
 
 std::string ScanLocalizer::setMap(const nav_msgs::OccupancyGrid& map) {
+  return setMap(prepareMap(map, mapRecipe()));
+}
+
+std::string ScanLocalizer::setMap(pf::OccupancyGrid grid, const std::string& frame_id) {
+  return setMap(prepareMap(std::move(grid), frame_id, mapRecipe()));
+}
+
+ScanLocalizer::ReadyMap ScanLocalizer::prepareMap(const nav_msgs::OccupancyGrid& map,
+                                                  const MapRecipe& recipe) {
   pf::OccupancyGrid grid;
   try {
     grid = toCore(map);
   } catch (const std::invalid_argument& e) {
-    return std::string("ignoring the map: ") + e.what();
+    return {std::string("ignoring the map: ") + e.what(), std::nullopt, map.info};
   }
-  return install(std::move(grid), map.header.frame_id, map.info);
+  ReadyMap ready = prepareMap(std::move(grid), map.header.frame_id, recipe);
+  ready.info = map.info;
+  return ready;
 }
 
-std::string ScanLocalizer::setMap(pf::OccupancyGrid grid, const std::string& frame_id) {
+ScanLocalizer::ReadyMap ScanLocalizer::prepareMap(pf::OccupancyGrid grid,
+                                                  const std::string& frame_id,
+                                                  const MapRecipe& recipe) {
   const nav_msgs::MapMetaData info = toMapInfo(grid);
-  return install(std::move(grid), frame_id, info);
+  if (grid.freeCells().empty()) {
+    return {"ignoring the map: it has no free cell, so no pose on it is possible", std::nullopt,
+            info};
+  }
+  if (!frame_id.empty() && frame_id != recipe.global_frame) {
+    return {"ignoring the map: its frame '" + frame_id + "' is not the global frame '" +
+                recipe.global_frame + "'",
+            std::nullopt, info};
+  }
+  return {"", pf::PreparedMap::build(std::move(grid), recipe.filter), info};
 }
 
-std::string ScanLocalizer::install(pf::OccupancyGrid grid, const std::string& frame_id,
-                                   const nav_msgs::MapMetaData& info) {
-  if (grid.freeCells().empty()) {
-    return "ignoring the map: it has no free cell, so no pose on it is possible";
-  }
-  if (!frame_id.empty() && frame_id != config_.global_frame) {
-    return "ignoring the map: its frame '" + frame_id + "' is not the global frame '" +
-           config_.global_frame + "'";
-  }
-  const bool kept = filter_.setMap(std::move(grid));
-  map_info_ = info;
+std::string ScanLocalizer::setMap(ReadyMap ready) {
+  if (!ready.map) return ready.error;
+  const bool kept = filter_.setMap(std::move(*ready.map));
+  map_info_ = ready.info;
   const bool first = !had_map_;
   had_map_ = true;
   if (kept) return "";

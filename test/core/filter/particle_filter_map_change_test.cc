@@ -74,5 +74,48 @@ TEST(ParticleFilter, SetMapDropsParticlesWhenTheEstimateLeavesTheMap) {
   EXPECT_THROW(filter.setMap(OccupancyGrid()), std::invalid_argument);
 }
 
+// A node builds a new map while updates run on the current one
+// (prepared_map.h), then swaps it in: the filter then runs as if the map had
+// been set directly.
+TEST(ParticleFilter, AMapBuiltBeforehandRunsAsOneSetDirectly) {
+  const OccupancyGrid grid = asymmetricRoom();
+  const OccupancyGrid moved = room(4.0, 3.0, {{2.5, 0.5, 3.0, 1.2}, {3.0, 2.0, 3.5, 2.5}});
+  ParticleFilter direct(baseParams()), swapped(baseParams());
+  for (ParticleFilter* f : {&direct, &swapped}) {
+    f->setMap(grid);
+    f->initializeGaussian({1.0, 1.5, 0.0}, diag(0.05, 0.05, 0.05));
+    ASSERT_TRUE(f->update(odomOf({1.0, 1.5, 0.0}), simulateScan(grid, {1.0, 1.5, 0.0})).updated);
+  }
+  const OccupancyGrid* old_map = swapped.map();
+  PreparedMap prepared = PreparedMap::build(moved, swapped.mapRecipe());
+  // Building touched nothing of the filter: it still runs on the old map.
+  EXPECT_EQ(old_map, swapped.map());
+  ASSERT_TRUE(swapped.update(odomOf({1.3, 1.5, 0.0}), simulateScan(grid, {1.3, 1.5, 0.0})).updated);
+  ASSERT_TRUE(direct.update(odomOf({1.3, 1.5, 0.0}), simulateScan(grid, {1.3, 1.5, 0.0})).updated);
+  EXPECT_TRUE(direct.setMap(moved));
+  EXPECT_TRUE(swapped.setMap(std::move(prepared)));
+  for (double x : {1.6, 1.9, 2.2}) {
+    const LaserScan scan = simulateScan(moved, {x, 1.5, 0.0});
+    ASSERT_TRUE(direct.update(odomOf({x, 1.5, 0.0}), scan).updated);
+    ASSERT_TRUE(swapped.update(odomOf({x, 1.5, 0.0}), scan).updated);
+  }
+  EXPECT_EQ(direct.particles().x, swapped.particles().x);
+  EXPECT_EQ(direct.particles().yaw, swapped.particles().yaw);
+  EXPECT_EQ(direct.estimate().pose.x, swapped.estimate().pose.x);
+}
+
+// The sensor's parameters changed while the map was being built: the model
+// built with the old ones is not used.
+TEST(ParticleFilter, AMapBuiltBeforeAReconfigureIsBuiltAgain) {
+  ParticleFilterParams params = baseParams();
+  ParticleFilter filter(params);
+  PreparedMap prepared = PreparedMap::build(asymmetricRoom(), filter.mapRecipe());
+  params.sensor.sigma_hit *= 2.0;
+  filter.setParams(params);
+  filter.setMap(std::move(prepared));
+  const auto& model = dynamic_cast<const LikelihoodFieldModel&>(*filter.sensorModel());
+  EXPECT_EQ(params.sensor.sigma_hit, model.params().sigma_hit);
+}
+
 }  // namespace
 }  // namespace pf

@@ -212,6 +212,36 @@ TEST_F(ScanLocalizerTest, AMapInTheCoresFormIsTheMessagesMap) {
   EXPECT_NE(elsewhere.setMap(full).find("no free cell"), std::string::npos);
 }
 
+TEST_F(ScanLocalizerTest, AMapIsCheckedAndBuiltApartThenInstalled) {
+  // pf_node builds a new map without the filter's lock: building reads only
+  // the recipe, refuses what setMap refuses, and installing is setMap's.
+  ScanLocalizer localizer(config_, &tf_);
+  const ScanLocalizer::MapRecipe recipe = localizer.mapRecipe();
+  nav_msgs::OccupancyGrid bad = map_;
+  bad.data.pop_back();
+  ScanLocalizer::ReadyMap refused = ScanLocalizer::prepareMap(bad, recipe);
+  EXPECT_FALSE(refused.map);
+  EXPECT_NE(refused.error.find("ignoring the map"), std::string::npos);
+  nav_msgs::OccupancyGrid elsewhere = map_;
+  elsewhere.header.frame_id = "odom";
+  EXPECT_NE(ScanLocalizer::prepareMap(elsewhere, recipe).error.find("not the global frame"),
+            std::string::npos);
+  EXPECT_NE(localizer.setMap(std::move(refused)).find("ignoring the map"), std::string::npos);
+  EXPECT_FALSE(localizer.filter().hasMap());
+
+  ScanLocalizer::ReadyMap ready = ScanLocalizer::prepareMap(map_, recipe);
+  ASSERT_TRUE(ready.map) << ready.error;
+  EXPECT_FALSE(localizer.filter().hasMap());  // built, not installed
+  ASSERT_EQ(localizer.setMap(std::move(ready)), "");
+  ScanLocalizer direct(config_, &tf_);
+  ASSERT_EQ(direct.setMap(map_), "");
+  EXPECT_EQ(direct.filter().map()->data(), localizer.filter().map()->data());
+  EXPECT_EQ(direct.filter().particles().x, localizer.filter().particles().x);
+  const auto a = direct.mapChangesMsg(ros::Time(1.0)), b = localizer.mapChangesMsg(ros::Time(1.0));
+  ASSERT_TRUE(a && b);
+  EXPECT_EQ(a->info, b->info);
+}
+
 TEST(ScanInconsistency, ConsistentScanHasNone) {
   sensor_msgs::LaserScan scan;
   scan.angle_min = -1.0;

@@ -51,8 +51,9 @@ struct Judgement {
 
 class EstimateUpdate {
  public:
-  /// A new map: its look-alike places; the last fit and the places listed are forgotten.
-  void setMap(const DistanceField& field);
+  /// A new map, with its look-alike places (findMapSymmetries); the last
+  /// fit and the places listed are forgotten.
+  void setMap(std::vector<MapSymmetry> symmetries);
   /// No estimate (a map the robot is not on).
   void forget() { estimate_ = PoseEstimate(); }
   /// After an initialisation: `estimate` is the new cloud's; "uncertain",

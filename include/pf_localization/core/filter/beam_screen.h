@@ -78,9 +78,16 @@ class PreparedBeams {
 
 class BeamScreen {
  public:
-  /// A new map (`field`'s): the judging casts rays on it, and the layer of
-  /// its changes starts empty.
-  void setMap(const DistanceField& field);
+  /// What the screening builds from a map: the rays the judging casts on
+  /// it, and the layer of its changes, empty.
+  struct MapParts {
+    MapEvidence evidence;
+    MapChangeLayer layer;
+  };
+  static MapParts prepare(const DistanceField& field);
+  /// A new map: the judging casts rays on it, and the layer of its changes
+  /// starts empty (`parts`, prepared from its field).
+  void setMap(MapParts parts);
   /// The same map under a new likelihood field (new sensor parameters): the
   /// judging casts on it, with what the layer learned.
   void setField(const DistanceField& field);

@@ -39,6 +39,7 @@
 #include "pf_localization/core/filter/beam_screen.h"
 #include "pf_localization/core/filter/particle_filter_params.h"
 #include "pf_localization/core/filter/particle_set.h"
+#include "pf_localization/core/filter/prepared_map.h"
 #include "pf_localization/core/filter/update_gate.h"
 #include "pf_localization/core/map/map_change_layer.h"
 #include "pf_localization/core/map/occupancy_grid.h"
@@ -94,12 +95,20 @@ class ParticleFilter {
   /// validate()) and then leaves everything as it was.
   void setParams(const ParticleFilterParams& params);
 
-  /// Installs a map (rebuilding the likelihood field). If particles exist and
-  /// the current estimate lies in free space of the new map they are kept;
-  /// otherwise the filter becomes uninitialised. Returns whether they were kept.
-  /// Throws std::invalid_argument for an empty map. The filter keeps `grid`
-  /// (moved in: a large map is not held twice).
-  bool setMap(OccupancyGrid grid);
+  /// Installs a map. If particles exist and the current estimate lies in
+  /// free space of the new map they are kept; otherwise the filter becomes
+  /// uninitialised. Returns whether they were kept. Throws
+  /// std::invalid_argument for an empty map. The filter keeps `grid` (moved
+  /// in: a large map is not held twice).
+  bool setMap(OccupancyGrid grid) {
+    return setMap(PreparedMap::build(std::move(grid), mapRecipe()));
+  }
+  /// The same with the map's structures built beforehand, from mapRecipe()
+  /// (prepared_map.h): only a swap, unless a sensor parameter changed since
+  /// the recipe was taken, which builds them again.
+  bool setMap(PreparedMap map);
+  /// What building a map for this filter needs, to build it elsewhere.
+  PreparedMap::Recipe mapRecipe() const { return {params_, sensor_.ranges()}; }
   bool hasMap() const { return sensor_.hasModel(); }
   /// Scans from a sensor whose range_max is `range_max` (as it reports it)
   /// are to come: what weighing them needs (the likelihood table) is built

@@ -80,7 +80,9 @@ class LookAlikes {
   static constexpr double kSeenMargin = 0.2;
 
   /// Finds the symmetries of `field`'s map (findMapSymmetries).
-  void setMap(const DistanceField& field);
+  void setMap(const DistanceField& field) { setSymmetries(findMapSymmetries(field)); }
+  /// A map's symmetries, found beforehand.
+  void setSymmetries(std::vector<MapSymmetry> symmetries);
   /// Forgets the streaks of better fits (after an initialisation).
   void restart();
   const std::vector<MapSymmetry>& symmetries() const { return symmetries_; }

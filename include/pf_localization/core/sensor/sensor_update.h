@@ -51,6 +51,8 @@ class SensorUpdate {
   /// they need now. Up to LikelihoodTables::kMaxTables ranges are kept, the
   /// latest.
   void expectRange(double range_max);
+  /// The range_max values expected, oldest first.
+  const std::vector<double>& ranges() const { return ranges_; }
   bool hasModel() const { return static_cast<bool>(model_); }
   /// Null without a model.
   const SensorModel* get() const { return model_.get(); }

@@ -7,11 +7,12 @@
 // saved by an earlier run on the first map (saved_pose.h).
 //
 // Threads (docs/ros-interface.md, "Threads, latency and overload"): every
-// method but saver() and haveMap() must be called with the filter's lock
-// held (UpdateScheduler); an update holds it whole (on the filter thread, or on roscpp's poll
-// thread when it is short), the main spinner's callbacks that touch the filter
-// wait for it. What runs at a steady rate never does: the republisher and the
-// saver get their data under small locks of their own.
+// method but saver(), haveMap() and installMap() must be called with the
+// filter's lock held (UpdateScheduler); an update holds it whole (on the
+// filter thread, or on roscpp's poll thread when it is short), the main
+// spinner's callbacks that touch the filter wait for it; installMap() takes
+// it itself, only around the swap of a map it built without it. What runs at a steady rate never
+// does: the republisher and the saver get their data under small locks of their own.
 #pragma once
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
@@ -36,6 +37,7 @@
 #include "pf_localization/ros/params/saved_pose.h"
 #include "pf_localization/ros/scheduling/latest_scan_slot.h"
 #include "pf_localization/ros/scheduling/update_placement.h"
+#include "pf_localization/ros/scheduling/update_scheduler.h"
 #include "pf_localization/ros/scheduling/update_time_governor.h"
 
 namespace pf_ros {
@@ -51,7 +53,11 @@ class LiveLocalizer {
                 ros::NodeHandle& nh, PoseSaver::Write write_pose = {});
 
   /// A new map (map topic or set_map). False when it was refused (logged).
-  bool installMap(const nav_msgs::OccupancyGrid& map);
+  /// Unlike the other methods, called without the filter's lock: the map is
+  /// built without it, while updates and map -> odom go on from the current
+  /// map, and `scheduler` lends it only to read what building needs and to
+  /// swap the map in (prepared_map.h).
+  bool installMap(const nav_msgs::OccupancyGrid& map, UpdateScheduler& scheduler);
   /// Whether a map was installed. Changed only by installMap(), which pf_node
   /// calls from its main spinner; read there without the mutex.
   bool haveMap() const { return have_map_; }
@@ -94,6 +100,10 @@ class LiveLocalizer {
 
  private:
   void logInitialPose() const;
+  // installMap's part with the filter's lock held: `ready`, built from `map`
+  // whose signature (mapSignature) is `signature`, replaces the filter's map.
+  bool install(ScanLocalizer::ReadyMap ready, const nav_msgs::OccupancyGrid& map,
+               const std::string& signature);
   void checkSavedPose(const std::string& map_signature);
   void restartAfterJump(double back_s);
   void applyParticleCap(std::size_t cap);

@@ -70,6 +70,28 @@ class ScanLocalizer {
   /// needs no message (pf_bag_runner).
   std::string setMap(pf::OccupancyGrid grid, const std::string& frame_id = "");
 
+  /// A map checked and built apart from the localizer (prepareMap), for
+  /// setMap(ReadyMap) to install at once.
+  struct ReadyMap {
+    std::string error;  // why the map was refused; empty when `map` is ready
+    std::optional<pf::PreparedMap> map;
+    nav_msgs::MapMetaData info;  // as map-change messages carry it
+  };
+  /// What prepareMap needs from a localizer, copied with the filter's lock held.
+  struct MapRecipe {
+    pf::PreparedMap::Recipe filter;
+    std::string global_frame;
+  };
+  MapRecipe mapRecipe() const { return {filter_.mapRecipe(), config_.global_frame}; }
+  /// setMap's checks and the seconds a large map takes to build, reading no
+  /// localizer: they run on any thread while updates go on with the current
+  /// map (pf_node's map topic and set_map).
+  static ReadyMap prepareMap(const nav_msgs::OccupancyGrid& map, const MapRecipe& recipe);
+  static ReadyMap prepareMap(pf::OccupancyGrid grid, const std::string& frame_id,
+                             const MapRecipe& recipe);
+  /// Installs a prepared map as setMap above does; `map.error` when it was refused.
+  std::string setMap(ReadyMap map);
+
   /// Re-initialises around a pose given in the global frame. A pose in
   /// another frame must be transformed by the caller (pf_node does, via tf).
   /// Returns an error message (empty on success).
@@ -121,10 +143,6 @@ class ScanLocalizer {
   geometry_msgs::PoseArray particleCloud(const ros::Time& stamp, std::size_t max_poses) const;
 
  private:
-  // setMap's checks and the filter's new map; `info` is what map-change
-  // messages carry as their grid's.
-  std::string install(pf::OccupancyGrid grid, const std::string& frame_id,
-                      const nav_msgs::MapMetaData& info);
   // tf's mounting of `frame` on the base and the odometry at `stamp`, into
   // `result` (its error when either is missing).
   std::optional<geometry_msgs::TransformStamped> lookUp(const std::string& frame,
