@@ -144,12 +144,12 @@ class PfNode {
     return global && scheduler_->withFilter([&] { return live_->setInitialPose(*global); });
   }
 
-  // amcl's set_map: a new map and the pose on it in one call (a robot moved
-  // to another floor). The map is installed even when first_map_only is set:
-  // that guards against map topic updates, not against an explicit request.
+  // amcl's set_map: a new map and the pose on it in one call (a robot moved to another floor), the
+  // pose the robot's when asked (the odometry moves it on while the map builds). The map is
+  // installed even when first_map_only is set, which guards against map topic updates only.
   bool onSetMap(nav_msgs::SetMap::Request& req, nav_msgs::SetMap::Response& res) {
-    const bool installed = live_->installMap(req.map, *scheduler_);
-    res.success = installed && applyInitialPose(req.initial_pose);
+    if (req.initial_pose.header.stamp.isZero()) req.initial_pose.header.stamp = ros::Time::now();
+    res.success = live_->installMap(req.map, *scheduler_) && applyInitialPose(req.initial_pose);
     return true;
   }
 

@@ -20,7 +20,13 @@ Watches, while the bag plays (from the first to the last /ground_truth):
     sim time after the first ground truth] to the end it may grow by at most
     max_rss_growth_mb;
   - tracking: for each /ground_truth stamped t (from start_after [s] on), the
-    tf lookup map -> base_link at t; RMSE must stay below rmse_below [m].
+    tf lookup map -> base_link at t; RMSE must stay below rmse_below [m]
+    and every error at most max_error [m];
+  - a new map, when asked (map_on_topic_at, set_map_at [s of sim time after
+    the first ground truth]): the map on /map published again by this node,
+    or sent to set_map with the pose on amcl_pose; the new maps must be
+    installed (pf_node's "map W x H cells" lines on /rosout) and set_map
+    must succeed;
 and that pf_node is alive at the end. Every figure is printed (rostest --text,
 or the XML result's <system-out>) whether the test passes or not.
 
@@ -48,7 +54,10 @@ import rospy
 import rostest
 import tf2_ros
 from diagnostic_msgs.msg import DiagnosticStatus
-from geometry_msgs.msg import PoseStamped
+from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
+from nav_msgs.msg import OccupancyGrid
+from nav_msgs.srv import SetMap
+from rosgraph_msgs.msg import Log
 from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
 
@@ -104,6 +113,7 @@ class OverloadChecker:
         rospy.Subscriber('/pf_status', DiagnosticStatus, self._on_status, queue_size=20)
         self.clock = []       # /clock values (sim s), in order of arrival
         rospy.Subscriber('/clock', Clock, self._on_clock, queue_size=1000)
+        self.swaps = MapSwaps(self.node)
 
     def _on_clock(self, msg):
         with self.lock:
@@ -174,6 +184,8 @@ class OverloadChecker:
                 mb = rss_mb(pid)
                 if mb is not None and t_rel >= rss_after:
                     self.rss.append((t_rel, mb))
+            if first is not None:
+                self.swaps.when_due(rospy.Time.now().to_sec() - first)
             if last_wall is not None and time.time() - last_wall > idle:
                 break
         self._compare(flush=True)
@@ -268,18 +280,96 @@ class OverloadChecker:
         if n:
             rmse = math.sqrt(sum(e * e for _, e, _ in self.errors) / n)
             yaw_rmse = math.sqrt(sum(y * y for _, _, y in self.errors) / n)
-            info.append('tracking: %d samples, RMSE %.3f m, yaw RMSE %.2f deg, max %.3f m' %
-                        (n, rmse, yaw_rmse, max(e for _, e, _ in self.errors)))
+            worst = max(self.errors, key=lambda e: e[1])
+            info.append('tracking: %d samples, RMSE %.3f m, yaw RMSE %.2f deg, max %.3f m at t=%.1f s' %
+                        (n, rmse, yaw_rmse, worst[1], worst[0]))
             b = opt('rmse_below')
             if b is not None and not rmse <= float(b):
                 failures.append('RMSE %.3f m > rmse_below %s m' % (rmse, b))
+            b = opt('max_error')
+            if b is not None and not worst[1] <= float(b):
+                failures.append('error %.3f m at t=%.1f s > max_error %s m' % (worst[1], worst[0], b))
         if n < int(opt('min_samples', 50)):
             failures.append('only %d tracking samples' % n)
+        self.swaps.evaluate(info, failures)
         if node_pid(self.node) is None:
             failures.append('%s is not alive at the end' % self.node)
         text = '\n'.join(info + ['FAIL: ' + f for f in failures] or ['ok'])
         print('overload_checker:\n' + text)
         return not failures, text
+
+
+class MapSwaps:
+    """Gives pf_node the map it has again, on /map and through set_map, when asked."""
+
+    def __init__(self, node):
+        self.at = {'topic': opt('map_on_topic_at'), 'set_map': opt('set_map_at')}
+        self.done = {}        # way -> (sim s, wall s the call took, success)
+        self.map = None
+        self.pose = None
+        self.installed = 0    # pf_node's "map ... cells" lines since the first swap
+        self.first_swap = None  # sim s
+        self.node = node
+        self.threads = []
+        if not any(v is not None for v in self.at.values()):
+            return
+        self.publisher = rospy.Publisher('/map', OccupancyGrid, queue_size=1, latch=True)
+        rospy.Subscriber('/map', OccupancyGrid, self._on_map, queue_size=1)
+        rospy.Subscriber('/amcl_pose', PoseWithCovarianceStamped, self._on_pose, queue_size=2)
+        rospy.Subscriber('/rosout', Log, self._on_log, queue_size=100)
+
+    def _on_map(self, msg):
+        if self.map is None:
+            self.map = msg
+
+    def _on_pose(self, msg):
+        self.pose = msg
+
+    def _on_log(self, msg):
+        if msg.name == self.node and msg.msg.startswith('pf_node: map ') and ' cells at ' in msg.msg \
+                and self.first_swap is not None and msg.header.stamp.to_sec() >= self.first_swap:
+            self.installed += 1
+
+    def when_due(self, t):
+        for way, at in self.at.items():
+            if at is None or way in self.done or t < float(at) or self.map is None:
+                continue
+            self.done[way] = (t, None, None)
+            if self.first_swap is None:
+                self.first_swap = rospy.Time.now().to_sec()
+            thread = threading.Thread(target=self._swap, args=(way, t))
+            thread.start()
+            self.threads.append(thread)
+
+    def _swap(self, way, t):
+        start = time.time()
+        if way == 'topic':
+            self.publisher.publish(self.map)
+            self.done[way] = (t, 0.0, True)
+            return
+        rospy.wait_for_service('/set_map', timeout=10.0)
+        pose = self.pose
+        ok = rospy.ServiceProxy('/set_map', SetMap)(self.map, pose).success
+        self.done[way] = (t, time.time() - start, ok)
+
+    def evaluate(self, info, failures):
+        asked = [way for way, at in self.at.items() if at is not None]
+        if not asked:
+            return
+        for thread in self.threads:
+            thread.join(30.0)
+        for way in asked:
+            if way not in self.done:
+                failures.append('the map was never given again by %s (at %s s)' % (way, self.at[way]))
+                continue
+            t, took, ok = self.done[way]
+            info.append('map given again by %s at t=%.1f s%s' %
+                        (way, t, '' if took is None else ': the call took %.2f s wall' % took))
+            if not ok:
+                failures.append('giving the map by %s failed' % way)
+        info.append('pf_node installed %d maps since' % self.installed)
+        if self.installed != len(asked):
+            failures.append('pf_node installed %d maps, not %d' % (self.installed, len(asked)))
 
 
 class OverloadCheckerTest(unittest.TestCase):

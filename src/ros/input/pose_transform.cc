@@ -32,6 +32,7 @@ std::optional<geometry_msgs::PoseWithCovarianceStamped> poseInFrame(
   }
   geometry_msgs::PoseWithCovarianceStamped out = inParentFrame(pose, t);
   out.header.frame_id = frame;
+  out.header.stamp = t.header.stamp;  // moved by the latest transform: the pose then
   return out;
 }
 
@@ -52,6 +53,21 @@ std::optional<geometry_msgs::PoseWithCovarianceStamped> initialPoseInFrame(
                                      "': " + error);
   }
   return moved;
+}
+
+pf::Pose2 movedByOdometrySince(const tf2::BufferCore& tf, const pf::Pose2& pose,
+                               const ros::Time& stamp, const std::string& odom_frame,
+                               const std::string& base_frame) {
+  if (stamp.isZero()) return pose;
+  try {
+    const geometry_msgs::TransformStamped then = tf.lookupTransform(odom_frame, base_frame, stamp);
+    const geometry_msgs::TransformStamped latest =
+        tf.lookupTransform(odom_frame, base_frame, ros::Time(0));
+    if (latest.header.stamp <= stamp) return pose;
+    return pf::compose(pose, pf::between(toPose2(then.transform), toPose2(latest.transform)));
+  } catch (const tf2::TransformException&) {
+    return pose;  // no odometry for then (before tf's buffer, or from a topic)
+  }
 }
 
 }  // namespace pf_ros

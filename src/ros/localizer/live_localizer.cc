@@ -95,7 +95,7 @@ bool LiveLocalizer::setInitialPose(const geometry_msgs::PoseWithCovarianceStampe
     return false;
   }
   if (!have_map_) pose_before_map_ = true;
-  const pf::Pose2 p = toPose2(pose.pose.pose);
+  const pf::Pose2 p = *localizer_.config().initial_pose;  // moved on by the odometry since
   ROS_INFO("pf_node: re-initialised at (%.3f, %.3f, %.3f) in %s", p.x, p.y, p.yaw,
            config_.global_frame.c_str());
   output_.publishEstimate(localizer_, pose.header.stamp, true);

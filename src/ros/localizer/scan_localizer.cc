@@ -9,6 +9,7 @@
 
 #include "pf_localization/ros/input/conversions.h"
 #include "pf_localization/ros/input/point_cloud.h"
+#include "pf_localization/ros/input/pose_transform.h"
 #include "pf_localization/ros/params/live_params.h"
 
 namespace pf_ros {
@@ -97,6 +98,7 @@ ScanLocalizer::ReadyMap ScanLocalizer::prepareMap(pf::OccupancyGrid grid,
 std::string ScanLocalizer::setMap(ReadyMap ready) {
   if (!ready.map) return ready.error;
   const bool kept = filter_.setMap(std::move(*ready.map));
+  if (!kept) given_map_to_odom_.reset();
   map_info_ = ready.info;
   const bool first = !had_map_;
   had_map_ = true;
@@ -121,8 +123,8 @@ std::string ScanLocalizer::reconfigure(const LocalizerConfig& config) {
 }
 
 std::string ScanLocalizer::setInitialPose(const geometry_msgs::PoseWithCovarianceStamped& msg) {
-  const pf::Pose2 pose = toPose2(msg.pose.pose);
-  if (!pose.isFinite()) return "ignoring the initial pose: it is not finite (NaN or inf)";
+  const pf::Pose2 given = toPose2(msg.pose.pose);
+  if (!given.isFinite()) return "ignoring the initial pose: it is not finite (NaN or inf)";
   const auto& q = msg.pose.pose.orientation;
   if (!std::isfinite(q.x + q.y + q.z + q.w) ||
       q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w < 1e-9) {
@@ -132,18 +134,31 @@ std::string ScanLocalizer::setInitialPose(const geometry_msgs::PoseWithCovarianc
   if (!cov.allFinite()) return "ignoring the initial pose: its covariance is not finite";
   // rviz sends a fixed covariance; an all-zero one means "no opinion".
   if (cov.isZero()) cov = config_.initial_cov;
+  const pf::Pose2 pose = tf_ ? movedByOdometrySince(*tf_, given, msg.header.stamp,
+                                                    config_.odom_frame, config_.base_frame)
+                             : given;
   config_.initial_pose = pose;
   config_.initial_cov = cov;
+  given_map_to_odom_.reset();
   if (!filter_.hasMap()) return "";  // used when the map arrives
   try {
     filter_.initializeGaussian(pose, cov);
   } catch (const std::invalid_argument& e) {
     return std::string("ignoring the initial pose: ") + e.what();
   }
+  if (!tf_) return "";
+  try {
+    const geometry_msgs::TransformStamped odom =
+        tf_->lookupTransform(config_.odom_frame, config_.base_frame, ros::Time(0));
+    given_map_to_odom_ = pf::compose(pose, pf::inverse(toPose2(odom.transform)));
+  } catch (const tf2::TransformException&) {
+    // No odometry yet: map -> odom waits for the first update.
+  }
   return "";
 }
 
 std::string ScanLocalizer::startGlobalLocalization() {
+  given_map_to_odom_.reset();
   if (!filter_.hasMap()) return "global localization needs a map; none has arrived yet";
   try {
     filter_.initializeUniform();
@@ -154,6 +169,7 @@ std::string ScanLocalizer::startGlobalLocalization() {
 }
 
 std::string ScanLocalizer::restart() {
+  given_map_to_odom_.reset();
   config_.initial_pose = configured_pose_;
   config_.initial_cov = configured_cov_;
   if (!filter_.hasMap()) return "";
@@ -273,7 +289,8 @@ void ScanLocalizer::update(pf::LaserScan scan, std::size_t sensor, const ros::Ti
 
 std::optional<geometry_msgs::TransformStamped> ScanLocalizer::mapToOdom(
     const ros::Time& stamp) const {
-  const auto m2o = filter_.mapToOdom();
+  auto m2o = filter_.mapToOdom();
+  if (!m2o) m2o = given_map_to_odom_;
   if (!m2o) return std::nullopt;
   geometry_msgs::TransformStamped t;
   t.header.stamp = stamp;

@@ -212,6 +212,40 @@ TEST_F(ScanLocalizerTest, AMapInTheCoresFormIsTheMessagesMap) {
   EXPECT_NE(elsewhere.setMap(full).find("no free cell"), std::string::npos);
 }
 
+TEST_F(ScanLocalizerTest, AnInitialPoseIsMovedOnByTheOdometrySinceItsStamp) {
+  // Given at t = 10 while the robot drives: by the latest odometry (t = 11)
+  // it moved 0.8 m ahead and turned 0.1 rad, in its own frame. set_map's pose
+  // waits for its map to be built, seconds on a large floor.
+  ScanLocalizer localizer(config_, &tf_);
+  ASSERT_EQ(localizer.setMap(map_), "");
+  tf_.setTransform(transform("odom", "base_link", {2.0, 1.0, M_PI / 2}, ros::Time(10)), "test");
+  tf_.setTransform(transform("odom", "base_link", {2.0, 1.8, M_PI / 2 + 0.1}, ros::Time(11)),
+                   "test");
+  geometry_msgs::PoseWithCovarianceStamped given;
+  given.header.frame_id = "map";
+  given.header.stamp = ros::Time(10);
+  given.pose.pose = toPoseMsg({1.0, 1.5, 0.0});
+  ASSERT_EQ(localizer.setInitialPose(given), "");
+  EXPECT_NEAR(1.8, localizer.config().initial_pose->x, 1e-9);
+  EXPECT_NEAR(1.5, localizer.config().initial_pose->y, 1e-9);
+  EXPECT_NEAR(0.1, localizer.config().initial_pose->yaw, 1e-9);
+  // Before the first update after it, map -> odom is the one that pose gives
+  // with the latest odometry (published on, not dropped).
+  const auto m2o = localizer.mapToOdom(ros::Time(11));
+  ASSERT_TRUE(m2o);
+  const pf::Pose2 base = pf::compose(toPose2(m2o->transform), {2.0, 1.8, M_PI / 2 + 0.1});
+  EXPECT_NEAR(1.8, base.x, 1e-9);
+  EXPECT_NEAR(1.5, base.y, 1e-9);
+  EXPECT_NEAR(0.1, base.yaw, 1e-9);
+  // Global localization has no such pose.
+  ASSERT_EQ(localizer.startGlobalLocalization(), "");
+  EXPECT_FALSE(localizer.mapToOdom(ros::Time(11)));
+  // A zero stamp is "now": the pose as given.
+  given.header.stamp = ros::Time();
+  ASSERT_EQ(localizer.setInitialPose(given), "");
+  EXPECT_EQ(1.0, localizer.config().initial_pose->x);
+}
+
 TEST_F(ScanLocalizerTest, AMapIsCheckedAndBuiltApartThenInstalled) {
   // pf_node builds a new map without the filter's lock: building reads only
   // the recipe, refuses what setMap refuses, and installing is setMap's.

@@ -1,15 +1,17 @@
 // An initial pose given in another frame than the global one (odom, or
 // base_link: "1 m ahead of the robot") moved into the global frame, its
-// covariance rotated with it.
+// covariance rotated with it; and moved on by the odometry since it was given.
 #pragma once
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <geometry_msgs/TransformStamped.h>
+#include <tf2/buffer_core.h>
 #include <tf2_ros/buffer.h>
 
 #include <optional>
 #include <string>
 
+#include "pf_localization/core/util/pose2.h"
 #include "pf_localization/ros/diagnostics/limited_warn.h"
 
 namespace pf_ros {
@@ -24,7 +26,7 @@ geometry_msgs::PoseWithCovarianceStamped inParentFrame(
 
 /// `pose` moved into `frame` through `tf`'s latest transform from its
 /// frame, waiting up to `timeout` for one; the header's frame_id becomes
-/// `frame`. Nothing when there is none, and `error` says why.
+/// `frame`, its stamp the transform's. Nothing when there is none, and `error` says why.
 std::optional<geometry_msgs::PoseWithCovarianceStamped> poseInFrame(
     const tf2_ros::Buffer& tf, const geometry_msgs::PoseWithCovarianceStamped& pose,
     const std::string& frame, const ros::Duration& timeout, std::string* error);
@@ -36,5 +38,14 @@ std::optional<geometry_msgs::PoseWithCovarianceStamped> poseInFrame(
 std::optional<geometry_msgs::PoseWithCovarianceStamped> initialPoseInFrame(
     const tf2_ros::Buffer& tf, const geometry_msgs::PoseWithCovarianceStamped& pose,
     const std::string& global_frame, LimitedWarn* warn);
+
+/// The robot's pose `pose`, as it was at `stamp`, moved on by the odometry
+/// since: where tf's latest odom_frame -> base_frame puts it (amcl moves an
+/// initial pose the same way). A pose given while the robot drives, or with
+/// a map that takes a while to build (set_map), is where the robot was when
+/// it was given. As it is when `stamp` is zero or tf cannot tell.
+pf::Pose2 movedByOdometrySince(const tf2::BufferCore& tf, const pf::Pose2& pose,
+                               const ros::Time& stamp, const std::string& odom_frame,
+                               const std::string& base_frame);
 
 }  // namespace pf_ros

@@ -92,8 +92,9 @@ class ScanLocalizer {
   /// Installs a prepared map as setMap above does; `map.error` when it was refused.
   std::string setMap(ReadyMap map);
 
-  /// Re-initialises around a pose given in the global frame. A pose in
-  /// another frame must be transformed by the caller (pf_node does, via tf).
+  /// Re-initialises around a pose given in the global frame, moved on by the
+  /// odometry since its stamp (movedByOdometrySince). A pose in another
+  /// frame must be transformed by the caller (pf_node does, via tf).
   /// Returns an error message (empty on success).
   std::string setInitialPose(const geometry_msgs::PoseWithCovarianceStamped& pose);
 
@@ -125,7 +126,10 @@ class ScanLocalizer {
   /// weighed like any other sensor's scan.
   ScanResult processCloud(const sensor_msgs::PointCloud2& cloud, std::size_t sensor);
 
-  /// map -> odom to publish, stamped `stamp` (the caller adds transform_tolerance).
+  /// map -> odom to publish, stamped `stamp` (the caller adds transform_tolerance):
+  /// the filter's, or between an initial pose and the first update after it,
+  /// the one that pose gives with the latest odometry (as amcl keeps
+  /// publishing through a re-initialisation; none when tf has no odometry).
   std::optional<geometry_msgs::TransformStamped> mapToOdom(const ros::Time& stamp) const;
   /// The estimate with covariance, stamped `stamp`, in the global frame.
   std::optional<geometry_msgs::PoseWithCovarianceStamped> estimate(const ros::Time& stamp) const;
@@ -167,6 +171,7 @@ class ScanLocalizer {
   const Eigen::Matrix3d configured_cov_;
   const tf2::BufferCore* tf_;
   pf::ParticleFilter filter_;
+  std::optional<pf::Pose2> given_map_to_odom_;  // mapToOdom() from the last initial pose
   bool had_map_ = false;
   nav_msgs::MapMetaData map_info_;                 // of the map in use
   std::vector<std::optional<SensorScan>> latest_;  // per sensor
