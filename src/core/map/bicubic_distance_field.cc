@@ -63,19 +63,22 @@ __attribute__((target("avx2"))) inline void stencil4(__m128i lo, int size, __m12
 struct Grid {
   double c, s, inv_res, origin_x, origin_y, max_distance;
   int width, height;
-  const float* d;  // the surface distances, row-major
+  const float* d;  // DistanceField::signedDistances: |d| is the surface distance
 };
 
-// One row of four lanes' stencils: v[k] holds, in each lane, the cell at
-// column xs[k] of the row starting at row_start. `contiguous`: every lane's
-// four columns are xs[0] .. xs[0] + 3 (none clamped), which four loads and a
+// One row of four lanes' stencils: v[k] holds, in each lane, the surface
+// distance (|d|: the sign bit cleared, as std::fabs) of the cell at column
+// xs[k] of the row starting at row_start. `contiguous`: every lane's four
+// columns are xs[0] .. xs[0] + 3 (none clamped), which four loads and a
 // transpose fetch faster than four gathers.
 __attribute__((target("avx2"))) inline void stencilRow4(const float* d, __m128i row_start,
                                                         const __m128i xs[4], bool contiguous,
                                                         __m256d v[4]) {
+  const __m128 sign = _mm_set1_ps(-0.0f);
   if (!contiguous) {
     for (int k = 0; k < 4; ++k) {
-      v[k] = _mm256_cvtps_pd(_mm_i32gather_ps(d, _mm_add_epi32(row_start, xs[k]), 4));
+      const __m128 g = _mm_i32gather_ps(d, _mm_add_epi32(row_start, xs[k]), 4);
+      v[k] = _mm256_cvtps_pd(_mm_andnot_ps(sign, g));
     }
     return;
   }
@@ -84,10 +87,10 @@ __attribute__((target("avx2"))) inline void stencilRow4(const float* d, __m128i 
   __m128 r0 = _mm_loadu_ps(d + first[0]), r1 = _mm_loadu_ps(d + first[1]);
   __m128 r2 = _mm_loadu_ps(d + first[2]), r3 = _mm_loadu_ps(d + first[3]);
   _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
-  v[0] = _mm256_cvtps_pd(r0);
-  v[1] = _mm256_cvtps_pd(r1);
-  v[2] = _mm256_cvtps_pd(r2);
-  v[3] = _mm256_cvtps_pd(r3);
+  v[0] = _mm256_cvtps_pd(_mm_andnot_ps(sign, r0));
+  v[1] = _mm256_cvtps_pd(_mm_andnot_ps(sign, r1));
+  v[2] = _mm256_cvtps_pd(_mm_andnot_ps(sign, r2));
+  v[3] = _mm256_cvtps_pd(_mm_andnot_ps(sign, r3));
 }
 
 // BicubicDistanceField::sample for the points [0, n) in blocks of four, one
@@ -194,13 +197,14 @@ FieldSample BicubicDistanceField::sample(double wx, double wy) const {
   const auto clamp = [](int v, int size) { return v < 0 ? 0 : (v >= size ? size - 1 : v); };
   int xs[4];
   for (int i = 0; i < 4; ++i) xs[i] = clamp(ix - 1 + i, width_);
-  const float* d = field_.surfaceDistances().data();
+  // The surface distance of a cell is |d| (DistanceField::signedDistances).
+  const float* d = field_.signedDistances().data();
   double value = 0.0, dgx = 0.0, dgy = 0.0;
   for (int j = 0; j < 4; ++j) {
     const float* row_cells = d + static_cast<std::size_t>(clamp(iy - 1 + j, height_)) * width_;
     double row = 0.0, drow = 0.0;
     for (int i = 0; i < 4; ++i) {
-      const double v = row_cells[xs[i]];
+      const double v = std::fabs(row_cells[xs[i]]);
       row += wxs[i] * v;
       drow += dwxs[i] * v;
     }
@@ -220,7 +224,7 @@ void BicubicDistanceField::sample(const double* wx, const double* wy, std::size_
   if (avx2 && int_indices_) {
     const Grid g{cos_yaw_,  sin_yaw_,  inv_resolution_,
                  origin_x_, origin_y_, field_.maxDistance(),
-                 width_,    height_,   field_.surfaceDistances().data()};
+                 width_,    height_,   field_.signedDistances().data()};
     i = sampleBlocksAvx2(g, wx, wy, n, out);
   }
 #endif

@@ -19,34 +19,35 @@ DistanceField::DistanceField(OccupancyGrid grid, double max_distance)
   for (std::size_t i = 0; i < occupied.size(); ++i) {
     occupied[i] = OccupancyGrid::classify(grid_.data()[i]) == CellState::kOccupied;
   }
-  // Squared cells, turned into metres in place.
-  distances_ = squaredDistanceTransform(occupied, grid_.width(), grid_.height());
+  // Squared cells, turned into metres in place: +0 on occupied cells, > 0
+  // elsewhere (at least a cell away).
+  signed_ = squaredDistanceTransform(occupied, grid_.width(), grid_.height());
   const float cap = static_cast<float>(max_distance);
   const float res = static_cast<float>(grid_.resolution());
-  for (float& d : distances_) d = std::min(std::sqrt(d) * res, cap);  // sqrt(inf) = inf -> cap
+  for (float& d : signed_) d = std::min(std::sqrt(d) * res, cap);  // sqrt(inf) = inf -> cap
   // Inside an obstacle, how far past its surface: the distance to the nearest
   // cell that is not occupied, less the surface cell's own and kFreeDepth. A
   // map whose obstacles are all that thin (a real map's walls) needs no second
-  // transform: its surface distances are its distances.
+  // transform: its occupied cells' depths are all 0, which the +0 holds.
   if (!hasDeepCells(occupied, grid_.width(), grid_.height())) return;
   addDepths(occupied, grid_.width(), grid_.height(), res, cap);
 }
 
 void DistanceField::addDepths(const std::vector<bool>& occupied, int width, int height, float res,
                               float cap) {
-  // Over the whole map, not only the obstacles' bounding box: the depths'
-  // own array then becomes the surface distances, and at most two arrays of
-  // the map's size are held at once (a box's depths beside a whole copy of
-  // the distances were three: 575 MB on a 200 x 600 m floor).
+  // The depths over the whole map in their own array, merged into signed_:
+  // two arrays of the map's size for the moment of the merge, one after it.
   std::vector<bool> open = occupied;
   open.flip();
-  std::vector<float> depth = squaredDistanceTransform(open, width, height);
+  const std::vector<float> depth = squaredDistanceTransform(open, width, height);
+  open = std::vector<bool>();
   for (std::size_t i = 0; i < depth.size(); ++i) {
-    depth[i] = occupied[i]
-                   ? std::min(std::max(std::sqrt(depth[i]) - 1.0f - kFreeDepth, 0.0f) * res, cap)
-                   : distances_[i];
+    // The depth is >= +0 (max with +0), so its negation is <= 0; -0 where
+    // it is 0, which distance() and surfaceDistance() both read as +0.
+    if (occupied[i]) {
+      signed_[i] = -std::min(std::max(std::sqrt(depth[i]) - 1.0f - kFreeDepth, 0.0f) * res, cap);
+    }
   }
-  surface_distances_ = std::move(depth);
 }
 
 bool DistanceField::hasDeepCells(const std::vector<bool>& occupied, int width, int height) {
@@ -72,7 +73,8 @@ bool DistanceField::hasDeepCells(const std::vector<bool>& occupied, int width, i
 }
 
 double DistanceField::distance(const CellIndex& c) const {
-  return grid_.contains(c) ? distances_[grid_.linearIndex(c)] : max_distance_;
+  return grid_.contains(c) ? distance(static_cast<std::size_t>(grid_.linearIndex(c)))
+                           : max_distance_;
 }
 
 }  // namespace pf

@@ -96,7 +96,6 @@ MapChangeLayer::MapChangeLayer(const DistanceField& field)
       frame_(field.grid()),
       tiles_x_((width_ + kTileSize - 1) >> kTileBits) {
   const OccupancyGrid& grid = field.grid();
-  const std::vector<float>& distance = field.distances();
   cells_.resize(grid.data().size());
   for (std::size_t i = 0; i < cells_.size(); ++i) {
     switch (OccupancyGrid::classify(grid.data()[i])) {
@@ -107,7 +106,7 @@ MapChangeLayer::MapChangeLayer(const DistanceField& field)
         cells_[i] = kMapUnknown;
         break;
       case CellState::kFree:
-        cells_[i] = distance[i] <= kBesideObstacle ? kMapBeside : kMapFree;
+        cells_[i] = field.distance(i) <= kBesideObstacle ? kMapBeside : kMapFree;
         break;
     }
   }

@@ -69,13 +69,13 @@ double MapEvidence::cast(double cx, double cy, double dx, double dy, double max_
   // DistanceFieldRayCaster's trace, each cell's jump worked out from the
   // field's distance as the ray reaches it rather than read from a table.
   const OccupancyGrid& grid = field_->grid();
-  const std::vector<float>& distance = field_->distances();
+  const DistanceField& field = *field_;
   const int w = grid.width(), h = grid.height();
   return sphereTrace(cx, cy, dx, dy, max_range, grid.resolution(), w + 2, h + 2, [&](int x, int y) {
     if (x == 0 || y == 0 || x > w || y > h) return kTraceLeaves;  // the border
     const std::size_t i = static_cast<std::size_t>(y - 1) * w + (x - 1);
     // An occupied cell is 0 from the nearest occupied cell: never a jump.
-    const float cells = distance[i] * cells_per_metre_;
+    const float cells = field.distance(i) * cells_per_metre_;
     if (cells > 1.5f) return cells - 1.5f;
     const bool stops =
         OccupancyGrid::classify(grid.data()[i]) == CellState::kOccupied && gone_.count(i) == 0;

@@ -106,12 +106,12 @@ LikelihoodFieldModel::LikelihoodFieldModel(OccupancyGrid grid,
   const OccupancyGrid& map = field_->grid();
   const int stride = map.width() + 2;
   near_.assign(static_cast<std::size_t>(stride) * (map.height() + 2), 0);
-  const std::vector<float>& dist = field_->distances();
   for (int y = 0; y < map.height(); ++y) {
     for (int x = 0; x < map.width(); ++x) {
-      // amcl's test: occ_dist < beam_skip_distance.
+      // amcl's test: occ_dist < beam_skip_distance (0 on an occupied cell).
+      const float occ_dist = field_->distance(static_cast<std::size_t>(y) * map.width() + x);
       near_[static_cast<std::size_t>(y + 1) * stride + x + 1] =
-          dist[static_cast<std::size_t>(y) * map.width() + x] < params.beam_skip_distance ? 1 : 0;
+          occ_dist < params.beam_skip_distance ? 1 : 0;
     }
   }
 }
@@ -157,10 +157,9 @@ void LikelihoodFieldModel::buildTable(double range_max, std::vector<float>* out)
   };
   constexpr int kMemoBits = 14;
   std::vector<Memo> memo(std::size_t{1} << kMemoBits);
-  const std::vector<float>& dist = field_->distances();
   for (int y = 0; y < grid.height(); ++y) {
     for (int x = 0; x < grid.width(); ++x) {
-      const float d = dist[static_cast<std::size_t>(y) * grid.width() + x];
+      const float d = field_->distance(static_cast<std::size_t>(y) * grid.width() + x);
       uint32_t bits;
       std::memcpy(&bits, &d, sizeof bits);
       Memo& m = memo[(bits * 2654435761u) >> (32 - kMemoBits)];

@@ -134,5 +134,40 @@ TEST(BicubicDistanceField, ManyPointsAtOnceAreTheSameBits) {
   }
 }
 
+// Inside a thick obstacle the field is the surface distance, which
+// DistanceField stores negated: both paths, one point at a time and four,
+// read it as |v|, and pass through it at the cell centres.
+TEST(BicubicDistanceField, InsideAThickObstacleBothPathsSampleTheSurfaceDistance) {
+  // 23 x 17 cells of 0.05 m with a block 15 x 11 cells (x 4-18, y 3-13),
+  // whose middle lies up to six cells deep.
+  const int width = 23, height = 17;
+  std::vector<int8_t> data(static_cast<std::size_t>(width) * height, 0);
+  for (int y = 3; y <= 13; ++y) {
+    for (int x = 4; x <= 18; ++x) data[y * width + x] = 100;
+  }
+  const DistanceField field(OccupancyGrid(width, height, 0.05, {}, data), 0.5);
+  const BicubicDistanceField smooth(field);
+  std::vector<double> wx, wy;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      wx.push_back((x + 0.5) * 0.05);
+      wy.push_back((y + 0.5) * 0.05);
+    }
+  }
+  std::vector<FieldSample> many(wx.size());
+  smooth.sample(wx.data(), wy.data(), wx.size(), many.data());
+  int deep = 0;
+  for (std::size_t i = 0; i < wx.size(); ++i) {
+    const FieldSample one = smooth.sample(wx[i], wy[i]);
+    EXPECT_NEAR(field.surfaceDistance(i), one.distance, 1e-9) << wx[i] << ", " << wy[i];
+    EXPECT_EQ(0, std::memcmp(&one, &many[i], sizeof(FieldSample))) << wx[i] << ", " << wy[i];
+    if (field.surfaceDistance(i) > 0.0f && field.distance(i) == 0.0f) ++deep;
+  }
+  // Three to six cells deep, (x 6-16) x (y 5-11): one to four cells past
+  // the surface less kFreeDepth.
+  EXPECT_EQ(11 * 7, deep);
+  EXPECT_NEAR(0.2, smooth.sample(11.5 * 0.05, 8.5 * 0.05).distance, 1e-6);  // six deep (a float)
+}
+
 }  // namespace
 }  // namespace pf

@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <limits>
 #include <stdexcept>
 #include <vector>
@@ -28,8 +31,8 @@ TEST(DistanceField, DistancesAreInMetres) {
   EXPECT_NEAR(0.5 * std::sqrt(2.0), field.distance({0, 0}), kTol);
   EXPECT_NEAR(1.5, field.distance({4, 1}), kTol);
   EXPECT_NEAR(0.5 * std::sqrt(13.0), field.distance({4, 3}), kTol);  // (3^2 + 2^2)
-  ASSERT_EQ(20u, field.distances().size());
-  EXPECT_NEAR(0.5 * std::sqrt(13.0), field.distances()[3 * 5 + 4], kTol);
+  ASSERT_EQ(20u, field.size());
+  EXPECT_NEAR(0.5 * std::sqrt(13.0), field.distance(std::size_t{3 * 5 + 4}), kTol);
 }
 
 TEST(DistanceField, InsideAThickObstacleTheSurfaceDistanceIsHowFarPastItsSurface) {
@@ -39,7 +42,7 @@ TEST(DistanceField, InsideAThickObstacleTheSurfaceDistanceIsHowFarPastItsSurface
     for (int x = 1; x <= 6; ++x) data[y * 9 + x] = 100;
   }
   const DistanceField field(OccupancyGrid(9, 3, 0.1, {}, data), 2.0);
-  const auto at = [&field](int x) { return field.surfaceDistances()[1 * 9 + x]; };
+  const auto at = [&field](int x) { return field.surfaceDistance(1 * 9 + x); };
   // The surface cells and the next (kFreeDepth) are on the wall ...
   EXPECT_NEAR(0.0, at(1), kTol);
   EXPECT_NEAR(0.0, at(2), kTol);
@@ -55,6 +58,73 @@ TEST(DistanceField, InsideAThickObstacleTheSurfaceDistanceIsHowFarPastItsSurface
   EXPECT_NEAR(0.0, field.distance({3, 1}), kTol);
 }
 
+// The float's bits: +0.0f and -0.0f compare equal, but the likelihood
+// table's memo keys on the bits.
+uint32_t bitsOf(float v) {
+  uint32_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  return bits;
+}
+
+TEST(DistanceField, OneArrayHoldsBothTheDistanceAndTheSurfaceDistance) {
+  // 16 x 12 cells of 0.1 m: a block 10 x 8 cells (x 3-12, y 2-9), whose
+  // middle lies up to four cells deep, beside a wall one cell thick (x 14).
+  const int w = 16, h = 12;
+  std::vector<int8_t> data(w * h, 0);
+  std::vector<bool> occupied(w * h, false);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      if ((x >= 3 && x <= 12 && y >= 2 && y <= 9) || x == 14) {
+        data[y * w + x] = 100;
+        occupied[y * w + x] = true;
+      }
+    }
+  }
+  const double res = 0.1, cap = 2.0;
+  const DistanceField field(OccupancyGrid(w, h, res, {}, data), cap);
+  ASSERT_EQ(static_cast<std::size_t>(w * h), field.size());
+  const auto nearest = [&](int x, int y, bool want_occupied) {
+    double best = std::numeric_limits<double>::infinity();
+    for (int v = 0; v < h; ++v) {
+      for (int u = 0; u < w; ++u) {
+        if (occupied[v * w + u] == want_occupied) best = std::min(best, std::hypot(u - x, v - y));
+      }
+    }
+    return best;
+  };
+  int deep = 0;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = y * w + x;
+      const float v = field.signedDistances()[i];
+      if (occupied[i]) {
+        // The distance is +0.0f to the bit; the surface distance the depth
+        // past the surface less the surface cell and kFreeDepth.
+        EXPECT_EQ(bitsOf(0.0f), bitsOf(field.distance(i))) << x << ", " << y;
+        EXPECT_EQ(0.0, field.distance({x, y}));
+        const double depth = std::min(
+            std::max(nearest(x, y, false) - 1.0 - DistanceField::kFreeDepth, 0.0) * res, cap);
+        EXPECT_NEAR(depth, field.surfaceDistance(i), kTol) << x << ", " << y;
+        EXPECT_FALSE(std::signbit(field.surfaceDistance(i)));
+        EXPECT_LE(v, 0.0f);
+        if (depth > 0.0) ++deep;
+      } else {
+        // Off obstacles the two are one value, the distance, > 0.
+        const double d = std::min(nearest(x, y, true) * res, cap);
+        EXPECT_NEAR(d, field.distance(i), kTol) << x << ", " << y;
+        EXPECT_EQ(bitsOf(field.distance(i)), bitsOf(field.surfaceDistance(i)));
+        EXPECT_EQ(bitsOf(v), bitsOf(field.distance(i)));
+        EXPECT_GT(v, 0.0f);
+      }
+    }
+  }
+  // The block's middle, 6 x 4 cells three or four deep (x 5-10, y 4-7): one
+  // or two cells past the surface less kFreeDepth.
+  EXPECT_EQ(6 * 4, deep);
+  EXPECT_NEAR(0.2, field.surfaceDistance(5 * w + 7), kTol);  // 4 cells deep
+  EXPECT_NEAR(0.1, field.surfaceDistance(4 * w + 6), kTol);  // 3 cells deep
+}
+
 TEST(DistanceField, DistancesAreCappedAtMaxDistance) {
   const DistanceField field(oneObstacle(), 1.0);
   EXPECT_EQ(1.0, field.maxDistance());
@@ -62,12 +132,15 @@ TEST(DistanceField, DistancesAreCappedAtMaxDistance) {
   EXPECT_NEAR(1.0, field.distance({3, 1}), kTol);                   // exactly 2 cells
   EXPECT_NEAR(1.0, field.distance({4, 1}), kTol);                   // 1.5 m, capped
   EXPECT_NEAR(1.0, field.distance({4, 3}), kTol);                   // 1.80 m, capped
-  for (float d : field.distances()) EXPECT_LE(d, 1.0f);
+  for (std::size_t i = 0; i < field.size(); ++i) EXPECT_LE(field.surfaceDistance(i), 1.0f);
 }
 
 TEST(DistanceField, NoObstacleIsMaxDistanceEverywhere) {
   const DistanceField field(OccupancyGrid(5, 4, 0.5, {}, std::vector<int8_t>(20, 0)), 2.0);
-  for (float d : field.distances()) EXPECT_EQ(2.0f, d);
+  for (std::size_t i = 0; i < field.size(); ++i) {
+    EXPECT_EQ(2.0f, field.distance(i));
+    EXPECT_EQ(2.0f, field.surfaceDistance(i));
+  }
 }
 
 TEST(DistanceField, UnknownCellsAreNotObstacles) {

@@ -193,14 +193,14 @@ TEST(LikelihoodFieldModel, EveryCellScoresItsOwnDistanceOnALargeMap) {
   p.z_rand = 0.0;
   p.sigma_hit = 5.0;
   const LikelihoodFieldModel model(OccupancyGrid(200, 200, 0.1, {}, data), p);
-  const std::vector<float>& distance = model.field().distances();
+  const DistanceField& field = model.field();
   // One beam of 1 m along +x, from 1 m left of each cell's centre.
   const PreparedScan scan = model.prepare(quarterScan({1.0f}));
   ASSERT_EQ(1u, scan.size());
   for (int y = 0; y < 200; y += 3) {
     for (int x = 0; x < 200; ++x) {
       const float expected =
-          static_cast<float>(model.beamLogLikelihood(distance[y * 200 + x], scan.range_max));
+          static_cast<float>(model.beamLogLikelihood(field.distance(y * 200 + x), scan.range_max));
       const double got = model.logLikelihood(scan, {(x + 0.5) * 0.1 - 1.0, (y + 0.5) * 0.1, 0.0});
       ASSERT_EQ(expected, static_cast<float>(got)) << "cell (" << x << ", " << y << ")";
     }

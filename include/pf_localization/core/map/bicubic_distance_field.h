@@ -1,5 +1,5 @@
 // A smooth distance field: the likelihood field's per-cell distances to the
-// obstacles' surfaces (DistanceField::surfaceDistances: inside a thick
+// obstacles' surfaces (DistanceField::surfaceDistance: inside a thick
 // obstacle they grow again), interpolated bicubically between cell centres,
 // with the gradient.
 //
