@@ -32,13 +32,6 @@ OccupancyGrid::OccupancyGrid(int width, int height, double resolution, const Pos
                           [this](std::size_t i) { return classify(data_[i]) == CellState::kFree; });
 }
 
-CellState OccupancyGrid::classify(int8_t value) {
-  if (value < 0) return CellState::kUnknown;
-  if (value >= kOccupiedMin) return CellState::kOccupied;
-  if (value <= kFreeMax) return CellState::kFree;
-  return CellState::kUnknown;
-}
-
 CellState OccupancyGrid::state(const CellIndex& c) const {
   return contains(c) ? classify(data_[linearIndex(c)]) : CellState::kUnknown;
 }

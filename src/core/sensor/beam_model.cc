@@ -31,7 +31,10 @@ const ParameterTable<BeamModelParams>& beamModelParameters() {
 
 BeamModel::BeamModel(const OccupancyGrid& grid, const LikelihoodFieldModelParams& shared,
                      const BeamModelParams& params)
-    : shared_(shared), params_(params), field_(grid, shared.max_distance), caster_(grid) {
+    : shared_(shared),
+      params_(params),
+      field_(grid, shared.max_distance, shared.threads),
+      caster_(grid) {
   checkRanges(beamModelParameters(), params);
   validate(shared);
 }

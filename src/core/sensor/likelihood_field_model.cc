@@ -101,7 +101,8 @@ void validate(const LikelihoodFieldModelParams& params) {
 LikelihoodFieldModel::LikelihoodFieldModel(OccupancyGrid grid,
                                            const LikelihoodFieldModelParams& params)
     : params_((validate(params), params)),
-      field_(std::make_shared<const DistanceField>(std::move(grid), params.max_distance)) {
+      field_(std::make_shared<const DistanceField>(std::move(grid), params.max_distance,
+                                                   params.threads)) {
   if (!params.beam_skip) return;
   const OccupancyGrid& map = field_->grid();
   const int stride = map.width() + 2;

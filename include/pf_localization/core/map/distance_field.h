@@ -33,14 +33,19 @@ class DistanceField {
   static constexpr float kFreeDepth = 1.0f;
 
   /// Throws std::invalid_argument when max_distance is not positive and
-  /// finite. Keeps `grid` (moved in: a large map is not held twice).
-  DistanceField(OccupancyGrid grid, double max_distance);
+  /// finite. Keeps `grid` (moved in: a large map is not held twice). Its two
+  /// transforms (to the obstacles, and inside them) run on up to `threads`
+  /// threads (WorkerPool); the result is the same on any number.
+  DistanceField(OccupancyGrid grid, double max_distance, int threads = 1);
 
   double maxDistance() const { return max_distance_; }
   const OccupancyGrid& grid() const { return grid_; }
 
   /// Distance in metres to the nearest occupied cell centre, at most max_distance.
-  double distance(const CellIndex& c) const;
+  double distance(const CellIndex& c) const {
+    return grid_.contains(c) ? distance(static_cast<std::size_t>(grid_.linearIndex(c)))
+                             : max_distance_;
+  }
   double distanceAt(double wx, double wy) const { return distance(grid_.worldToCell(wx, wy)); }
 
   /// Cell i's (row-major) distance: metres to the nearest occupied cell
@@ -62,10 +67,12 @@ class DistanceField {
   // Whether any occupied cell lies deeper than 1 + kFreeDepth cells inside
   // its obstacle (the only cells whose surface distance is not 0).
   static bool hasDeepCells(const std::vector<bool>& occupied, int width, int height);
-  // Stores each occupied cell's depth past the surface, negated, in
+  // Stores each occupied cell's depth past the surface (from `depth`, the
+  // squared distances in cells to the nearest open cell), negated, in
   // signed_ (which holds the distances; res: metres per cell; cap:
   // max_distance).
-  void addDepths(const std::vector<bool>& occupied, int width, int height, float res, float cap);
+  void addDepths(const std::vector<bool>& occupied, const std::vector<float>& depth, float res,
+                 float cap);
 
   OccupancyGrid grid_;
   double max_distance_;

@@ -57,7 +57,11 @@ class OccupancyGrid {
 
   /// State of a cell; out-of-map cells are kUnknown.
   CellState state(const CellIndex& c) const;
-  static CellState classify(int8_t value);
+  static CellState classify(int8_t value) {
+    if (value < 0) return CellState::kUnknown;
+    if (value >= kOccupiedMin) return CellState::kOccupied;
+    return value <= kFreeMax ? CellState::kFree : CellState::kUnknown;
+  }
 
   /// Cell containing a world point. A point off the map gives -1 or width
   /// (height) in the coordinate that is off: check contains().
