@@ -59,23 +59,30 @@ void MapChangeLayer::count(std::size_t i, Kind kind) {
       bump(&c.ends);
       break;
   }
-  setValue(i, valueOf(classify(i)));
+  show(i, classify(i));
 }
 
-void MapChangeLayer::setValue(std::size_t i, std::int8_t v) {
-  const std::int8_t was = values_[i];
-  if (v == was) return;
-  // Unseen counts nowhere; every other value once in seen.
-  if (was == valueOf(Cell::kUnseen)) ++summary_.seen;
-  if (v == valueOf(Cell::kUnseen)) --summary_.seen;
-  if (was == valueOf(Cell::kAdded)) --summary_.added;
-  if (v == valueOf(Cell::kAdded)) ++summary_.added;
-  if (was == valueOf(Cell::kRemoved)) --summary_.removed;
-  if (v == valueOf(Cell::kRemoved)) ++summary_.removed;
-  values_[i] = v;
-  if (removed(i) || added(i) || was == valueOf(Cell::kAdded) || was == valueOf(Cell::kRemoved)) {
+void MapChangeLayer::show(std::size_t i, Cell c) {
+  const Cell was = shown(i);
+  if (c == was) return;
+  // Unseen counts nowhere; every other state once in seen.
+  if (was == Cell::kUnseen) ++summary_.seen;
+  if (c == Cell::kUnseen) --summary_.seen;
+  if (was == Cell::kAdded) --summary_.added;
+  if (c == Cell::kAdded) ++summary_.added;
+  if (was == Cell::kRemoved) --summary_.removed;
+  if (c == Cell::kRemoved) ++summary_.removed;
+  cells_[i] = static_cast<std::uint8_t>((cells_[i] & ~kShownBits) | static_cast<std::uint8_t>(c)
+                                                                        << kShownShift);
+  if (removed(i) || added(i) || was == Cell::kAdded || was == Cell::kRemoved) {
     changed_cells_.push_back(i);
   }
+}
+
+std::vector<std::int8_t> MapChangeLayer::occupancy() const {
+  std::vector<std::int8_t> out(cells_.size());
+  for (std::size_t i = 0; i < cells_.size(); ++i) out[i] = valueOf(shown(i));
+  return out;
 }
 
 std::vector<std::size_t> MapChangeLayer::takeChangedCells() {
@@ -87,7 +94,7 @@ std::vector<std::size_t> MapChangeLayer::takeChangedCells() {
 void MapChangeLayer::see(std::size_t i) {
   if (cells_[i] & kSeen) return;
   cells_[i] |= kSeen;
-  setValue(i, valueOf(Cell::kAsMapped));
+  show(i, Cell::kAsMapped);
 }
 
 MapChangeLayer::MapChangeLayer(const DistanceField& field)
@@ -111,16 +118,14 @@ MapChangeLayer::MapChangeLayer(const DistanceField& field)
     }
   }
   tiles_.resize(static_cast<std::size_t>(tiles_x_) * ((height_ + kTileSize - 1) >> kTileBits));
-  values_.assign(cells_.size(), valueOf(Cell::kUnseen));
 }
 
 void MapChangeLayer::clear() {
-  for (std::size_t i = 0; i < values_.size(); ++i) {
+  for (std::size_t i = 0; i < cells_.size(); ++i) {
     if (removed(i) || added(i)) changed_cells_.push_back(i);
   }
   for (std::unique_ptr<Counts[]>& tile : tiles_) tile.reset();
-  for (std::uint8_t& c : cells_) c &= kMapBits;
-  std::fill(values_.begin(), values_.end(), valueOf(Cell::kUnseen));
+  for (std::uint8_t& c : cells_) c &= kMapBits;  // unseen, shown as such (0)
   summary_ = Summary();
   scans_ = 0;
 }
@@ -239,9 +244,10 @@ std::int8_t MapChangeLayer::valueOf(Cell c) {
 }
 
 std::vector<std::uint8_t> MapChangeLayer::pixels() const {
-  std::vector<std::uint8_t> out(values_.size());
-  for (std::size_t i = 0; i < values_.size(); ++i) {
-    out[i] = values_[i] == 100 ? 0 : values_[i] == 50 ? 205 : values_[i] == 0 ? 254 : 128;
+  std::vector<std::uint8_t> out(cells_.size());
+  for (std::size_t i = 0; i < cells_.size(); ++i) {
+    const Cell c = shown(i);
+    out[i] = c == Cell::kAdded ? 0 : c == Cell::kRemoved ? 205 : c == Cell::kAsMapped ? 254 : 128;
   }
   return out;
 }

@@ -129,31 +129,35 @@ Candidate refine(const DistanceField& field, const std::vector<Eigen::Vector2d>&
   return bestOffset(field, samples, rough.motion, step, 1);
 }
 
-// Grid-frame centres of the map's obstacle cells.
-std::vector<Eigen::Vector2d> obstacleCentres(const OccupancyGrid& grid) {
-  const int w = grid.width(), h = grid.height();
-  const double res = grid.resolution();
-  std::vector<Eigen::Vector2d> obstacles;
+// The map's obstacle cells, by linear index (four bytes each, not a
+// centre's sixteen: a warehouse floor has millions).
+std::vector<std::uint32_t> obstacleCells(const OccupancyGrid& grid) {
+  std::vector<std::uint32_t> obstacles;
   const std::vector<int8_t>& cells = grid.data();
-  for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      if (OccupancyGrid::classify(cells[static_cast<std::size_t>(y) * w + x]) ==
-          CellState::kOccupied) {
-        obstacles.emplace_back((x + 0.5) * res, (y + 0.5) * res);
-      }
+  for (std::size_t i = 0; i < cells.size(); ++i) {
+    if (OccupancyGrid::classify(cells[i]) == CellState::kOccupied) {
+      obstacles.push_back(static_cast<std::uint32_t>(i));
     }
   }
   return obstacles;
 }
 
+// The grid-frame centre of obstacle cell `i`.
+Eigen::Vector2d centreOf(std::uint32_t i, const OccupancyGrid& grid) {
+  const std::uint32_t w = static_cast<std::uint32_t>(grid.width());
+  return {(static_cast<int>(i % w) + 0.5) * grid.resolution(),
+          (static_cast<int>(i / w) + 0.5) * grid.resolution()};
+}
+
 // The peaks of the coarse grid's autocorrelation (shifts) and
 // self-convolution (half turns) holding kMinSymmetryOverlap of its obstacle
 // cells, strongest first, at most kMaxSymmetries; `cell` m a side.
-std::vector<Candidate> coarsePeaks(const std::vector<Eigen::Vector2d>& obstacles, int cw, int ch,
-                                   double cell) {
+std::vector<Candidate> coarsePeaks(const std::vector<std::uint32_t>& obstacles,
+                                   const OccupancyGrid& grid, int cw, int ch, double cell) {
   const int p = fftSize(2 * std::max(cw, ch));
   std::vector<Complex> spectrum(static_cast<std::size_t>(p) * p);
-  for (const Eigen::Vector2d& u : obstacles) {
+  for (std::uint32_t i : obstacles) {
+    const Eigen::Vector2d u = centreOf(i, grid);
     const int cx = static_cast<int>(u.x() / cell), cy = static_cast<int>(u.y() / cell);
     spectrum[static_cast<std::size_t>(cy) * p + cx] = 1.0;
   }
@@ -205,17 +209,20 @@ std::vector<MapSymmetry> findMapSymmetries(const DistanceField& field) {
   const OccupancyGrid& grid = field.grid();
   const int w = grid.width(), h = grid.height();
   const double res = grid.resolution();
-  const std::vector<Eigen::Vector2d> obstacles = obstacleCentres(grid);
+  if (grid.data().size() > std::numeric_limits<std::uint32_t>::max()) return {};
+  const std::vector<std::uint32_t> obstacles = obstacleCells(grid);
   if (obstacles.empty()) return {};
 
   int f = std::max(1, static_cast<int>(std::ceil(kCoarseCell / res - 1e-9)));
   while ((w + f - 1) / f > kMaxCoarseSide || (h + f - 1) / f > kMaxCoarseSide) ++f;
   const std::vector<Candidate> candidates =
-      coarsePeaks(obstacles, (w + f - 1) / f, (h + f - 1) / f, f * res);
+      coarsePeaks(obstacles, grid, (w + f - 1) / f, (h + f - 1) / f, f * res);
 
   std::vector<Eigen::Vector2d> samples;
   const std::size_t stride = std::max<std::size_t>(1, obstacles.size() / kRefineSamples);
-  for (std::size_t i = 0; i < obstacles.size(); i += stride) samples.push_back(obstacles[i]);
+  for (std::size_t i = 0; i < obstacles.size(); i += stride) {
+    samples.push_back(centreOf(obstacles[i], grid));
+  }
   std::vector<Eigen::Vector2d> some;
   for (std::size_t i = 0; i < samples.size(); i += 4) some.push_back(samples[i]);
   std::vector<Candidate> refined;

@@ -84,8 +84,9 @@ class MapChangeLayer {
 
   /// Every cell as a nav_msgs/OccupancyGrid value, row-major from the
   /// lower-left cell: -1 unseen, 0 seen as mapped, 100 added, 50 removed
-  /// (kept up to date as scans are added: a copy is all a message costs).
-  const std::vector<std::int8_t>& occupancy() const { return values_; }
+  /// (each cell's state is kept up to date as scans are added, in two bits
+  /// of its byte: a message costs a pass over the cells).
+  std::vector<std::int8_t> occupancy() const;
   static std::int8_t valueOf(Cell c);
   /// Every cell as an image's pixel (saveImage, map_loader.h), in the true
   /// change mask's convention (pf_simulator --change-mask): 0 added, 205
@@ -96,8 +97,8 @@ class MapChangeLayer {
 
   /// Whether the cell at row-major index i is a mapped obstacle seen gone;
   /// an obstacle the map lacks.
-  bool removed(std::size_t i) const { return values_[i] == valueOf(Cell::kRemoved); }
-  bool added(std::size_t i) const { return values_[i] == valueOf(Cell::kAdded); }
+  bool removed(std::size_t i) const { return shown(i) == Cell::kRemoved; }
+  bool added(std::size_t i) const { return shown(i) == Cell::kAdded; }
   /// The cells (row-major indices) that became added or removed, or stopped
   /// being, since the last call: what the judging of scans learns.
   std::vector<std::size_t> takeChangedCells();
@@ -116,9 +117,13 @@ class MapChangeLayer {
   };
   enum Kind : std::uint8_t { kHit = 1, kFree = 2, kPass = 4, kEnd = 8 };
   // Each cell's byte: what the map has there (the low two bits), whether a
-  // beam reached it, and whether one ever ended there short of the map.
+  // beam reached it, whether one ever ended there short of the map, and the
+  // Cell it is shown as (two bits from kShownShift).
   enum MapCell : std::uint8_t { kMapFree, kMapBeside, kMapOccupied, kMapUnknown, kMapBits = 3 };
   enum Flag : std::uint8_t { kSeen = 4, kWasHit = 8 };
+  static constexpr int kShownShift = 4;
+  static constexpr std::uint8_t kShownBits = 3 << kShownShift;
+  Cell shown(std::size_t i) const { return static_cast<Cell>(cells_[i] >> kShownShift & 3); }
 
   // Square tiles of kTileSize cells a side hold the counts, each made when a
   // beam first counts in it: a beam reaches kMaxRange at most, so a run
@@ -136,8 +141,8 @@ class MapChangeLayer {
   void count(std::size_t i, Kind kind);
   // Marks cell i seen.
   void see(std::size_t i);
-  // Sets cell i's occupancy() value, and keeps summary_ and changed_cells_.
-  void setValue(std::size_t i, std::int8_t v);
+  // Shows cell i as `c` (occupancy()), and keeps summary_ and changed_cells_.
+  void show(std::size_t i, Cell c);
   // One beam from (x, y) along (ux, uy), in cells of the grid's frame.
   void walk(double x, double y, double ux, double uy, double range);
   // The end point of a beam, in cells of the grid's frame.
@@ -145,11 +150,10 @@ class MapChangeLayer {
 
   int width_, height_;
   GridFrame frame_;                               // to walk in cells
-  std::vector<std::uint8_t> cells_;               // MapCell | Flag
+  std::vector<std::uint8_t> cells_;               // MapCell | Flag | shown Cell
   int tiles_x_;                                   // tiles per row
   std::vector<std::unique_ptr<Counts[]>> tiles_;  // row-major; null: no count yet
-  std::vector<std::int8_t> values_;               // occupancy()
-  Summary summary_;                               // of values_
+  Summary summary_;                               // of the cells shown
   std::vector<std::size_t> changed_cells_;        // takeChangedCells()
   std::size_t scans_ = 0;
   Pose2 last_;  // the robot pose of the last scan added
