@@ -55,19 +55,27 @@ std::optional<geometry_msgs::PoseWithCovarianceStamped> initialPoseInFrame(
   return moved;
 }
 
-pf::Pose2 movedByOdometrySince(const tf2::BufferCore& tf, const pf::Pose2& pose,
-                               const ros::Time& stamp, const std::string& odom_frame,
-                               const std::string& base_frame) {
-  if (stamp.isZero()) return pose;
+PoseNow movedByOdometrySince(const tf2::BufferCore& tf, const pf::Pose2& pose,
+                             const ros::Time& stamp, const std::string& odom_frame,
+                             const std::string& base_frame) {
+  PoseNow out{pose, std::nullopt};
+  geometry_msgs::TransformStamped latest;
   try {
-    const geometry_msgs::TransformStamped then = tf.lookupTransform(odom_frame, base_frame, stamp);
-    const geometry_msgs::TransformStamped latest =
-        tf.lookupTransform(odom_frame, base_frame, ros::Time(0));
-    if (latest.header.stamp <= stamp) return pose;
-    return pf::compose(pose, pf::between(toPose2(then.transform), toPose2(latest.transform)));
+    latest = tf.lookupTransform(odom_frame, base_frame, ros::Time(0));
   } catch (const tf2::TransformException&) {
-    return pose;  // no odometry for then (before tf's buffer, or from a topic)
+    return out;  // no odometry yet (or it comes from a topic)
   }
+  const pf::Pose2 odom = toPose2(latest.transform);
+  if (!stamp.isZero() && stamp < latest.header.stamp) {
+    try {
+      const pf::Pose2 then = toPose2(tf.lookupTransform(odom_frame, base_frame, stamp).transform);
+      out.pose = pf::compose(pose, pf::between(then, odom));
+    } catch (const tf2::TransformException&) {
+      // No odometry for then (before tf's buffer): as given.
+    }
+  }
+  out.map_to_odom = pf::compose(out.pose, pf::inverse(odom));
+  return out;
 }
 
 }  // namespace pf_ros

@@ -134,9 +134,10 @@ std::string ScanLocalizer::setInitialPose(const geometry_msgs::PoseWithCovarianc
   if (!cov.allFinite()) return "ignoring the initial pose: its covariance is not finite";
   // rviz sends a fixed covariance; an all-zero one means "no opinion".
   if (cov.isZero()) cov = config_.initial_cov;
-  const pf::Pose2 pose = tf_ ? movedByOdometrySince(*tf_, given, msg.header.stamp,
-                                                    config_.odom_frame, config_.base_frame)
-                             : given;
+  const PoseNow now = tf_ ? movedByOdometrySince(*tf_, given, msg.header.stamp, config_.odom_frame,
+                                                 config_.base_frame)
+                          : PoseNow{given, std::nullopt};
+  const pf::Pose2& pose = now.pose;
   config_.initial_pose = pose;
   config_.initial_cov = cov;
   given_map_to_odom_.reset();
@@ -146,14 +147,7 @@ std::string ScanLocalizer::setInitialPose(const geometry_msgs::PoseWithCovarianc
   } catch (const std::invalid_argument& e) {
     return std::string("ignoring the initial pose: ") + e.what();
   }
-  if (!tf_) return "";
-  try {
-    const geometry_msgs::TransformStamped odom =
-        tf_->lookupTransform(config_.odom_frame, config_.base_frame, ros::Time(0));
-    given_map_to_odom_ = pf::compose(pose, pf::inverse(toPose2(odom.transform)));
-  } catch (const tf2::TransformException&) {
-    // No odometry yet: map -> odom waits for the first update.
-  }
+  given_map_to_odom_ = now.map_to_odom;  // none: map -> odom waits for the first update
   return "";
 }
 

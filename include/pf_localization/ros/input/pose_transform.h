@@ -39,13 +39,18 @@ std::optional<geometry_msgs::PoseWithCovarianceStamped> initialPoseInFrame(
     const tf2_ros::Buffer& tf, const geometry_msgs::PoseWithCovarianceStamped& pose,
     const std::string& global_frame, LimitedWarn* warn);
 
-/// The robot's pose `pose`, as it was at `stamp`, moved on by the odometry
-/// since: where tf's latest odom_frame -> base_frame puts it (amcl moves an
-/// initial pose the same way). A pose given while the robot drives, or with
-/// a map that takes a while to build (set_map), is where the robot was when
-/// it was given. As it is when `stamp` is zero or tf cannot tell.
-pf::Pose2 movedByOdometrySince(const tf2::BufferCore& tf, const pf::Pose2& pose,
-                               const ros::Time& stamp, const std::string& odom_frame,
-                               const std::string& base_frame);
+/// A pose given for the robot at `stamp`, as it stands at tf's latest
+/// odometry (odom_frame -> base_frame), and the map -> odom that goes with it.
+struct PoseNow {
+  pf::Pose2 pose;
+  std::optional<pf::Pose2> map_to_odom;  // none when tf has no odometry yet
+};
+/// `pose` moved on by the odometry since `stamp` (amcl moves an initial pose
+/// the same way): a pose given while the robot drives, or with a map that
+/// takes a while to build (set_map), is where the robot was when it was
+/// given. Not moved when `stamp` is zero or tf has no odometry for it.
+PoseNow movedByOdometrySince(const tf2::BufferCore& tf, const pf::Pose2& pose,
+                             const ros::Time& stamp, const std::string& odom_frame,
+                             const std::string& base_frame);
 
 }  // namespace pf_ros
