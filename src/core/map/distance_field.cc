@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 #include <utility>
 
 #include "pf_localization/core/map/distance_transform.h"
@@ -10,74 +11,197 @@
 
 namespace pf {
 
+// The distinct values a cell can take, and each squared distance's class.
+// Off obstacles a cell at k squared cells from the nearest obstacle is
+// outside(k) metres from it; an occupied cell k squared cells from the
+// nearest cell that is not occupied is inside(k) (negated, <= 0). Both reach
+// the cap at some k and stay there: only the k below it are listed.
+struct DistanceField::ValueClasses {
+  ValueClasses(float res, float cap) : res(res), cap(cap) {
+    outside_cap = firstAt(cap, [this](int64_t k) { return outside(k); });
+    inside_cap = firstAt(-cap, [this](int64_t k) { return inside(k); });
+    outside_reach = reach(outside_cap);
+    inside_reach = reach(inside_cap);
+    // The squared distances that occur: sums of two squares.
+    const int64_t top = std::max(outside_cap, inside_cap);
+    std::vector<bool> occurs(static_cast<std::size_t>(top), false);
+    for (int64_t a = 0; a * a < top; ++a) {
+      for (int64_t b = a; a * a + b * b < top; ++b) occurs[a * a + b * b] = true;
+    }
+    for (int64_t k = 0; k < top; ++k) {
+      if (!occurs[k]) continue;
+      if (k < outside_cap) values.push_back(outside(k));
+      if (k < inside_cap) values.push_back(inside(k));
+    }
+    values.push_back(cap);
+    values.push_back(-cap);
+    std::sort(values.begin(), values.end());
+    values.erase(std::unique(values.begin(), values.end()), values.end());
+    for (float& v : values) v = v == 0.0f ? 0.0f : v;  // -0 and +0 are one value: +0
+    // Past kMaxClasses, runs of neighbouring values share a class, the
+    // first one's value.
+    const std::size_t n = values.size();
+    const auto classOfRank = [n](std::size_t r) {
+      return n <= kMaxClasses ? r : r * kMaxClasses / n;
+    };
+    const auto classOf = [&](float v) {
+      const auto r = std::lower_bound(values.begin(), values.end(), v) - values.begin();
+      return static_cast<uint16_t>(classOfRank(static_cast<std::size_t>(r)));
+    };
+    of_outside.resize(static_cast<std::size_t>(outside_cap));
+    of_inside.resize(static_cast<std::size_t>(inside_cap));
+    for (int64_t k = 0; k < top; ++k) {
+      if (!occurs[k]) continue;
+      if (k < outside_cap) of_outside[k] = classOf(outside(k));
+      if (k < inside_cap) of_inside[k] = classOf(inside(k));
+    }
+    outside_cap_class = classOf(cap);
+    inside_cap_class = classOf(-cap);
+    if (n > kMaxClasses) {
+      std::vector<float> merged(kMaxClasses);
+      for (std::size_t r = n; r-- > 0;) merged[classOfRank(r)] = values[r];
+      values = std::move(merged);
+    }
+  }
+
+  float outside(int64_t k) const { return std::min(std::sqrt(static_cast<float>(k)) * res, cap); }
+  float inside(int64_t k) const {
+    return -std::min(std::max(std::sqrt(static_cast<float>(k)) - 1.0f - kFreeDepth, 0.0f) * res,
+                     cap);
+  }
+  // The first squared distance whose value is `end` (then so are all after it).
+  template <typename Value>
+  static int64_t firstAt(float end, Value value) {
+    int64_t k = 0;
+    while (value(k) != end) ++k;
+    return k;
+  }
+  // The first column distance whose square reaches `k_cap`.
+  static uint16_t reach(int64_t k_cap) {
+    int64_t g = 0;
+    while (g * g < k_cap) ++g;
+    return static_cast<uint16_t>(g);
+  }
+  // The class of squared distance d (-1: no source below the cap).
+  static uint16_t classOf(int64_t d, int64_t k_cap, const std::vector<uint16_t>& of,
+                          uint16_t cap_class) {
+    return d < 0 || d >= k_cap ? cap_class : of[static_cast<std::size_t>(d)];
+  }
+
+  float res, cap;
+  int64_t outside_cap, inside_cap;       // the first squared distance at the cap
+  uint16_t outside_reach, inside_reach;  // the first column distance at it
+  std::vector<uint16_t> of_outside, of_inside;
+  uint16_t outside_cap_class, inside_cap_class;
+  std::vector<float> values;  // per class
+};
+
 DistanceField::DistanceField(OccupancyGrid grid, double max_distance, int threads)
     : grid_(std::move(grid)), max_distance_(max_distance) {
   if (!(max_distance > 0.0) || !std::isfinite(max_distance)) {
     throw std::invalid_argument("likelihood field: max_distance must be positive and finite, got " +
                                 std::to_string(max_distance));
   }
-  const int w = grid_.width(), h = grid_.height();
+  if (max_distance / grid_.resolution() > kMaxCapCells) {
+    throw std::invalid_argument("likelihood field: max_distance " + std::to_string(max_distance) +
+                                " m is more than " +
+                                std::to_string(static_cast<int>(kMaxCapCells)) + " cells of " +
+                                std::to_string(grid_.resolution()) + " m");
+  }
   std::vector<bool> occupied(grid_.data().size());
   for (std::size_t i = 0; i < occupied.size(); ++i) {
     occupied[i] = OccupancyGrid::classify(grid_.data()[i]) == CellState::kOccupied;
   }
-  const float cap = static_cast<float>(max_distance);
-  const float res = static_cast<float>(grid_.resolution());
-  // Inside an obstacle, how far past its surface: the distance to the nearest
-  // cell that is not occupied, less the surface cell's own and kFreeDepth. A
-  // map whose obstacles are all that thin (a real map's walls) needs no second
-  // transform: its occupied cells' depths are all 0, which the +0 holds.
-  const bool deep = hasDeepCells(occupied, w, h);
-  // The two transforms are independent: each a task of its own, so that a
-  // second core takes one (the same result on any number of threads).
-  std::vector<float> depth;
-  auto transform = [&](std::size_t k) {
-    if (k == 0) {
-      // Squared cells, turned into metres in place: +0 on occupied cells, > 0
-      // elsewhere (at least a cell away).
-      signed_ = squaredDistanceTransform(occupied, w, h);
-      for (float& d : signed_) d = std::min(std::sqrt(d) * res, cap);  // sqrt(inf) = inf -> cap
-    } else {
-      std::vector<bool> open = occupied;
-      open.flip();
-      depth = squaredDistanceTransform(open, w, h);
-    }
-  };
-  WorkerPool::instance().run(threads, deep ? 2 : 1, transform);
-  if (deep) addDepths(occupied, depth, res, cap);
-}
-
-void DistanceField::addDepths(const std::vector<bool>& occupied, const std::vector<float>& depth,
-                              float res, float cap) {
-  for (std::size_t i = 0; i < depth.size(); ++i) {
-    // The depth is >= +0 (max with +0), so its negation is <= 0; -0 where
-    // it is 0, which distance() and surfaceDistance() both read as +0.
-    if (occupied[i]) {
-      signed_[i] = -std::min(std::max(std::sqrt(depth[i]) - 1.0f - kFreeDepth, 0.0f) * res, cap);
-    }
+  const ValueClasses values(static_cast<float>(grid_.resolution()),
+                            static_cast<float>(max_distance));
+  classes_.assign(occupied.size() + 1, values.outside_cap_class);
+  transformOutside(occupied, values, threads);
+  transformInside(occupied, values, threads);
+  distances_.resize(values.values.size());
+  surfaces_.resize(values.values.size());
+  for (std::size_t c = 0; c < values.values.size(); ++c) {
+    const float v = values.values[c];
+    distances_[c] = v > 0.0f ? v : 0.0f;
+    surfaces_[c] = std::fabs(v);
   }
 }
 
-bool DistanceField::hasDeepCells(const std::vector<bool>& occupied, int width, int height) {
-  // Deeper than 1 + kFreeDepth cells: every cell within that radius occupied
-  // or off the map (off the map is no free cell to measure to either).
-  const int r = static_cast<int>(1.0f + kFreeDepth);
-  const auto open = [&](int x, int y) {
-    return x >= 0 && y >= 0 && x < width && y < height &&
-           !occupied[static_cast<std::size_t>(y) * width + x];
-  };
-  for (int y = 0; y < height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      bool deep = true;
-      for (int dy = -r; dy <= r && deep; ++dy) {
-        for (int dx = -r; dx <= r && deep; ++dx) {
-          if (dx * dx + dy * dy <= r * r) deep = !open(x + dx, y + dy);
-        }
+namespace {
+
+// Calls part(begin, end) for `parts` even slices of [0, n), on up to
+// `threads` threads.
+template <typename Part>
+void inSlices(int threads, std::size_t n, Part part) {
+  const std::size_t parts = static_cast<std::size_t>(std::max(threads, 1));
+  auto task = [&](std::size_t k) { part(n * k / parts, n * (k + 1) / parts); };
+  WorkerPool::instance().run(threads, parts, task);
+}
+
+}  // namespace
+
+void DistanceField::transformOutside(const std::vector<bool>& occupied, const ValueClasses& values,
+                                     int threads) {
+  const int w = grid_.width(), h = grid_.height();
+  uint16_t* cells = classes_.data();
+  // The column distances, then each row's classes in their place.
+  inSlices(threads, static_cast<std::size_t>(w), [&](std::size_t begin, std::size_t end) {
+    cappedColumnDistances(occupied, w, h, values.outside_reach, static_cast<int>(begin),
+                          static_cast<int>(end), cells);
+  });
+  inSlices(threads, static_cast<std::size_t>(h), [&](std::size_t begin, std::size_t end) {
+    CappedRowPass pass;
+    std::vector<uint16_t> g(static_cast<std::size_t>(w));
+    std::vector<int64_t> d(static_cast<std::size_t>(w));
+    for (std::size_t y = begin; y < end; ++y) {
+      uint16_t* row = cells + y * w;
+      std::copy(row, row + w, g.begin());
+      pass.run(g.data(), w, values.outside_reach, d.data());
+      for (int x = 0; x < w; ++x) {
+        row[x] = ValueClasses::classOf(d[x], values.outside_cap, values.of_outside,
+                                       values.outside_cap_class);
       }
-      if (deep) return true;
     }
-  }
-  return false;
+  });
+}
+
+void DistanceField::transformInside(const std::vector<bool>& occupied, const ValueClasses& values,
+                                    int threads) {
+  const int w = grid_.width(), h = grid_.height();
+  std::vector<bool> open = occupied;
+  open.flip();
+  std::vector<uint16_t> column(occupied.size());
+  inSlices(threads, static_cast<std::size_t>(w), [&](std::size_t begin, std::size_t end) {
+    cappedColumnDistances(open, w, h, values.inside_reach, static_cast<int>(begin),
+                          static_cast<int>(end), column.data());
+  });
+  // Along a row, the cell that is not occupied just before (after) a run of
+  // occupied cells is nearer than any before (after) it: each run's row pass
+  // needs only the run and those two cells.
+  inSlices(threads, static_cast<std::size_t>(h), [&](std::size_t begin, std::size_t end) {
+    CappedRowPass pass;
+    std::vector<uint16_t> g(static_cast<std::size_t>(w));
+    std::vector<int64_t> d(static_cast<std::size_t>(w));
+    for (std::size_t y = begin; y < end; ++y) {
+      const std::size_t row = y * w;
+      for (int a = 0; a < w;) {
+        if (!occupied[row + a]) {
+          ++a;
+          continue;
+        }
+        int b = a;
+        while (b + 1 < w && occupied[row + b + 1]) ++b;
+        const int first = std::max(a - 1, 0), last = std::min(b + 1, w - 1);
+        const int n = last - first + 1;
+        std::copy(&column[row + first], &column[row + first] + n, g.begin());
+        pass.run(g.data(), n, values.inside_reach, d.data());
+        for (int x = a; x <= b; ++x) {
+          classes_[row + x] = ValueClasses::classOf(d[x - first], values.inside_cap,
+                                                    values.of_inside, values.inside_cap_class);
+        }
+        a = b + 1;
+      }
+    }
+  });
 }
 
 }  // namespace pf

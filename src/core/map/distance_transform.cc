@@ -82,4 +82,61 @@ std::vector<float> squaredDistanceTransform(const std::vector<bool>& is_source, 
   return out;
 }
 
+void cappedColumnDistances(const std::vector<bool>& is_source, int width, int height, uint16_t cap,
+                           int x_begin, int x_end, uint16_t* out) {
+  const std::size_t w = static_cast<std::size_t>(width);
+  const std::size_t n = w * static_cast<std::size_t>(height);
+  if (n == 0 || x_begin >= x_end) return;
+  const auto below = [cap](uint16_t g) { return static_cast<uint16_t>(g < cap ? g + 1 : cap); };
+  for (std::size_t x = x_begin; x < static_cast<std::size_t>(x_end); ++x) {
+    out[x] = is_source[x] ? 0 : cap;
+  }
+  for (std::size_t row = w; row < n; row += w) {
+    for (std::size_t i = row + x_begin; i < row + x_end; ++i) {
+      out[i] = is_source[i] ? 0 : below(out[i - w]);
+    }
+  }
+  for (std::size_t row = n - w; row >= w;) {
+    row -= w;
+    for (std::size_t i = row + x_begin; i < row + x_end; ++i) {
+      out[i] = std::min(out[i], below(out[i + w]));
+    }
+  }
+}
+
+void CappedRowPass::run(const uint16_t* g, int n, uint16_t cap, int64_t* d) {
+  v_.resize(static_cast<std::size_t>(n));
+  z_.resize(static_cast<std::size_t>(n) + 1);
+  const auto f = [g](int p) { return static_cast<double>(g[p]) * g[p]; };
+  // Felzenszwalb-Huttenlocher's envelope (transform1d above), over the
+  // sources that can reach below the cap only; z_[0] is -inf, so once a
+  // source is in, k never drops below 0.
+  int k = -1;
+  for (int q = 0; q < n; ++q) {
+    if (g[q] >= cap) continue;
+    const double fq = f(q) + static_cast<double>(q) * q;
+    double s = -std::numeric_limits<double>::infinity();
+    while (k >= 0) {
+      const int p = v_[k];
+      s = (fq - (f(p) + static_cast<double>(p) * p)) / (2.0 * (q - p));
+      if (s > z_[k]) break;
+      --k;
+    }
+    ++k;
+    v_[k] = q;
+    z_[k] = s;
+  }
+  if (k < 0) {
+    std::fill(d, d + n, -1);
+    return;
+  }
+  z_[k + 1] = std::numeric_limits<double>::infinity();
+  int j = 0;
+  for (int q = 0; q < n; ++q) {
+    while (z_[j + 1] < q) ++j;
+    const int64_t dq = q - v_[j];
+    d[q] = dq * dq + static_cast<int64_t>(g[v_[j]]) * g[v_[j]];
+  }
+}
+
 }  // namespace pf

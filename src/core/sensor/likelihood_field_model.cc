@@ -143,31 +143,15 @@ const std::vector<float>& LikelihoodFieldModel::table(double range_max) const {
 }
 
 void LikelihoodFieldModel::buildTable(double range_max, std::vector<float>* out) const {
-  const OccupancyGrid& grid = field_->grid();
-  const int stride = grid.width() + 2;
+  // A value per class of the field's cells (distance_field.h), and past
+  // them one for a point off the map.
+  const std::vector<float>& distances = field_->classDistances();
   const double k = params_.likelihood_exponent;
-  const float outside = static_cast<float>(k * beamLogLikelihood(field_->maxDistance(), range_max));
-  out->assign(static_cast<std::size_t>(stride) * (grid.height() + 2), outside);
-  // The distances take few values (square roots of whole numbers of cells,
-  // and the cap), so each value's exp and log are computed once, not once per
-  // cell: a direct-mapped memo keyed by the float's bits (a distance is never
-  // NaN, so the all-ones key means empty).
-  struct Memo {
-    uint32_t bits = ~uint32_t{0};
-    float value = 0.0f;
-  };
-  constexpr int kMemoBits = 14;
-  std::vector<Memo> memo(std::size_t{1} << kMemoBits);
-  for (int y = 0; y < grid.height(); ++y) {
-    for (int x = 0; x < grid.width(); ++x) {
-      const float d = field_->distance(static_cast<std::size_t>(y) * grid.width() + x);
-      uint32_t bits;
-      std::memcpy(&bits, &d, sizeof bits);
-      Memo& m = memo[(bits * 2654435761u) >> (32 - kMemoBits)];
-      if (m.bits != bits) m = {bits, static_cast<float>(k * beamLogLikelihood(d, range_max))};
-      (*out)[static_cast<std::size_t>(y + 1) * stride + x + 1] = m.value;
-    }
+  out->resize(distances.size() + 1);
+  for (std::size_t c = 0; c < distances.size(); ++c) {
+    (*out)[c] = static_cast<float>(k * beamLogLikelihood(distances[c], range_max));
   }
+  out->back() = static_cast<float>(k * beamLogLikelihood(field_->maxDistance(), range_max));
 }
 
 double LikelihoodFieldModel::logLikelihood(const PreparedScan& scan, const Pose2& pose) const {
@@ -188,11 +172,16 @@ double LikelihoodFieldModel::logLikelihood(const PreparedScan& scan, const Pose2
 
 namespace {
 
-// What scoring a particle needs, in the grid's cell units.
+// What scoring a particle needs, in the grid's cell units. The end points
+// are placed on the map with a one-cell border all round that stands for
+// "off the map".
 struct ScoringFrame {
-  const float* table;  // per-cell log-likelihood with a one-cell border
-  int stride;          // table width
-  float max_x, max_y;  // last border column and row
+  const float* table;       // per class of cell, log-likelihood; off the map last
+  const uint16_t* classes;  // per cell (DistanceField::classes)
+  int off_map;              // the table's last entry
+  int width, height;        // of the map
+  int stride;               // of the map with its border
+  float max_x, max_y;       // last border column and row
   float inv_res;
   Pose2 origin;
   double origin_cos, origin_sin;
@@ -216,13 +205,32 @@ inline void particleInCells(const ScoringFrame& f, const ParticleSet& particles,
 // outside the map to the border, and makes truncation equal floor for what
 // remains. The comparisons are written so that NaN (from a particle at
 // infinity) also lands in the border instead of becoming an undefined int.
-inline int endPointCell(const ScoringFrame& f, float px, float py, float c, float s, float ux,
-                        float uy) {
+inline void endPointColumnRow(const ScoringFrame& f, float px, float py, float c, float s, float ux,
+                              float uy, int* column, int* row) {
   const float ex = px + c * ux - s * uy;
   const float ey = py + s * ux + c * uy;
   const float gx = ex > 0.0f ? std::min(ex, f.max_x) : 0.0f;
   const float gy = ey > 0.0f ? std::min(ey, f.max_y) : 0.0f;
-  return static_cast<int>(gy) * f.stride + static_cast<int>(gx);
+  *column = static_cast<int>(gx);
+  *row = static_cast<int>(gy);
+}
+
+inline int endPointCell(const ScoringFrame& f, float px, float py, float c, float s, float ux,
+                        float uy) {
+  int column, row;
+  endPointColumnRow(f, px, py, c, s, ux, uy, &column, &row);
+  return row * f.stride + column;
+}
+
+// The log-likelihood of endPointCell's cell: its class's on the map, the
+// last entry's on the border.
+inline float endPointValue(const ScoringFrame& f, float px, float py, float c, float s, float ux,
+                           float uy) {
+  int column, row;
+  endPointColumnRow(f, px, py, c, s, ux, uy, &column, &row);
+  const bool on = column > 0 && row > 0 && column <= f.width && row <= f.height;
+  return f
+      .table[on ? f.classes[static_cast<std::size_t>(row - 1) * f.width + column - 1] : f.off_map];
 }
 
 #if defined(__x86_64__)
@@ -235,8 +243,12 @@ __attribute__((target("avx2"))) std::size_t scoreBlocksAvx2(
     const ScoringFrame& f, const ParticleSet& particles, const double* sin_yaw,
     const double* cos_yaw, std::size_t begin, std::size_t end, double* out) {
   const __m256 zero = _mm256_setzero_ps();
+  const __m256i zero_i = _mm256_setzero_si256();
   const __m256 max_x = _mm256_set1_ps(f.max_x), max_y = _mm256_set1_ps(f.max_y);
-  const __m256i stride = _mm256_set1_epi32(f.stride);
+  const __m256i width = _mm256_set1_epi32(f.width), height = _mm256_set1_epi32(f.height);
+  const __m256i one = _mm256_set1_epi32(1), low = _mm256_set1_epi32(0xFFFF);
+  const __m256i off_map = _mm256_set1_epi32(f.off_map);
+  const int* classes = reinterpret_cast<const int*>(f.classes);
   std::size_t i = begin;
   for (; i + 8 <= end; i += 8) {
     alignas(32) float px_l[8], py_l[8];
@@ -258,11 +270,22 @@ __attribute__((target("avx2"))) std::size_t scoreBlocksAvx2(
       // NaN, zero and below all become +0, as there.
       const __m256 gx = _mm256_max_ps(_mm256_min_ps(max_x, ex), zero);
       const __m256 gy = _mm256_max_ps(_mm256_min_ps(max_y, ey), zero);
-      const __m256i cell = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_cvttps_epi32(gy), stride),
-                                            _mm256_cvttps_epi32(gx));
-      // One gather for the eight cells: 0.55 ns per particle and beam here,
-      // against 1.25 ns with eight scalar loads, or one particle at a time.
-      const __m256 v = _mm256_i32gather_ps(f.table, cell, 4);
+      // The column and row on the map (endPointValue): the border is -1 or
+      // the width (height), where the cell's class is off_map.
+      const __m256i x = _mm256_sub_epi32(_mm256_cvttps_epi32(gx), one);
+      const __m256i y = _mm256_sub_epi32(_mm256_cvttps_epi32(gy), one);
+      const __m256i on = _mm256_andnot_si256(
+          _mm256_or_si256(
+              _mm256_or_si256(_mm256_cmpgt_epi32(zero_i, x), _mm256_cmpgt_epi32(zero_i, y)),
+              _mm256_or_si256(_mm256_cmpeq_epi32(x, width), _mm256_cmpeq_epi32(y, height))),
+          _mm256_set1_epi32(-1));
+      const __m256i cell = _mm256_add_epi32(_mm256_mullo_epi32(y, width), x);
+      // Two gathers for the eight cells: their classes (four bytes at two-
+      // byte steps, the upper half masked off; the map's lanes only), then
+      // the classes' values.
+      const __m256i cls =
+          _mm256_and_si256(_mm256_mask_i32gather_epi32(off_map, classes, cell, on, 2), low);
+      const __m256 v = _mm256_i32gather_ps(f.table, cls, 4);
       sum = _mm256_add_ps(sum, v);
     }
     alignas(32) float sum_l[8];
@@ -290,7 +313,7 @@ void scoreParticles(const ScoringFrame& f, const ParticleSet& particles, const d
     const float s = static_cast<float>(sin_yaw[i]);
     float sum = 0.0f;
     for (std::size_t b = 0; b < f.beams; ++b) {
-      sum += f.table[endPointCell(f, px, py, c, s, f.bx[b], f.by[b])];
+      sum += endPointValue(f, px, py, c, s, f.bx[b], f.by[b]);
     }
     out[i] = sum;
   }
@@ -324,10 +347,16 @@ void countAgreeingParticles(const ScoringFrame& f, const uint8_t* near,
   }
 }
 
-// The frame for scoring `beams` end points (in cells) on `grid`'s table.
-ScoringFrame scoringFrame(const OccupancyGrid& grid, const float* table, const float* bx,
+// The frame for scoring `beams` end points (in cells) on `field`, whose
+// classes' log-likelihoods `table` holds (nullptr: for endPointCell only).
+ScoringFrame scoringFrame(const DistanceField& field, const float* table, const float* bx,
                           const float* by, std::size_t beams) {
+  const OccupancyGrid& grid = field.grid();
   return ScoringFrame{table,
+                      field.classes(),
+                      static_cast<int>(field.classDistances().size()),
+                      grid.width(),
+                      grid.height(),
                       grid.width() + 2,
                       static_cast<float>(grid.width() + 1),
                       static_cast<float>(grid.height() + 1),
@@ -345,7 +374,7 @@ ScoringFrame scoringFrame(const OccupancyGrid& grid, const float* table, const f
 void LikelihoodFieldModel::score(const float* table, const float* bx, const float* by,
                                  std::size_t beams, const ParticleSet& particles,
                                  std::vector<double>* log_likelihood) const {
-  const ScoringFrame frame = scoringFrame(field_->grid(), table, bx, by, beams);
+  const ScoringFrame frame = scoringFrame(*field_, table, bx, by, beams);
   log_likelihood->resize(particles.size());
   // The headings' sines and cosines for the whole cloud at once (sinCos
   // vectorises), not one C library call per particle. Kept per thread: no
@@ -384,7 +413,7 @@ void LikelihoodFieldModel::score(const float* table, const float* bx, const floa
 std::vector<uint8_t> LikelihoodFieldModel::keptBeams(const float* bx, const float* by,
                                                      std::size_t beams,
                                                      const ParticleSet& particles) const {
-  const ScoringFrame frame = scoringFrame(field_->grid(), nullptr, bx, by, beams);
+  const ScoringFrame frame = scoringFrame(*field_, nullptr, bx, by, beams);
   std::vector<std::size_t> agree;
   countAgreeingParticles(frame, near_.data(), particles, &agree);
   std::vector<uint8_t> kept(beams, 1);

@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace pf {
@@ -129,6 +131,58 @@ TEST(SquaredDistanceTransform, FarCornersOfALargerGridAreExact) {
   EXPECT_EQ(399.0f * 399.0f, d[width - 1]);
   EXPECT_EQ(299.0f * 299.0f, d[(height - 1) * width]);
   EXPECT_EQ(123.0f * 123.0f + 77.0f * 77.0f, d[77 * width + 123]);
+}
+
+// The capped passes on a whole grid: -1 where nothing is nearer than `cap` cells.
+std::vector<int64_t> cappedTransform(const std::vector<bool>& grid, int width, int height,
+                                     uint16_t cap) {
+  std::vector<uint16_t> column(grid.size());
+  // In two slices of columns, as two threads would.
+  cappedColumnDistances(grid, width, height, cap, 0, width / 3, column.data());
+  cappedColumnDistances(grid, width, height, cap, width / 3, width, column.data());
+  std::vector<int64_t> out(grid.size());
+  CappedRowPass pass;
+  for (int y = 0; y < height; ++y) {
+    pass.run(&column[static_cast<std::size_t>(y) * width], width, cap, &out[y * width]);
+  }
+  return out;
+}
+
+TEST(CappedDistanceTransform, ExactBelowTheCapOnRandomGrids) {
+  std::mt19937 rng(99);
+  const int width = 31, height = 23;
+  for (uint16_t cap : {1, 2, 5, 40}) {
+    for (double density : {0.3, 0.05, 0.003}) {
+      std::bernoulli_distribution is_source(density);
+      for (int trial = 0; trial < 4; ++trial) {
+        std::vector<bool> grid(width * height);
+        for (std::size_t i = 0; i < grid.size(); ++i) grid[i] = is_source(rng);
+        const std::vector<float> exact = bruteForce(grid, width, height);
+        const std::vector<int64_t> capped = cappedTransform(grid, width, height, cap);
+        for (std::size_t i = 0; i < grid.size(); ++i) {
+          // Below cap^2 the value itself; at or past it, -1 or any value
+          // at least cap^2 (a source in reach, another out of it).
+          const std::string at = "cell (" + std::to_string(i % width) + ", " +
+                                 std::to_string(i / width) + "), cap " + std::to_string(cap);
+          if (exact[i] < static_cast<float>(cap) * cap) {
+            ASSERT_EQ(static_cast<int64_t>(exact[i]), capped[i]) << at;
+          } else {
+            ASSERT_TRUE(capped[i] == -1 || capped[i] >= int64_t{cap} * cap) << at;
+          }
+        }
+      }
+    }
+  }
+}
+
+TEST(CappedDistanceTransform, NoSourceInReachIsMinusOne) {
+  const std::vector<int64_t> d = cappedTransform(sources(9, 1, {{0, 0}}), 9, 1, 3);
+  EXPECT_EQ((std::vector<int64_t>{0, 1, 4, 9, 16, 25, 36, 49, 64}), d);  // in the row: no cap
+  const std::vector<int64_t> none = cappedTransform(sources(3, 9, {{0, 0}}), 3, 9, 3);
+  EXPECT_EQ(0, none[0]);
+  EXPECT_EQ(4, none[2 * 3]);
+  EXPECT_EQ(-1, none[3 * 3]);  // three rows up: out of the column pass's reach
+  EXPECT_EQ(-1, none[8 * 3 + 2]);
 }
 
 }  // namespace

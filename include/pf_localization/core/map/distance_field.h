@@ -12,14 +12,19 @@
 // point lies, less kFreeDepth cells, so that for the scan fit (bicubic
 // distance field) a thick wall is not a better fit the deeper a beam goes.
 //
-// Both are held in one float a cell (a 200 x 600 m floor at 5 cm has 48
-// million): the distance where it is not 0 (free and unknown cells, > 0),
-// the depth past the surface negated on occupied cells (<= 0), where the
-// distance is 0. So distance = max(v, 0) and surface distance = |v|.
+// Both come from one 16-bit class a cell (a 200 x 600 m floor at 5 cm has 48
+// million cells): the distances take few values (square roots of sums of two
+// squares of whole cells, up to the cap, and the same inside obstacles), so a
+// cell holds the index of its value among them, and the values are tables of
+// a few thousand floats. The likelihood field scores a beam by its end cell's
+// class through a table of its own (likelihood_field_model.h). The exact
+// values take at most kMaxClasses classes; a cap of more than about 550
+// cells would need more, and then neighbouring values share a class.
 #pragma once
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 #include "pf_localization/core/map/occupancy_grid.h"
@@ -32,9 +37,14 @@ class DistanceField {
   /// real map's walls are blurred over two or three cells).
   static constexpr float kFreeDepth = 1.0f;
 
+  /// Classes at most (a class is 16 bits).
+  static constexpr std::size_t kMaxClasses = 65535;
+  /// The cap at most, in cells: the distinct values are listed up to it.
+  static constexpr double kMaxCapCells = 2048.0;
+
   /// Throws std::invalid_argument when max_distance is not positive and
-  /// finite. Keeps `grid` (moved in: a large map is not held twice). Its two
-  /// transforms (to the obstacles, and inside them) run on up to `threads`
+  /// finite, or more than kMaxCapCells cells. Keeps `grid` (moved in: a
+  /// large map is not held twice). Its passes run on up to `threads`
   /// threads (WorkerPool); the result is the same on any number.
   DistanceField(OccupancyGrid grid, double max_distance, int threads = 1);
 
@@ -50,33 +60,33 @@ class DistanceField {
 
   /// Cell i's (row-major) distance: metres to the nearest occupied cell
   /// centre, at most max_distance; +0.0f on an occupied cell.
-  float distance(std::size_t i) const { return signed_[i] > 0.0f ? signed_[i] : 0.0f; }
+  float distance(std::size_t i) const { return distances_[classes_[i]]; }
   /// Cell i's surface distance: its distance, but inside an obstacle how far
   /// past its surface (less kFreeDepth cells, at most max_distance; +0.0f
   /// near the surface): what the scan fit measures. See docs/design.md, "A
   /// map out of date is not a wrong pose".
-  float surfaceDistance(std::size_t i) const { return std::fabs(signed_[i]); }
-  /// Every cell's value v, row-major, for loops over many cells: the
-  /// distance (v > 0) off obstacles, the surface distance negated (v <= 0)
-  /// on them; distance(i) = max(v, 0), surfaceDistance(i) = |v|. A depth of
-  /// 0 may be stored as -0.0f: read it through those two formulas.
-  const std::vector<float>& signedDistances() const { return signed_; }
-  std::size_t size() const { return signed_.size(); }
+  float surfaceDistance(std::size_t i) const { return surfaces_[classes_[i]]; }
+  std::size_t size() const { return classes_.size() - 1; }
+
+  /// Every cell's class, row-major, for loops over many cells: the cell's
+  /// distance is classDistances()[class], its surface distance
+  /// classSurfaceDistances()[class]. One more entry follows the last cell,
+  /// so that a four-byte read at any cell stays inside.
+  const uint16_t* classes() const { return classes_.data(); }
+  const std::vector<float>& classDistances() const { return distances_; }
+  const std::vector<float>& classSurfaceDistances() const { return surfaces_; }
 
  private:
-  // Whether any occupied cell lies deeper than 1 + kFreeDepth cells inside
-  // its obstacle (the only cells whose surface distance is not 0).
-  static bool hasDeepCells(const std::vector<bool>& occupied, int width, int height);
-  // Stores each occupied cell's depth past the surface (from `depth`, the
-  // squared distances in cells to the nearest open cell), negated, in
-  // signed_ (which holds the distances; res: metres per cell; cap:
-  // max_distance).
-  void addDepths(const std::vector<bool>& occupied, const std::vector<float>& depth, float res,
-                 float cap);
+  struct ValueClasses;
+  // The distances to the obstacles, into classes_.
+  void transformOutside(const std::vector<bool>& occupied, const ValueClasses& values, int threads);
+  // The depths of the occupied cells, into their classes_.
+  void transformInside(const std::vector<bool>& occupied, const ValueClasses& values, int threads);
 
   OccupancyGrid grid_;
   double max_distance_;
-  std::vector<float> signed_;  // see signedDistances()
+  std::vector<uint16_t> classes_;  // see classes()
+  std::vector<float> distances_, surfaces_;
 };
 
 }  // namespace pf

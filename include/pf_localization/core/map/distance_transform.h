@@ -10,8 +10,14 @@
 // "Distance Transforms of Sampled Functions", Theory of Computing 8 (2012).
 // Apart from a row of scratch, the result is the only memory it takes: each
 // fresh page costs a page fault, and a map at 2 cm has millions of cells.
+//
+// A transform that only needs distances below a cap (the likelihood field's)
+// runs the same two passes on 16-bit column distances, and leaves out of the
+// row pass every source whose column distance alone reaches the cap: what it
+// gives is the exact squared distance wherever that is below the cap.
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 namespace pf {
@@ -21,5 +27,25 @@ namespace pf {
 /// at all in the grid get +infinity.
 std::vector<float> squaredDistanceTransform(const std::vector<bool>& is_source, int width,
                                             int height);
+
+/// The column pass for distances below `cap` cells: out[y * width + x] is
+/// the distance in cells from (x, y) to the nearest source in column x, or
+/// `cap` when that is `cap` or more (or the column has none). Columns
+/// [x_begin, x_end) only, so that threads can share a grid.
+void cappedColumnDistances(const std::vector<bool>& is_source, int width, int height, uint16_t cap,
+                           int x_begin, int x_end, uint16_t* out);
+
+/// The row pass over one row of column distances g[0, n) from
+/// cappedColumnDistances with the same `cap`: d[x] = min over x' of
+/// (x - x')^2 + g[x']^2 over the sources with g[x'] < cap, or -1 where
+/// there is none. Keeps its scratch between rows.
+class CappedRowPass {
+ public:
+  void run(const uint16_t* g, int n, uint16_t cap, int64_t* d);
+
+ private:
+  std::vector<int> v_;     // the lower envelope's parabolas: their columns
+  std::vector<double> z_;  // the boundaries between them
+};
 
 }  // namespace pf

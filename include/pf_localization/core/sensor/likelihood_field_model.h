@@ -8,10 +8,13 @@
 // beams' log p. Working in log space means no product of hundreds of small
 // numbers can underflow to zero.
 //
-// log p depends only on the cell an end point falls in, so it is precomputed
-// once per map (and per range_max) into a table with a one-cell border that
-// stands for "outside the map". The per-beam work is then: transform the end
-// point, clamp the cell index into the table, add.
+// log p depends only on the distance of the cell an end point falls in, and
+// the cells' distances take few values: the field keeps a class a cell
+// (distance_field.h), and log p is precomputed per class (and per
+// range_max), with one more entry for "outside the map", into a table of a
+// few thousand floats that stays in the processor's cache. The per-beam work
+// is then: transform the end point, clamp it to the map or its one-cell
+// border, read the cell's class, add its entry.
 //
 // Beam skipping (ROS amcl's likelihood_field_prob, in its
 // AMCLLaser::LikelihoodFieldModelProb; not in Probabilistic Robotics): a beam
@@ -125,8 +128,8 @@ class LikelihoodFieldModel : public SensorModel {
 
   LikelihoodFieldModelParams params_;
   std::shared_ptr<const DistanceField> field_;
-  // The precomputed tables, one per range_max: (width + 2) x (height + 2)
-  // with a border of "outside the map" cells.
+  // The precomputed tables, one per range_max: an entry per class of the
+  // field's cells, then one for outside the map.
   mutable LikelihoodTables tables_;
   // For beam skipping: 1 where a cell lies within beam_skip_distance of an
   // obstacle, with the same border (0: outside the map agrees with nothing).
