@@ -227,7 +227,33 @@ TEST(LikelihoodFieldModel, RotatedMapOrigin) {
   }
 }
 
+// Scores a cloud on the model with `layout`'s tables, as below.
+void expectCloudMatchesPerPoseAndBruteForce(LikelihoodFieldModel::TableLayout layout);
+
 TEST(LikelihoodFieldModel, ParticleSetMatchesPerPoseAndBruteForce) {
+  expectCloudMatchesPerPoseAndBruteForce(LikelihoodFieldModel::TableLayout::kPerCell);
+}
+
+TEST(LikelihoodFieldModel, TablesByClassScoreAsTablesByCell) {
+  expectCloudMatchesPerPoseAndBruteForce(LikelihoodFieldModel::TableLayout::kPerClass);
+  // The same bits both ways, on and off the map.
+  const OccupancyGrid grid = test::wallGrid(8);
+  const LikelihoodFieldModel by_cell(grid, params(), LikelihoodFieldModel::TableLayout::kPerCell);
+  const LikelihoodFieldModel by_class(grid, params(), LikelihoodFieldModel::TableLayout::kPerClass);
+  ParticleSet set;
+  set.resize(203);
+  Random random(5);
+  for (std::size_t i = 0; i < set.size(); ++i) {
+    set.setPose(i, {random.uniform(-0.5, 1.5), random.uniform(-0.5, 1.0), random.uniform(-3, 3)});
+  }
+  const LaserScan scan = quarterScan({0.3f, 0.2f, 0.4f, 0.25f});
+  std::vector<double> a, b;
+  by_cell.logLikelihoods(by_cell.prepare(scan), set, &a);
+  by_class.logLikelihoods(by_class.prepare(scan), set, &b);
+  EXPECT_EQ(a, b);
+}
+
+void expectCloudMatchesPerPoseAndBruteForce(LikelihoodFieldModel::TableLayout layout) {
   // A 3 m x 2 m room of 0.05 m cells with walls on its border and a pillar.
   const int w = 60, h = 40;
   std::vector<int8_t> data(w * h, 0);
@@ -242,7 +268,7 @@ TEST(LikelihoodFieldModel, ParticleSetMatchesPerPoseAndBruteForce) {
   const OccupancyGrid grid(w, h, 0.05, {-0.5, -0.3, 0.2}, data);
   LikelihoodFieldModelParams p = params(1.0);
   p.max_beams = 30;
-  const LikelihoodFieldModel model(grid, p);
+  const LikelihoodFieldModel model(grid, p, layout);
 
   LaserScan raw;
   raw.angle_min = -2.0;

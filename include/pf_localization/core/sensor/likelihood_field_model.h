@@ -8,13 +8,15 @@
 // beams' log p. Working in log space means no product of hundreds of small
 // numbers can underflow to zero.
 //
-// log p depends only on the distance of the cell an end point falls in, and
-// the cells' distances take few values: the field keeps a class a cell
-// (distance_field.h), and log p is precomputed per class (and per
-// range_max), with one more entry for "outside the map", into a table of a
-// few thousand floats that stays in the processor's cache. The per-beam work
-// is then: transform the end point, clamp it to the map or its one-cell
-// border, read the cell's class, add its entry.
+// log p depends only on the distance of the cell an end point falls in, so
+// it is precomputed once per map (and per range_max): a map of up to
+// kMaxCellTableCells cells gets a float a cell, with a one-cell border that
+// stands for "outside the map", and the per-beam work is: transform the end
+// point, clamp the cell index into the table, add. A larger map's cells'
+// distances take few values (the field keeps a class a cell:
+// distance_field.h), so its table holds a value per class, a few thousand
+// floats, and a beam reads its cell's class first: a second lookup, but no
+// table of 4 bytes a cell per range_max (192 MB on a 200 x 600 m floor).
 //
 // Beam skipping (ROS amcl's likelihood_field_prob, in its
 // AMCLLaser::LikelihoodFieldModelProb; not in Probabilistic Robotics): a beam
@@ -80,9 +82,16 @@ void validate(const LikelihoodFieldModelParams& params);
 
 class LikelihoodFieldModel : public SensorModel {
  public:
+  /// The largest map whose tables hold a float a cell (64 MB a table).
+  static constexpr std::size_t kMaxCellTableCells = std::size_t{16} << 20;
+  /// How the tables are laid out: by the map's size (kMaxCellTableCells),
+  /// or either way whatever the size (for tests: the scores are the same).
+  enum class TableLayout { kBySize, kPerCell, kPerClass };
+
   /// Throws std::invalid_argument naming the parameter when one is out of
   /// range. Its field keeps `grid` (moved in).
-  LikelihoodFieldModel(OccupancyGrid grid, const LikelihoodFieldModelParams& params);
+  LikelihoodFieldModel(OccupancyGrid grid, const LikelihoodFieldModelParams& params,
+                       TableLayout layout = TableLayout::kBySize);
 
   const LikelihoodFieldModelParams& params() const { return params_; }
   const DistanceField& field() const override { return *field_; }
@@ -120,6 +129,8 @@ class LikelihoodFieldModel : public SensorModel {
   LikelihoodFieldModel(const LikelihoodFieldModel& model, double sigma_hit);
   // The table for scans of `range_max` (built on first use).
   const std::vector<float>& table(double range_max) const;
+  // Whether the tables hold a value a cell (else a value a class).
+  bool cellTables() const { return cell_tables_; }
   void buildTable(double range_max, std::vector<float>* out) const;
   void score(const float* table, const float* bx, const float* by, std::size_t beams,
              const ParticleSet& particles, std::vector<double>* log_likelihood) const;
@@ -128,8 +139,10 @@ class LikelihoodFieldModel : public SensorModel {
 
   LikelihoodFieldModelParams params_;
   std::shared_ptr<const DistanceField> field_;
-  // The precomputed tables, one per range_max: an entry per class of the
-  // field's cells, then one for outside the map.
+  bool cell_tables_;
+  // The precomputed tables, one per range_max: with cellTables(), (width +
+  // 2) x (height + 2) with a border of "outside the map" cells; without, an
+  // entry per class of the field's cells, then one for outside the map.
   mutable LikelihoodTables tables_;
   // For beam skipping: 1 where a cell lies within beam_skip_distance of an
   // obstacle, with the same border (0: outside the map agrees with nothing).
