@@ -213,6 +213,12 @@ class PnmParser {
       }
       img.color_sum.assign(w * h, 0);
       const auto* p = reinterpret_cast<const unsigned char*>(buf_.data()) + pos_;
+      if (bytes_per_sample == 1 && channels == 1 && maxval == 255) {
+        // What map_saver writes: each byte is its own sum, and none can
+        // exceed maxval (a plain copy, at memory speed on a large map).
+        std::copy(p, p + samples, img.color_sum.begin());
+        return img;
+      }
       for (uint64_t i = 0; i < samples; ++i) {
         // Netpbm stores 16-bit samples most significant byte first.
         const uint64_t v = bytes_per_sample == 2 ? (uint64_t{p[2 * i]} << 8) | p[2 * i + 1] : p[i];
@@ -349,7 +355,13 @@ std::string readFile(const std::string& path, const char* what) {
     throw MapLoadError(path + ": cannot open " + what + " (" + std::strerror(errno) + ")");
   }
   try {
-    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    // In blocks, not a character at a time: a large map's image is tens of MB.
+    std::string bytes;
+    std::error_code size_error;
+    const auto size = std::filesystem::file_size(path, size_error);
+    if (!size_error) bytes.reserve(size);
+    char block[1 << 16];
+    while (in.read(block, sizeof block) || in.gcount() > 0) bytes.append(block, in.gcount());
     if (in.bad()) throw MapLoadError(path + ": error while reading " + what);
     return bytes;
   } catch (const std::ios_base::failure& e) {
