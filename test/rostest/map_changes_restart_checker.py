@@ -36,6 +36,7 @@ import rospy
 import rostest
 import rosservice
 import yaml
+from diagnostic_msgs.msg import DiagnosticStatus
 from nav_msgs.msg import OccupancyGrid
 from std_srvs.srv import Empty
 
@@ -62,7 +63,13 @@ class Layers:
         self.lock = threading.Lock()
         self.latest = {}
         self.count = {}
+        self.status = {}  # node -> the values of its latest pf_status
         rospy.Subscriber('/pf_map_changes', OccupancyGrid, self._on_layer, queue_size=5)
+        rospy.Subscriber('/pf_status', DiagnosticStatus, self._on_status, queue_size=5)
+
+    def _on_status(self, msg):
+        with self.lock:
+            self.status[msg._connection_header.get('callerid', '')] = {v.key: v.value for v in msg.values}
 
     def _on_layer(self, msg):
         node = msg._connection_header.get('callerid', '')
@@ -169,6 +176,11 @@ class MapChangesRestartTest(unittest.TestCase):
         time.sleep(1.0)
         learned, _ = self.wait_for_layer('pf_restart_1')
         learned = marked(learned)
+        with self.layers.lock:
+            status = self.layers.status.get('/pf_restart_1', {})
+        self.assertIn('map changes', status, 'pf_status says nothing of the map changes')
+        self.assertGreater(float(status['map_cells_new']) + float(status['map_cells_gone']), 0)
+        report.append('run 1 pf_status: map changes: ' + status['map changes'])
         self.interrupt('pf_restart_1', first)
         self.assertTrue(learned, 'run 1 learned no change from the bag')
         self.assertTrue(os.path.getsize(self.file) > 0, 'no layer saved at ' + self.file)
@@ -179,6 +191,8 @@ class MapChangesRestartTest(unittest.TestCase):
         restored, count = self.wait_for_layer('pf_restart_2')
         restored = marked(restored)
         self.wait_for_line('pf_restart_2', 'restored the map changes learned on this map from ' + self.file)
+        line = [l for l in self.output('pf_restart_2').splitlines() if 'restored the map changes' in l][0]
+        report.append('run 2: ' + line[line.index('pf_node:'):])
         kept = len(learned & restored) / float(len(learned))
         report.append('run 2: %d cells marked before any scan, %.3f of run 1\'s' % (len(restored), kept))
         self.assertGreaterEqual(kept, self.min_share, '; '.join(report))

@@ -3,11 +3,10 @@
 // and the signature of the map it was learned on (the caller's text: the
 // ROS side gives its mapSignature), the state (MapChangeLayer::encode()),
 // and a 64-bit FNV-1a checksum of the state, so that a file cut short or
-// altered is refused before any of it is read. A building's map of 48
-// million cells, seen in part with a few changes, is a file of some
-// kilobytes: its unseen cells are run-length coded, and only the cells with
-// counts list them. See docs/ros-interface.md, "The map's changes across a
-// restart".
+// altered is refused before any of it is read. Unseen cells cost nothing:
+// the cells' states are run-length coded, and only the cells with counts
+// list them (a map of 4 million cells with 8 900 seen: 5.4 kB). See
+// docs/ros-interface.md, "The map's changes across a restart".
 #pragma once
 
 #include <string>
