@@ -111,7 +111,9 @@ void LiveLocalizer::mapChangesOnNewMap(const std::string& signature, bool first,
   } else {
     ROS_INFO("pf_node: %s", r.message.c_str());
   }
-  if (r.restored) output_.publishMapChangesNow(localizer_, stamp);
+  if (!r.restored) return;
+  changes_saver_.setMap(signature, localizer_.mapChanges()->scans());  // the file holds it
+  output_.publishMapChangesNow(localizer_, stamp);
 }
 
 bool LiveLocalizer::clearMapChanges() {

@@ -110,9 +110,9 @@ MapChangesRestore restoreMapChanges(const std::string& path, const std::string& 
 MapChangesSaver::MapChangesSaver(std::string path, double rate)
     : path_(std::move(path)), rate_(rate) {}
 
-void MapChangesSaver::setMap(const std::string& signature) {
+void MapChangesSaver::setMap(const std::string& signature, std::size_t saved_scans) {
   signature_ = signature;
-  copied_scans_ = 0;
+  copied_scans_ = saved_scans;
   dirty_ = false;
 }
 

@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "pf_localization/core/filter/beam_screen.h"
 #include "support/rooms.h"
 #include "support/scan_simulator.h"
 
@@ -171,6 +172,27 @@ TEST(MapChangeFile, RefusesAnotherMapsLayer) {
   MapChangeLayer blind(unknown_field);
   EXPECT_NE("", blind.decode(learned.encode()));
   EXPECT_EQ(0u, blind.summary().seen);
+}
+
+TEST(MapChangeFile, ARestoredLayerIsWhatTheScansAreJudgedOn) {
+  const OccupancyGrid map = mapOf();
+  const DistanceField field(map, 2.0);
+  MapChangeLayer learned(field);
+  tourOnce(&learned, world());
+  tourOnce(&learned, world());
+  BeamScreen screen;
+  screen.setMap(BeamScreen::prepare(field));
+  // A beam from the west wall along the removed box's row to the east wall.
+  const auto judged = [&screen] { return screen.evidence()->judge(0.5, 2.9, 0.0, 5.45); };
+  EXPECT_EQ(BeamEvidence::kThroughOntoMap, judged());
+  ASSERT_EQ("", screen.restoreLayer(learned.encode()));
+  EXPECT_EQ(learned.occupancy(), screen.layer()->occupancy());
+  EXPECT_EQ(BeamEvidence::kOnMap, judged());  // the box is gone
+  screen.clearLayer();
+  EXPECT_EQ(0u, screen.layer()->summary().seen);
+  EXPECT_EQ(BeamEvidence::kThroughOntoMap, judged());
+  EXPECT_NE("", screen.restoreLayer(learned.encode().substr(0, 40)));
+  EXPECT_EQ(BeamEvidence::kThroughOntoMap, judged());
 }
 
 }  // namespace

@@ -166,6 +166,13 @@ TEST_F(MapChangesSaverTest, CopiesOnlyWhatChangedAtMostOnceAPeriod) {
   ASSERT_EQ("", saver.writePending());
   EXPECT_EQ(first, readAll(path_));
 
+  // A layer restored from the file is not copied back to it.
+  saver.setMap(signature_, layer.scans());
+  std::filesystem::remove(path_);
+  saver.offer(&layer, ros::WallTime(300.0));
+  EXPECT_EQ("", saver.writePending());
+  EXPECT_FALSE(std::filesystem::exists(path_));
+
   MapChangesSaver off(path_ + ".off", 0.0);
   off.setMap(signature_);
   off.offer(&layer, ros::WallTime(200.0), true);

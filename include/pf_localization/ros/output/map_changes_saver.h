@@ -13,8 +13,8 @@
 // and only when the layer changed since), and the main spinner writes the
 // latest copy (writePending()) under a small mutex of the saver's own, so
 // that a write never waits for an update nor an update for the disk. A
-// copy of a building's map of 48 million cells seen in part is a pass over
-// its cells' bytes, eight unseen ones at a time.
+// copy is a pass over the cells' bytes, eight unseen ones at a time: 5 ms on
+// a map of 48 million cells seen in part (0.3 ms on 4 million).
 #pragma once
 
 #include <ros/time.h>
@@ -61,8 +61,10 @@ class MapChangesSaver {
   const std::string& path() const { return path_; }
 
   /// Filter side. A new map, of signature `signature`: its layer is
-  /// written from the first change on (the file keeps the last map's until then).
-  void setMap(const std::string& signature);
+  /// written from its first change on (the file keeps what it holds until
+  /// then); `saved_scans`: the scans of the layer the file already holds
+  /// (restored from it), not copied again.
+  void setMap(const std::string& signature, std::size_t saved_scans = 0);
   /// The layer changed otherwise than by learning (cleared, restored).
   void changed() { dirty_ = true; }
   /// After the filter changed: `layer` copied when it changed since the last
