@@ -13,7 +13,8 @@
 // filter's lock held (UpdateScheduler); an update holds it whole (on the
 // filter thread, or on roscpp's poll thread when it is short), the main
 // spinner's callbacks that touch the filter wait for it; installMap() takes
-// it itself, only around the swap of a map it built without it. What runs at a steady rate never
+// it itself, only around the swap of a map it built without it, and
+// saveAtShutdown() around the copy of the layer. What runs at a steady rate never
 // does: the republisher and the saver get their data under small locks of their own.
 #pragma once
 
