@@ -156,12 +156,17 @@ pytest_run() {
   return "$rc"
 }
 # rostest FILE ARGS...: one rostest as catkin's run_tests target runs it (run_tests.py
-# writes a failure when the test left no result file).
+# writes a failure when the test left no result file). Each has a ROS_HOME of its own:
+# pf_node saves the layer of the map's changes there (map_changes_file), which another
+# test on the same map, running beside it or after it, must not restore. The logs stay
+# where they were.
 rostest_run() {
   local file=$1 name
   shift
   name=test_rostest_$(basename "$file" .test)
-  /usr/bin/python3 /usr/share/catkin/cmake/test/run_tests.py \
+  mkdir -p "$logs/ros_home/$name"
+  ROS_LOG_DIR=${ROS_LOG_DIR:-${ROS_HOME:-$HOME/.ros}/log} ROS_HOME=$logs/ros_home/$name \
+    /usr/bin/python3 /usr/share/catkin/cmake/test/run_tests.py \
     "$results/pf_localization/rostest-$name.xml" \
     "/usr/bin/python3 /usr/bin/rostest --pkgdir=$ws/src/pf_localization --package=pf_localization \
 --results-filename $name.xml --results-base-dir $results $ws/src/pf_localization/$file $*"

@@ -5,7 +5,8 @@
 // ScanInputs and OdometryInput (the inputs), UpdateScheduler (where each
 // update runs, and the filter's lock), LiveLocalizer (the filter and what goes
 // with it: time jumping back, the saved pose, pf_pose, amcl_pose,
-// particlecloud), MapToOdomRepublisher (map -> odom on tf), ReconfigureServer.
+// particlecloud, the map's changes and clear_map_changes), MapToOdomRepublisher
+// (map -> odom on tf), ReconfigureServer.
 //
 // Threads (docs/ros-interface.md, "Threads, latency and overload"): tf, the
 // scans, short updates and map -> odom's timer or /clock on roscpp's poll
@@ -71,7 +72,8 @@ class PfNode {
         "initialpose", 2, [this](const auto& msg) { applyInitialPose(*msg); });
     services_ = {nh.advertiseService("global_localization", &PfNode::onGlobalLocalization, this),
                  nh.advertiseService("request_nomotion_update", &PfNode::onNoMotionUpdate, this),
-                 nh.advertiseService("set_map", &PfNode::onSetMap, this)};
+                 nh.advertiseService("set_map", &PfNode::onSetMap, this),
+                 nh.advertiseService("clear_map_changes", &PfNode::onClearMapChanges, this)};
     reconfigure_ = std::make_unique<ReconfigureServer>(
         pnh, config,
         [this](const LocalizerConfig& c) {
@@ -119,8 +121,7 @@ class PfNode {
       ros::getGlobalCallbackQueue()->callAvailable(ros::WallDuration(0.1));
       live_->saver().saveWhenDue(ros::Time::now());
       if (!g_sigint) continue;
-      // Without a master the save would block, waiting for one.
-      if (live_->saver().enabled() && ros::master::check()) live_->saver().saveNow();
+      live_->saveAtShutdown(*scheduler_);
       ros::shutdown();
     }
   }
@@ -155,6 +156,10 @@ class PfNode {
 
   bool onGlobalLocalization(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
     return scheduler_->withFilter([&] { return live_->startGlobalLocalization(); });
+  }
+
+  bool onClearMapChanges(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+    return scheduler_->withFilter([&] { return live_->clearMapChanges(); });
   }
 
   bool onNoMotionUpdate(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {

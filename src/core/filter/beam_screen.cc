@@ -67,6 +67,19 @@ void BeamScreen::learn(const ScanGroup& measured, const Pose2& estimate, bool lo
   shareMapChanges(false);
 }
 
+std::string BeamScreen::restoreLayer(const std::string& state) {
+  if (!layer_) return "no map to restore the map's changes on";
+  const std::string error = layer_->decode(state);
+  shareMapChanges(false);  // what was cleared, and what was restored
+  return error;
+}
+
+void BeamScreen::clearLayer() {
+  if (!layer_) return;
+  layer_->clear();
+  shareMapChanges(false);
+}
+
 void BeamScreen::shareMapChanges(bool all) {
   if (!layer_ || !evidence_) return;
   if (all) {

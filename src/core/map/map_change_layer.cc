@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
+#include <utility>
 
 #include "pf_localization/core/motion/scan_deskew.h"
 
@@ -12,6 +14,58 @@ namespace {
 void bump(std::uint16_t* n) {
   if (*n < std::numeric_limits<std::uint16_t>::max()) ++*n;
 }
+
+// encode()'s numbers: unsigned integers in 7-bit groups, the lowest first
+// (LEB128), doubles as their 8 bytes, the lowest first.
+void putNumber(std::string* out, std::uint64_t v) {
+  for (; v >= 0x80; v >>= 7) out->push_back(static_cast<char>(v | 0x80));
+  out->push_back(static_cast<char>(v));
+}
+
+void putReal(std::string* out, double d) {
+  std::uint64_t bits;
+  std::memcpy(&bits, &d, sizeof bits);
+  for (int k = 0; k < 8; ++k) out->push_back(static_cast<char>(bits >> (8 * k) & 0xff));
+}
+
+// Reads what putNumber and putReal wrote; past the end, or a number longer
+// than 64 bits, it stops being ok() and gives zeros.
+class ByteReader {
+ public:
+  explicit ByteReader(const std::string& bytes) : bytes_(bytes) {}
+  bool ok() const { return ok_; }
+  bool atEnd() const { return pos_ == bytes_.size(); }
+  std::uint8_t byte() {
+    if (pos_ >= bytes_.size()) ok_ = false;
+    return ok_ ? static_cast<std::uint8_t>(bytes_[pos_++]) : 0;
+  }
+  std::uint64_t number() {
+    std::uint64_t v = 0;
+    for (int shift = 0; shift < 64 && ok_; shift += 7) {
+      const std::uint8_t b = byte();
+      v |= static_cast<std::uint64_t>(b & 0x7f) << shift;
+      if (!(b & 0x80)) return ok_ ? v : 0;
+    }
+    ok_ = false;
+    return 0;
+  }
+  double real() {
+    std::uint64_t bits = 0;
+    for (int k = 0; k < 8; ++k) bits |= static_cast<std::uint64_t>(byte()) << (8 * k);
+    double d;
+    std::memcpy(&d, &bits, sizeof d);
+    return ok_ ? d : 0.0;
+  }
+
+ private:
+  const std::string& bytes_;
+  std::size_t pos_ = 0;
+  bool ok_ = true;
+};
+
+// The bits of a cell's byte encode() keeps: all but what the map has there.
+constexpr int kStateShift = 2;
+constexpr std::uint64_t kStateBytes = 0xfcfcfcfcfcfcfcfcull;  // of 8 cells at once
 
 }  // namespace
 
@@ -45,6 +99,7 @@ void MapChangeLayer::count(std::size_t i, Kind kind) {
   }
   if (c.counted & kind) return;
   c.counted |= kind;
+  weigh(shown(i), c, false);
   switch (kind) {
     case kHit:
       bump(&c.hits);
@@ -60,6 +115,15 @@ void MapChangeLayer::count(std::size_t i, Kind kind) {
       break;
   }
   show(i, classify(i));
+  weigh(shown(i), c, true);
+}
+
+void MapChangeLayer::weigh(Cell shown_as, const Counts& c, bool add) {
+  if (shown_as != Cell::kAdded && shown_as != Cell::kRemoved) return;
+  const bool added = shown_as == Cell::kAdded;
+  std::size_t& sum = added ? summary_.added_scans : summary_.removed_scans;
+  const std::size_t n = added ? c.hits : c.passes;
+  sum = add ? sum + n : sum - n;
 }
 
 void MapChangeLayer::show(std::size_t i, Cell c) {
@@ -241,6 +305,156 @@ std::int8_t MapChangeLayer::valueOf(Cell c) {
       return 50;
   }
   return -1;
+}
+
+std::string MapChangeLayer::encode() const {
+  std::string out;
+  putNumber(&out, static_cast<std::uint64_t>(width_));
+  putNumber(&out, static_cast<std::uint64_t>(height_));
+  putNumber(&out, scans_);
+  putReal(&out, last_.x);
+  putReal(&out, last_.y);
+  putReal(&out, last_.yaw);
+  // The cells' states in runs: (length, state) until every cell is covered.
+  // An unseen stretch is skipped 8 cells at a time.
+  const std::size_t n = cells_.size();
+  for (std::size_t i = 0; i < n;) {
+    const std::uint8_t state = cells_[i] >> kStateShift;
+    std::size_t j = i + 1;
+    if (state == 0) {
+      for (std::uint64_t w; j + 8 <= n; j += 8) {
+        std::memcpy(&w, &cells_[j], sizeof w);
+        if (w & kStateBytes) break;
+      }
+    }
+    while (j < n && cells_[j] >> kStateShift == state) ++j;
+    putNumber(&out, j - i);
+    out.push_back(static_cast<char>(state));
+    i = j;
+  }
+  // The tiles' counts: how many tiles, then each tile's index (from the
+  // last's), how many of its cells count, and each one's index in the tile
+  // (from the last's) and counts.
+  std::string counts;
+  std::size_t tiles = 0, last_tile = 0;
+  for (std::size_t t = 0; t < tiles_.size(); ++t) {
+    if (!tiles_[t]) continue;
+    std::string cells;
+    std::size_t counted = 0, last_cell = 0;
+    for (std::size_t k = 0; k < kTileSize * kTileSize; ++k) {
+      const Counts& c = tiles_[t][k];
+      if (c.hits == 0 && c.free == 0 && c.passes == 0 && c.ends == 0) continue;
+      putNumber(&cells, k - last_cell);
+      for (const std::uint16_t v : {c.hits, c.free, c.passes, c.ends}) putNumber(&cells, v);
+      last_cell = k;
+      ++counted;
+    }
+    if (counted == 0) continue;
+    putNumber(&counts, t - last_tile);
+    putNumber(&counts, counted);
+    counts += cells;
+    last_tile = t;
+    ++tiles;
+  }
+  putNumber(&out, tiles);
+  return out + counts;
+}
+
+std::string MapChangeLayer::decode(const std::string& bytes) {
+  clear();
+  const std::string error = restore(bytes);
+  if (!error.empty()) clear();
+  return error;
+}
+
+// On a cleared layer: encode()'s order, each value checked against the map.
+std::string MapChangeLayer::restore(const std::string& bytes) {
+  ByteReader in(bytes);
+  const std::uint64_t w = in.number(), h = in.number(), scans = in.number();
+  const Pose2 last{in.real(), in.real(), in.real()};
+  if (!in.ok()) return "truncated";
+  if (w != static_cast<std::uint64_t>(width_) || h != static_cast<std::uint64_t>(height_)) {
+    return "learned on a map of " + std::to_string(w) + " x " + std::to_string(h) +
+           " cells, not this one of " + std::to_string(width_) + " x " + std::to_string(height_);
+  }
+  if (!last.isFinite()) return "corrupt: the last scan's pose is not finite";
+  const std::size_t n = cells_.size();
+  for (std::size_t i = 0; i < n;) {
+    const std::uint64_t run = in.number();
+    const std::uint8_t state = in.byte();
+    if (!in.ok()) return "truncated in the cells";
+    if (run == 0 || run > n - i) return "corrupt: a run of cells past the map's end";
+    const std::uint8_t cell = static_cast<std::uint8_t>(state << kStateShift);
+    const auto shown_as = static_cast<Cell>(cell >> kShownShift & 3);
+    const bool seen = cell & kSeen;
+    if (cell >> kStateShift != state || (cell & ~(kSeen | kWasHit | kShownBits)) ||
+        seen != (shown_as != Cell::kUnseen) || ((cell & kWasHit) && !seen)) {
+      return "corrupt: a cell's state is not one the layer gives";
+    }
+    for (std::size_t k = i; state != 0 && k < i + run; ++k) {
+      const std::uint8_t map = cells_[k] & kMapBits;
+      if (map == kMapUnknown || ((cell & kWasHit) && map != kMapFree)) {
+        return "a cell seen here is unknown on this map, or a beam ended in an obstacle";
+      }
+      cells_[k] = map | cell;
+    }
+    i += run;
+  }
+  const std::uint64_t tiles = in.number();
+  if (!in.ok() || tiles > tiles_.size()) return "corrupt: more tiles of counts than the map has";
+  std::size_t t = 0;
+  for (std::uint64_t k = 0; k < tiles; ++k) {
+    const std::uint64_t step = in.number(), counted = in.number();
+    if (!in.ok()) return "truncated in the counts";
+    if ((k > 0 && step == 0) || step >= tiles_.size() - t || counted == 0 ||
+        counted > kTileSize * kTileSize) {
+      return "corrupt: a tile of counts out of order or out of the map";
+    }
+    t += step;
+    tiles_[t] = std::make_unique<Counts[]>(kTileSize * kTileSize);
+    std::size_t j = 0;
+    for (std::uint64_t m = 0; m < counted; ++m) {
+      const std::uint64_t cell_step = in.number();
+      std::uint64_t v[4];
+      for (std::uint64_t& x : v) x = in.number();
+      if (!in.ok()) return "truncated in the counts";
+      j += cell_step;
+      const std::size_t x = (t % tiles_x_) * kTileSize + (j & (kTileSize - 1));
+      const std::size_t y = (t / tiles_x_) * kTileSize + (j >> kTileBits);
+      if ((m > 0 && cell_step == 0) || j >= kTileSize * kTileSize || x >= std::size_t(width_) ||
+          y >= std::size_t(height_) || !(cells_[y * width_ + x] & kSeen) ||
+          *std::max_element(v, v + 4) > std::numeric_limits<std::uint16_t>::max()) {
+        return "corrupt: counts out of order, out of the map or of an unseen cell";
+      }
+      Counts& c = tiles_[t][j];
+      c.hits = static_cast<std::uint16_t>(v[0]);
+      c.free = static_cast<std::uint16_t>(v[1]);
+      c.passes = static_cast<std::uint16_t>(v[2]);
+      c.ends = static_cast<std::uint16_t>(v[3]);
+      // Counted in an earlier scan than the next one added.
+      c.scan = static_cast<std::uint16_t>(scans - 1);
+    }
+  }
+  if (!in.atEnd()) return "corrupt: bytes after the counts";
+  scans_ = scans;
+  last_ = last;
+  return summarize();
+}
+
+// After restore(): each seen cell must show what its counts say; summary_
+// and changed_cells_ follow.
+std::string MapChangeLayer::summarize() {
+  for (std::size_t i = 0; i < cells_.size(); ++i) {
+    if (!(cells_[i] & kSeen)) continue;
+    const Cell c = shown(i);
+    if (c != classify(i)) return "corrupt: a cell shown otherwise than its counts say";
+    ++summary_.seen;
+    if (c == Cell::kAdded) ++summary_.added;
+    if (c == Cell::kRemoved) ++summary_.removed;
+    weigh(c, std::as_const(*this).countsAt(i), true);
+    if (c == Cell::kAdded || c == Cell::kRemoved) changed_cells_.push_back(i);
+  }
+  return "";
 }
 
 std::vector<std::uint8_t> MapChangeLayer::pixels() const {

@@ -131,4 +131,28 @@ void addHypotheses(diagnostic_msgs::DiagnosticStatus* status, const pf::Hypothes
   status->message += named;
 }
 
+void addMapChanges(diagnostic_msgs::DiagnosticStatus* status, const pf::MapChangeLayer* layer) {
+  if (layer == nullptr) return;
+  const pf::MapChangeLayer::Summary s = layer->summary();
+  const auto mean = [](std::size_t scans, std::size_t cells) {
+    return cells == 0 ? 0.0 : static_cast<double>(scans) / static_cast<double>(cells);
+  };
+  const double new_scans = mean(s.added_scans, s.added),
+               gone_scans = mean(s.removed_scans, s.removed);
+  char text[200];
+  std::snprintf(text, sizeof text,
+                "%zu cells new, %zu gone, of %zu seen, from %zu scans; each new one stopped the "
+                "beams of %.1f scans on average, each gone one let through those of %.1f",
+                s.added, s.removed, s.seen, layer->scans(), new_scans, gone_scans);
+  diagnostic_msgs::KeyValue kv;
+  kv.key = "map changes";
+  kv.value = text;
+  status->values.push_back(kv);
+  add(status, "map_cells_seen", static_cast<double>(s.seen));
+  add(status, "map_cells_new", static_cast<double>(s.added));
+  add(status, "map_cells_gone", static_cast<double>(s.removed));
+  add(status, "map_new_mean_scans", new_scans);
+  add(status, "map_gone_mean_scans", gone_scans);
+}
+
 }  // namespace pf_ros

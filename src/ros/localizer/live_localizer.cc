@@ -25,7 +25,15 @@ LiveLocalizer::LiveLocalizer(const LocalizerConfig& config, std::optional<SavedP
       output_(nh),
       jumps_(tf, config.odom_frame, config.base_frame, warn,
              [this](double back_s) { restartAfterJump(back_s); }),
-      saver_(config.save_pose_rate, std::move(write_pose)),
+      changes_saver_(config.map_changes_file.empty()
+                         ? defaultMapChangesPath(ros::this_node::getName())
+                         : config.map_changes_file,
+                     config.save_pose_rate),
+      saver_(config.save_pose_rate,
+             [this, write_pose = std::move(write_pose)](const PoseSaver::Record& record) {
+               if (write_pose) write_pose(record);
+               writeMapChanges();
+             }),
       saved_pose_(std::move(saved)) {
   logInitialPose();
 }
@@ -65,6 +73,7 @@ bool LiveLocalizer::install(ScanLocalizer::ReadyMap ready, const nav_msgs::Occup
     saver_.setMap(signature);
     if (first && saved_pose_) checkSavedPose(signature);
   }
+  if (changes_saver_.enabled()) mapChangesOnNewMap(signature, first, map.header.stamp);
   ROS_INFO("pf_node: map %u x %u cells at %.3f m; %zu particles", map.info.width, map.info.height,
            map.info.resolution, localizer_.filter().particles().size());
   output_.publishEstimate(localizer_, map.header.stamp, true);
@@ -89,6 +98,48 @@ void LiveLocalizer::checkSavedPose(const std::string& map_signature) {
   if (pose_before_map_) return;
   const std::string error = localizer_.startGlobalLocalization();
   if (!error.empty()) ROS_WARN("pf_node: %s", error.c_str());
+}
+
+void LiveLocalizer::mapChangesOnNewMap(const std::string& signature, bool first,
+                                       const ros::Time& stamp) {
+  changes_saver_.setMap(signature);
+  if (!first) return;
+  const MapChangesRestore r =
+      restoreMapChanges(changes_saver_.path(), signature, &localizer_.filter());
+  if (r.level == MapChangesRestore::Level::kWarn) {
+    ROS_WARN("pf_node: %s", r.message.c_str());
+  } else {
+    ROS_INFO("pf_node: %s", r.message.c_str());
+  }
+  if (!r.restored) return;
+  changes_saver_.setMap(signature, localizer_.mapChanges()->scans());  // the file holds it
+  output_.publishMapChangesNow(localizer_, stamp);
+}
+
+bool LiveLocalizer::clearMapChanges() {
+  if (!have_map_) return false;
+  const std::size_t changed =
+      localizer_.mapChanges()->summary().added + localizer_.mapChanges()->summary().removed;
+  localizer_.filter().clearMapChanges();
+  changes_saver_.changed();
+  output_.publishMapChangesNow(localizer_, ros::Time::now());
+  ROS_INFO("pf_node: map changes cleared (%zu cells were new or gone)%s", changed,
+           changes_saver_.enabled() ? "; the file follows at the next save" : "");
+  return true;
+}
+
+void LiveLocalizer::saveAtShutdown(UpdateScheduler& scheduler) {
+  if (!saver_.enabled()) return;
+  scheduler.withFilter(
+      [&] { changes_saver_.offer(localizer_.mapChanges(), ros::WallTime::now(), true); });
+  // Without a master the pose's save would block, waiting for one.
+  if (ros::master::check()) saver_.saveNow();
+  writeMapChanges();  // when there was no pose to save with it
+}
+
+void LiveLocalizer::writeMapChanges() {
+  const std::string error = changes_saver_.writePending();
+  if (!error.empty()) warn_->warn("map changes file", "the map changes are not saved: " + error);
 }
 
 bool LiveLocalizer::setInitialPose(const geometry_msgs::PoseWithCovarianceStamped& pose) {
@@ -216,6 +267,7 @@ void LiveLocalizer::filterChanged(const ros::Time& scan_stamp) {
   republisher_->set(localizer_.mapToOdom(ros::Time()), scan_stamp);
   if (!saver_.enabled()) return;  // nothing is ever saved
   saver_.set(poseToSave(localizer_, last_odom_));
+  changes_saver_.offer(localizer_.mapChanges(), ros::WallTime::now());
 }
 
 }  // namespace pf_ros

@@ -58,6 +58,7 @@ void EstimatePublisher::publishConfidence(const ScanLocalizer& localizer, const 
   timing.addTo(&array.status.front(), dropped, cap);
   addHypotheses(&array.status.front(), hypotheses);
   addSensors(&array.status.front(), localizer.sensorHealth(), stamp.toSec());
+  addMapChanges(&array.status.front(), localizer.mapChanges());
   diagnostics_pub_.publish(array);
   status_pub_.publish(array.status.front());
   publishMapChanges(localizer, stamp);
@@ -78,6 +79,13 @@ void EstimatePublisher::publishMapChanges(const ScanLocalizer& localizer, const 
       (stamp - last_changes_stamp_).toSec() < kMapChangesPeriod) {
     return;
   }
+  publishMapChangesNow(localizer, stamp);
+}
+
+void EstimatePublisher::publishMapChangesNow(const ScanLocalizer& localizer,
+                                             const ros::Time& stamp) {
+  const pf::MapChangeLayer* layer = localizer.mapChanges();
+  if (layer == nullptr) return;
   if (auto msg = localizer.mapChangesMsg(stamp)) changes_pub_.publish(std::move(*msg));
   last_changes_stamp_ = stamp;
   changes_scans_ = layer->scans();

@@ -94,6 +94,11 @@ pf::ParameterTable<C> outputParameters() {
                      .in(Range::any())
                      .withNote("<= 0: never")
                      .amcl()),
+      pf::member(&C::map_changes_file,
+                 I("map_changes_file", "path",
+                   "pf_map_changes' layer is saved to this file with the pose, and restored on "
+                   "the same map; empty: $ROS_HOME/NODE.map_changes (~/.ros/pf_node.map_changes)")
+                     .unsetMeans("the default")),
       pf::member(&C::max_update_time,
                  I("max_update_time", "s",
                    "cap the particle count so that an update takes this long at p95")

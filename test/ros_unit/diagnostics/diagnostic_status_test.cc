@@ -2,7 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <map>
+
+#include "support/rooms.h"
+#include "support/scan_simulator.h"
 
 namespace pf_ros {
 namespace {
@@ -132,6 +136,42 @@ TEST(Diagnostics, OneHypothesisIsACountAndNothingElse) {
   EXPECT_EQ("localized: 95 % of the beams fit, one hypothesis", status.message);
   ASSERT_EQ(1u, status.values.size());
   EXPECT_EQ("1", values(status).at("hypotheses"));
+}
+
+TEST(Diagnostics, TheMapsChangesAreTheLayersCounts) {
+  // A room whose map has a box the world lacks, toured twice.
+  const pf::test::Box box{0.8, 1.8, 1.2, 2.2};
+  const pf::OccupancyGrid map = pf::test::room(4.0, 3.0, 0.05, {box});
+  const pf::DistanceField field(map, 2.0);
+  pf::MapChangeLayer layer(field);
+  pf::test::ScanSpec spec;
+  spec.beams = 360;
+  spec.angle_increment = 2.0 * M_PI / 360;
+  for (int k = 0; k < 2; ++k) {
+    for (const pf::Pose2& p : {pf::Pose2{2.0, 1.5, 0.0}, pf::Pose2{2.5, 2.0, -2.0}}) {
+      layer.add(pf::test::simulateScan(pf::test::room(4.0, 3.0, 0.05), p, spec), p);
+    }
+  }
+  const pf::MapChangeLayer::Summary s = layer.summary();
+  ASSERT_GT(s.removed, 0u);
+  diagnostic_msgs::DiagnosticStatus status;
+  addMapChanges(&status, &layer);
+  const auto v = values(status);
+  EXPECT_EQ(v.at("map_cells_seen"), std::to_string(s.seen));
+  EXPECT_EQ(v.at("map_cells_new"), "0");
+  EXPECT_EQ(v.at("map_cells_gone"), std::to_string(s.removed));
+  // Each gone cell was passed by 2 to 4 scans: the mean lies between.
+  const double mean = std::stod(v.at("map_gone_mean_scans"));
+  EXPECT_GE(mean, 2.0);
+  EXPECT_LE(mean, 4.0);
+  EXPECT_NE(v.at("map changes")
+                .find("0 cells new, " + std::to_string(s.removed) + " gone, of " +
+                      std::to_string(s.seen) + " seen, from 4 scans"),
+            std::string::npos)
+      << v.at("map changes");
+  diagnostic_msgs::DiagnosticStatus none;
+  addMapChanges(&none, nullptr);
+  EXPECT_TRUE(none.values.empty());
 }
 
 }  // namespace

@@ -17,6 +17,7 @@
 #pragma once
 
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "pf_localization/core/map/distance_field.h"
@@ -105,6 +106,11 @@ class BeamScreen {
   const MapEvidence* evidence() const { return evidence_ ? &*evidence_ : nullptr; }
   /// The layer of the map's changes (none without a map).
   const MapChangeLayer* layer() const { return layer_ ? &*layer_ : nullptr; }
+  /// The layer restored from `state` (MapChangeLayer::decode()), the judging
+  /// told all it holds: empty, or why not (then the layer is empty).
+  std::string restoreLayer(const std::string& state);
+  /// The layer emptied, the judging told.
+  void clearLayer();
 
  private:
   // The scans with the beams that see something that moved in masked, from

@@ -127,6 +127,12 @@ class ParticleFilter {
   /// the layer has it (map_evidence.h): its obstacles seen gone no longer
   /// stop rays, and a beam that ends on one it has seen added sees a change.
   const MapChangeLayer* mapChanges() const { return screen_.layer(); }
+  /// That layer restored from `state` (MapChangeLayer::encode(), learned on
+  /// this map), the scans judged on it from now on: empty, or why it was
+  /// refused (the layer is then empty). Without a map: refused.
+  std::string restoreMapChanges(const std::string& state) { return screen_.restoreLayer(state); }
+  /// That layer emptied: the scans are judged on the map as it is.
+  void clearMapChanges() { screen_.clearLayer(); }
 
   /// Particles drawn around `mean` from a Gaussian with covariance `cov`
   /// (x, y, yaw). Throws std::invalid_argument for a non-finite pose or a

@@ -20,6 +20,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "pf_localization/core/map/distance_field.h"
@@ -76,6 +77,10 @@ class MapChangeLayer {
 
   struct Summary {
     std::size_t seen = 0, added = 0, removed = 0;
+    // The evidence behind them: over the added cells, the scans whose beams
+    // stopped there (hits); over the removed ones, the scans whose beams went
+    // through the mapped obstacle (passes). Each cell has at least kMinScans.
+    std::size_t added_scans = 0, removed_scans = 0;
     double changedShare() const {
       return seen == 0 ? 0.0 : static_cast<double>(added + removed) / static_cast<double>(seen);
     }
@@ -102,6 +107,18 @@ class MapChangeLayer {
   /// The cells (row-major indices) that became added or removed, or stopped
   /// being, since the last call: what the judging of scans learns.
   std::vector<std::size_t> takeChangedCells();
+
+  /// What the layer learned as bytes, to restore on the same map after a
+  /// restart: the map's size, the scans added and the last one's pose, the
+  /// state of each cell run-length coded (a building's millions of unseen
+  /// cells are a few bytes) and the counts of the cells that have any, as
+  /// variable-length integers (map_change_file.h frames them in a file).
+  std::string encode() const;
+  /// The state encode() wrote, on a layer of a map of the same size: empty,
+  /// or why the bytes were refused (another map's size, truncated, corrupt)
+  /// and the layer left empty. Every restored added and removed cell is then
+  /// listed by takeChangedCells().
+  std::string decode(const std::string& bytes);
 
  private:
   // Scans, each counted once per cell and kind.
@@ -141,6 +158,13 @@ class MapChangeLayer {
   void count(std::size_t i, Kind kind);
   // Marks cell i seen.
   void see(std::size_t i);
+  // decode() without the clearing on error, and the check of what it read
+  // that fills summary_ and changed_cells_.
+  std::string restore(const std::string& bytes);
+  std::string summarize();
+  // Adds (`add`) or takes the evidence of a cell shown as `shown_as` with
+  // counts `c` to or from summary_.
+  void weigh(Cell shown_as, const Counts& c, bool add);
   // Shows cell i as `c` (occupancy()), and keeps summary_ and changed_cells_.
   void show(std::size_t i, Cell c);
   // One beam from (x, y) along (ux, uy), in cells of the grid's frame.

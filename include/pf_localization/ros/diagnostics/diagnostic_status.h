@@ -41,4 +41,12 @@ constexpr std::size_t kNamedHypotheses = 4;
 /// that a robot monitor shows where the robot may be.
 void addHypotheses(diagnostic_msgs::DiagnosticStatus* status, const pf::Hypotheses& hypotheses);
 
+/// What the layer of the map's changes (pf_map_changes) holds, from its
+/// counts (map_change_layer.h): "map changes" in words, and as numbers its
+/// cells seen, new (an obstacle the map lacks) and gone (a mapped obstacle
+/// seen through), and the scans behind each new and each gone cell on
+/// average (each has at least MapChangeLayer::kMinScans, and at least half of
+/// the scans that reached it said so). Nothing without a map.
+void addMapChanges(diagnostic_msgs::DiagnosticStatus* status, const pf::MapChangeLayer* layer);
+
 }  // namespace pf_ros

@@ -4,14 +4,17 @@
 // maps, initial poses and the services, the live parameters with
 // max_update_time's particle cap, time jumping back (TimeJumpHandler: tf
 // and the filter start over), the scans tf dropped and the check of a pose
-// saved by an earlier run on the first map (saved_pose.h).
+// saved by an earlier run on the first map (saved_pose.h), and the layer of
+// the map's changes saved with the pose, restored on the first map when it
+// was learned on it, and cleared on request (map_changes_saver.h).
 //
 // Threads (docs/ros-interface.md, "Threads, latency and overload"): every
 // method but saver(), haveMap() and installMap() must be called with the
 // filter's lock held (UpdateScheduler); an update holds it whole (on the
 // filter thread, or on roscpp's poll thread when it is short), the main
 // spinner's callbacks that touch the filter wait for it; installMap() takes
-// it itself, only around the swap of a map it built without it. What runs at a steady rate never
+// it itself, only around the swap of a map it built without it, and
+// saveAtShutdown() around the copy of the layer. What runs at a steady rate never
 // does: the republisher and the saver get their data under small locks of their own.
 #pragma once
 
@@ -31,6 +34,7 @@
 #include "pf_localization/ros/input/time_jump_handler.h"
 #include "pf_localization/ros/localizer/scan_localizer.h"
 #include "pf_localization/ros/output/estimate_publisher.h"
+#include "pf_localization/ros/output/map_changes_saver.h"
 #include "pf_localization/ros/output/map_to_odom_republisher.h"
 #include "pf_localization/ros/output/pose_saver.h"
 #include "pf_localization/ros/params/reconfigure_server.h"
@@ -95,8 +99,17 @@ class LiveLocalizer {
   void clockTick(const ros::Time& now);
 
   /// The pose to save and its schedule (pose_saver.h): may be used without
-  /// the filter's lock.
+  /// the filter's lock. Its saves write the layer of the map's changes too.
   PoseSaver& saver() { return saver_; }
+  /// At shutdown, on the main spinner without the filter's lock: the pose
+  /// saved (when a master answers) and the layer of the map's changes as it
+  /// is now (`scheduler` lends the lock to copy it). Nothing when saving is off.
+  void saveAtShutdown(UpdateScheduler& scheduler);
+
+  /// The clear_map_changes service: the layer of the map's changes emptied,
+  /// pf_map_changes published so, the file overwritten at the next save.
+  /// False without a map.
+  bool clearMapChanges();
 
  private:
   void logInitialPose() const;
@@ -105,6 +118,11 @@ class LiveLocalizer {
   bool install(ScanLocalizer::ReadyMap ready, const nav_msgs::OccupancyGrid& map,
                const std::string& signature);
   void checkSavedPose(const std::string& map_signature);
+  // A new map of signature `signature` for the layer's saver; on the first
+  // (`first`), the layer saved on it restored and published.
+  void mapChangesOnNewMap(const std::string& signature, bool first, const ros::Time& stamp);
+  // The layer's copy written now, if any (a warning if it cannot be).
+  void writeMapChanges();
   void restartAfterJump(double back_s);
   void applyParticleCap(std::size_t cap);
   void filterChanged(const ros::Time& scan_stamp);
@@ -118,6 +136,7 @@ class LiveLocalizer {
   UpdatePlacement placement_;
   EstimatePublisher output_;
   TimeJumpHandler jumps_;
+  MapChangesSaver changes_saver_;
   PoseSaver saver_;
   bool have_map_ = false;
   std::optional<SavedPoseMap> saved_pose_;  // until the first map checks it

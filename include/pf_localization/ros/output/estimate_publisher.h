@@ -54,6 +54,8 @@ class EstimatePublisher {
   void publishConfidence(const ScanLocalizer& localizer, const ros::Time& stamp,
                          const pf::UpdateReport& report, int config_generation,
                          const UpdateTiming& timing, std::uint64_t dropped, std::size_t cap);
+  /// pf_map_changes now, whatever learned or due (restored, or cleared).
+  void publishMapChangesNow(const ScanLocalizer& localizer, const ros::Time& stamp);
 
  private:
   // pf_map_changes when due and the layer learned something since.

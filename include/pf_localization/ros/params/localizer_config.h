@@ -69,6 +69,9 @@ struct LocalizerConfig {
   // so that it does (UpdateTimeGovernor); <= 0: off, max_particles alone.
   double max_update_time = 0.0;
   double save_pose_rate = 0.5;  // Hz the estimate is saved to ~initial_pose_*; <= 0: never
+  // The file the layer of the map's changes is saved to with the pose
+  // (map_changes_saver.h); empty: defaultMapChangesPath().
+  std::string map_changes_file;
   bool first_map_only = false;  // keep the first map; ignore later ones on the map topic
 };
 
