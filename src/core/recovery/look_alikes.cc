@@ -85,36 +85,63 @@ void peaks(const std::vector<double>& values, int p, double threshold, Keep keep
   }
 }
 
-// The share of `samples` (grid-frame points) that `motion` puts within one
-// cell of an obstacle.
-double overlapOf(const DistanceField& field, const std::vector<Eigen::Vector2d>& samples,
-                 const Pose2& motion) {
-  const OccupancyGrid& grid = field.grid();
-  const double res = grid.resolution();
-  const double c = std::cos(motion.yaw), s = std::sin(motion.yaw);
-  std::size_t hits = 0;
-  for (const Eigen::Vector2d& u : samples) {
-    const double x = c * u.x() - s * u.y() + motion.x;
-    const double y = s * u.x() + c * u.y() + motion.y;
-    const CellIndex cell{static_cast<int>(std::floor(x / res)),
-                         static_cast<int>(std::floor(y / res))};
-    if (grid.contains(cell) && field.distance(cell) <= 1.01 * res) ++hits;
+// The cells within one cell of an obstacle, a bit each: what the search
+// below reads, 6 MB on a 200 x 600 m floor where the field's classes are 96.
+class NearObstacle {
+ public:
+  explicit NearObstacle(const DistanceField& field) : grid_(field.grid()) {
+    const std::vector<float>& distances = field.classDistances();
+    std::vector<bool> near_class(distances.size());
+    for (std::size_t c = 0; c < distances.size(); ++c) {
+      near_class[c] = distances[c] <= 1.01 * grid_.resolution();
+    }
+    bits_.assign((field.size() + 63) / 64, 0);
+    const uint16_t* classes = field.classes();
+    for (std::size_t i = 0; i < field.size(); ++i) {
+      if (near_class[classes[i]]) bits_[i / 64] |= uint64_t{1} << (i % 64);
+    }
   }
-  return samples.empty() ? 0.0 : static_cast<double>(hits) / static_cast<double>(samples.size());
-}
+  const OccupancyGrid& grid() const { return grid_; }
+  bool near(const CellIndex& cell) const {
+    if (!grid_.contains(cell)) return false;
+    const auto i = static_cast<std::size_t>(grid_.linearIndex(cell));
+    return (bits_[i / 64] >> (i % 64)) & 1;
+  }
+
+ private:
+  const OccupancyGrid& grid_;
+  std::vector<uint64_t> bits_;
+};
 
 // The best of `candidate` moved by multiples of `step` cells within
-// +-reach cells, scored on `samples`.
-Candidate bestOffset(const DistanceField& field, const std::vector<Eigen::Vector2d>& samples,
+// +-reach cells, scored by the share of `samples` (grid-frame points) each
+// move puts within one cell of an obstacle. Each sample is tried at every
+// move in turn, so that the moves' cells, close together, share cache lines.
+// The first best move in row order wins.
+Candidate bestOffset(const NearObstacle& near, const std::vector<Eigen::Vector2d>& samples,
                      const Pose2& candidate, int reach, int step) {
-  const double res = field.grid().resolution();
-  Candidate best{candidate, -1.0};
+  const double res = near.grid().resolution();
+  std::vector<Pose2> moves;
   for (int dy = -reach; dy <= reach; dy += step) {
     for (int dx = -reach; dx <= reach; dx += step) {
-      const Pose2 m{candidate.x + dx * res, candidate.y + dy * res, candidate.yaw};
-      const double score = overlapOf(field, samples, m);
-      if (score > best.score) best = {m, score};
+      moves.push_back({candidate.x + dx * res, candidate.y + dy * res, candidate.yaw});
     }
+  }
+  const double c = std::cos(candidate.yaw), s = std::sin(candidate.yaw);
+  std::vector<std::size_t> hits(moves.size(), 0);
+  for (const Eigen::Vector2d& u : samples) {
+    const double rx = c * u.x() - s * u.y(), ry = s * u.x() + c * u.y();
+    for (std::size_t k = 0; k < moves.size(); ++k) {
+      const double x = rx + moves[k].x, y = ry + moves[k].y;
+      hits[k] +=
+          near.near({static_cast<int>(std::floor(x / res)), static_cast<int>(std::floor(y / res))});
+    }
+  }
+  Candidate best{candidate, -1.0};
+  for (std::size_t k = 0; k < moves.size(); ++k) {
+    const double score =
+        samples.empty() ? 0.0 : static_cast<double>(hits[k]) / static_cast<double>(samples.size());
+    if (score > best.score) best = {moves[k], score};
   }
   return best;
 }
@@ -122,11 +149,11 @@ Candidate bestOffset(const DistanceField& field, const std::vector<Eigen::Vector
 // `candidate` moved by whole cells within +-reach, to the best overlap: a
 // search on every step-th cell with `some` of the samples (a quarter), then
 // every cell around its best with them all.
-Candidate refine(const DistanceField& field, const std::vector<Eigen::Vector2d>& samples,
+Candidate refine(const NearObstacle& near, const std::vector<Eigen::Vector2d>& samples,
                  const std::vector<Eigen::Vector2d>& some, const Pose2& candidate, int reach) {
   const int step = std::max(1, reach / 4);
-  const Candidate rough = bestOffset(field, some, candidate, reach - reach % step, step);
-  return bestOffset(field, samples, rough.motion, step, 1);
+  const Candidate rough = bestOffset(near, some, candidate, reach - reach % step, step);
+  return bestOffset(near, samples, rough.motion, step, 1);
 }
 
 // The map's obstacle cells, by linear index (four bytes each, not a
@@ -225,9 +252,11 @@ std::vector<MapSymmetry> findMapSymmetries(const DistanceField& field) {
   }
   std::vector<Eigen::Vector2d> some;
   for (std::size_t i = 0; i < samples.size(); i += 4) some.push_back(samples[i]);
+  if (candidates.empty()) return {};
+  const NearObstacle near(field);
   std::vector<Candidate> refined;
   for (const Candidate& c : candidates) {
-    const Candidate r = refine(field, samples, some, c.motion, f);
+    const Candidate r = refine(near, samples, some, c.motion, f);
     const bool is_shift = r.motion.yaw == 0.0;
     if (r.score < LookAlikes::kMinSymmetryOverlap) continue;
     if (is_shift && std::hypot(r.motion.x, r.motion.y) < LookAlikes::kMinShift) continue;
