@@ -108,15 +108,11 @@ DistanceField::DistanceField(OccupancyGrid grid, double max_distance, int thread
                                 std::to_string(static_cast<int>(kMaxCapCells)) + " cells of " +
                                 std::to_string(grid_.resolution()) + " m");
   }
-  std::vector<bool> occupied(grid_.data().size());
-  for (std::size_t i = 0; i < occupied.size(); ++i) {
-    occupied[i] = OccupancyGrid::classify(grid_.data()[i]) == CellState::kOccupied;
-  }
   const ValueClasses values(static_cast<float>(grid_.resolution()),
                             static_cast<float>(max_distance));
-  classes_.assign(occupied.size() + 1, values.outside_cap_class);
-  transformOutside(occupied, values, threads);
-  transformInside(occupied, values, threads);
+  classes_.assign(grid_.data().size() + 1, values.outside_cap_class);
+  transformOutside(values, threads);
+  transformInside(values, threads);
   distances_.resize(values.values.size());
   surfaces_.resize(values.values.size());
   for (std::size_t c = 0; c < values.values.size(); ++c) {
@@ -139,10 +135,11 @@ void inSlices(int threads, std::size_t n, Part part) {
 
 }  // namespace
 
-void DistanceField::transformOutside(const std::vector<bool>& occupied, const ValueClasses& values,
-                                     int threads) {
+void DistanceField::transformOutside(const ValueClasses& values, int threads) {
   const int w = grid_.width(), h = grid_.height();
   uint16_t* cells = classes_.data();
+  const int8_t* map = grid_.data().data();
+  const auto occupied = [map](std::size_t i) { return DistanceField::occupied(map[i]); };
   // The column distances, then each row's classes in their place.
   inSlices(threads, static_cast<std::size_t>(w), [&](std::size_t begin, std::size_t end) {
     cappedColumnDistances(occupied, w, h, values.outside_reach, static_cast<int>(begin),
@@ -164,12 +161,12 @@ void DistanceField::transformOutside(const std::vector<bool>& occupied, const Va
   });
 }
 
-void DistanceField::transformInside(const std::vector<bool>& occupied, const ValueClasses& values,
-                                    int threads) {
+void DistanceField::transformInside(const ValueClasses& values, int threads) {
   const int w = grid_.width(), h = grid_.height();
-  std::vector<bool> open = occupied;
-  open.flip();
-  std::vector<uint16_t> column(occupied.size());
+  const int8_t* map = grid_.data().data();
+  const auto occupied = [map](std::size_t i) { return DistanceField::occupied(map[i]); };
+  const auto open = [map](std::size_t i) { return !DistanceField::occupied(map[i]); };
+  std::vector<uint16_t> column(grid_.data().size());
   inSlices(threads, static_cast<std::size_t>(w), [&](std::size_t begin, std::size_t end) {
     cappedColumnDistances(open, w, h, values.inside_reach, static_cast<int>(begin),
                           static_cast<int>(end), column.data());
@@ -184,12 +181,12 @@ void DistanceField::transformInside(const std::vector<bool>& occupied, const Val
     for (std::size_t y = begin; y < end; ++y) {
       const std::size_t row = y * w;
       for (int a = 0; a < w;) {
-        if (!occupied[row + a]) {
+        if (!occupied(row + a)) {
           ++a;
           continue;
         }
         int b = a;
-        while (b + 1 < w && occupied[row + b + 1]) ++b;
+        while (b + 1 < w && occupied(row + b + 1)) ++b;
         const int first = std::max(a - 1, 0), last = std::min(b + 1, w - 1);
         const int n = last - first + 1;
         std::copy(&column[row + first], &column[row + first] + n, g.begin());

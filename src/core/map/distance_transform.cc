@@ -82,28 +82,6 @@ std::vector<float> squaredDistanceTransform(const std::vector<bool>& is_source, 
   return out;
 }
 
-void cappedColumnDistances(const std::vector<bool>& is_source, int width, int height, uint16_t cap,
-                           int x_begin, int x_end, uint16_t* out) {
-  const std::size_t w = static_cast<std::size_t>(width);
-  const std::size_t n = w * static_cast<std::size_t>(height);
-  if (n == 0 || x_begin >= x_end) return;
-  const auto below = [cap](uint16_t g) { return static_cast<uint16_t>(g < cap ? g + 1 : cap); };
-  for (std::size_t x = x_begin; x < static_cast<std::size_t>(x_end); ++x) {
-    out[x] = is_source[x] ? 0 : cap;
-  }
-  for (std::size_t row = w; row < n; row += w) {
-    for (std::size_t i = row + x_begin; i < row + x_end; ++i) {
-      out[i] = is_source[i] ? 0 : below(out[i - w]);
-    }
-  }
-  for (std::size_t row = n - w; row >= w;) {
-    row -= w;
-    for (std::size_t i = row + x_begin; i < row + x_end; ++i) {
-      out[i] = std::min(out[i], below(out[i + w]));
-    }
-  }
-}
-
 void CappedRowPass::run(const uint16_t* g, int n, uint16_t cap, int64_t* d) {
   v_.resize(static_cast<std::size_t>(n));
   z_.resize(static_cast<std::size_t>(n) + 1);

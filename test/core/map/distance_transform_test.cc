@@ -138,8 +138,9 @@ std::vector<int64_t> cappedTransform(const std::vector<bool>& grid, int width, i
                                      uint16_t cap) {
   std::vector<uint16_t> column(grid.size());
   // In two slices of columns, as two threads would.
-  cappedColumnDistances(grid, width, height, cap, 0, width / 3, column.data());
-  cappedColumnDistances(grid, width, height, cap, width / 3, width, column.data());
+  const auto is_source = [&grid](std::size_t i) { return grid[i]; };
+  cappedColumnDistances(is_source, width, height, cap, 0, width / 3, column.data());
+  cappedColumnDistances(is_source, width, height, cap, width / 3, width, column.data());
   std::vector<int64_t> out(grid.size());
   CappedRowPass pass;
   for (int y = 0; y < height; ++y) {

@@ -78,10 +78,13 @@ class DistanceField {
 
  private:
   struct ValueClasses;
+  static bool occupied(int8_t value) {
+    return OccupancyGrid::classify(value) == CellState::kOccupied;
+  }
   // The distances to the obstacles, into classes_.
-  void transformOutside(const std::vector<bool>& occupied, const ValueClasses& values, int threads);
+  void transformOutside(const ValueClasses& values, int threads);
   // The depths of the occupied cells, into their classes_.
-  void transformInside(const std::vector<bool>& occupied, const ValueClasses& values, int threads);
+  void transformInside(const ValueClasses& values, int threads);
 
   OccupancyGrid grid_;
   double max_distance_;

@@ -17,6 +17,8 @@
 // gives is the exact squared distance wherever that is below the cap.
 #pragma once
 
+#include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -30,10 +32,31 @@ std::vector<float> squaredDistanceTransform(const std::vector<bool>& is_source, 
 
 /// The column pass for distances below `cap` cells: out[y * width + x] is
 /// the distance in cells from (x, y) to the nearest source in column x, or
-/// `cap` when that is `cap` or more (or the column has none). Columns
-/// [x_begin, x_end) only, so that threads can share a grid.
-void cappedColumnDistances(const std::vector<bool>& is_source, int width, int height, uint16_t cap,
-                           int x_begin, int x_end, uint16_t* out);
+/// `cap` when that is `cap` or more (or the column has none); is_source(i)
+/// says whether cell i (row-major) is a source. Columns [x_begin, x_end)
+/// only, so that threads can share a grid.
+template <typename IsSource>
+void cappedColumnDistances(const IsSource& is_source, int width, int height, uint16_t cap,
+                           int x_begin, int x_end, uint16_t* out) {
+  const std::size_t w = static_cast<std::size_t>(width);
+  const std::size_t n = w * static_cast<std::size_t>(height);
+  if (n == 0 || x_begin >= x_end) return;
+  const auto below = [cap](uint16_t g) { return static_cast<uint16_t>(g < cap ? g + 1 : cap); };
+  for (std::size_t x = x_begin; x < static_cast<std::size_t>(x_end); ++x) {
+    out[x] = is_source(x) ? 0 : cap;
+  }
+  for (std::size_t row = w; row < n; row += w) {
+    for (std::size_t i = row + x_begin; i < row + x_end; ++i) {
+      out[i] = is_source(i) ? 0 : below(out[i - w]);
+    }
+  }
+  for (std::size_t row = n - w; row >= w;) {
+    row -= w;
+    for (std::size_t i = row + x_begin; i < row + x_end; ++i) {
+      out[i] = std::min(out[i], below(out[i + w]));
+    }
+  }
+}
 
 /// The row pass over one row of column distances g[0, n) from
 /// cappedColumnDistances with the same `cap`: d[x] = min over x' of
