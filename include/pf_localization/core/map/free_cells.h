@@ -9,6 +9,7 @@
 // k-th free cell is a binary search over the words and a select in one word.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -21,8 +22,14 @@ class FreeCells {
   /// The cells `is_free(i)` says are free, of `cells` in all.
   template <typename IsFree>
   FreeCells(std::size_t cells, IsFree is_free) : words_((cells + 63) / 64, 0) {
-    for (std::size_t i = 0; i < cells; ++i) {
-      if (is_free(i)) words_[i / 64] |= uint64_t{1} << (i % 64);
+    // A word at a time, built in a register (a large floor has millions).
+    for (std::size_t w = 0; w < words_.size(); ++w) {
+      const std::size_t first = w * 64, end = std::min(first + 64, cells);
+      uint64_t word = 0;
+      for (std::size_t i = first; i < end; ++i) {
+        word |= static_cast<uint64_t>(is_free(i) ? 1 : 0) << (i - first);
+      }
+      words_[w] = word;
     }
     countBefore();
   }
