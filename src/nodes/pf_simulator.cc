@@ -111,7 +111,6 @@ constexpr int kWarehouseEvery = 10;       // the warehouse lidar's 10 Hz by defa
 constexpr double kNeatoRadius = 0.17;     // m, a Neato is 0.33 m across
 
 enum class RigKind { kNeato, kAmr, kCloud, kWarehouse };
-
 struct Options {
   std::string map, path, out;
   uint64_t seed = 0;
@@ -576,7 +575,8 @@ int main(int argc, char** argv) {
     pf::sim::FloorWorlds floors = pf::sim::FloorWorlds::load(o.map);
     const bool scene = o.rig == RigKind::kCloud || o.rig == RigKind::kWarehouse;
     if (floors.isBuilding() && (scene || !o.changes.empty())) usage("floors: neato or amr only");
-    pf::OccupancyGrid& world = floors.grids[floors.initial] = worldOf(o, floors.grids[floors.initial]);
+    pf::OccupancyGrid& world = floors.grids[floors.initial];
+    world = worldOf(o, world);
     const pf::sim::PathScript script = pf::sim::loadPathScript(o.path);
     if (const auto error = pf::sim::checkClearance(
             script, world, clearanceRadius(o.rig),

@@ -184,8 +184,8 @@ PathPlayer::PathPlayer(const PathScript& script) : script_(script) {
 void PathPlayer::advance(double dt, DiffDriveRobot* robot, SimRandom* random) {
   // Times below a picosecond are rounding noise from splitting steps.
   constexpr double kEps = 1e-12;
-  while (!finished() && (dt > kEps || script_.motions[next_].teleport ||
-                         !script_.motions[next_].floor.empty())) {
+  while (!finished() &&
+         (dt > kEps || script_.motions[next_].teleport || !script_.motions[next_].floor.empty())) {
     const Motion& m = script_.motions[next_];
     if (!m.floor.empty()) {
       floor_ = m.floor;

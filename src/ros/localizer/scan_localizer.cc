@@ -95,8 +95,9 @@ ScanLocalizer::ReadyMap ScanLocalizer::prepareMap(pf::OccupancyGrid grid,
   return {"", pf::PreparedMap::build(std::move(grid), recipe.filter), info};
 }
 
-std::string ScanLocalizer::setMap(ReadyMap ready) {
+std::string ScanLocalizer::setMap(ReadyMap ready, std::optional<pf::PreparedMap>* replaced) {
   if (!ready.map) return ready.error;
+  if (replaced) *replaced = filter_.releaseMap();
   const bool kept = filter_.setMap(std::move(*ready.map));
   if (!kept) given_map_to_odom_.reset();
   map_info_ = ready.info;

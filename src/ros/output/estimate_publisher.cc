@@ -58,6 +58,13 @@ void EstimatePublisher::publishConfidence(const ScanLocalizer& localizer, const 
   timing.addTo(&array.status.front(), dropped, cap);
   addHypotheses(&array.status.front(), hypotheses);
   addSensors(&array.status.front(), localizer.sensorHealth(), stamp.toSec());
+  if (!floor_.empty()) {
+    diagnostic_msgs::KeyValue floor;
+    floor.key = "floor";
+    floor.value = floor_;
+    array.status.front().values.insert(array.status.front().values.begin(), floor);
+    array.status.front().message += " on floor " + floor_;
+  }
   diagnostics_pub_.publish(array);
   status_pub_.publish(array.status.front());
   publishMapChanges(localizer, stamp);

@@ -20,7 +20,8 @@ class FloorsFileTest : public ::testing::Test {
     dir_ = fs::path(::testing::TempDir()) / "pf_floors_file_test" / info->name();
     fs::remove_all(dir_);
     fs::create_directories(dir_ / "maps");
-    for (const char* map : {"maps/a.yaml", "maps/b.yaml"}) std::ofstream(dir_ / map) << "image: x\n";
+    for (const char* map : {"maps/a.yaml", "maps/b.yaml"})
+      std::ofstream(dir_ / map) << "image: x\n";
   }
   std::string write(const std::string& text) {
     const fs::path p = dir_ / "floors.yaml";
@@ -40,9 +41,9 @@ class FloorsFileTest : public ::testing::Test {
 };
 
 TEST_F(FloorsFileTest, ReadsTheFloorsWithTheirMapsBesideTheFile) {
-  const FloorsFile f = loadFloorsFile(write(
-      "floors:\n  - {name: ground, map: maps/a.yaml}\n  - {name: upper, map: maps/b.yaml}\n"
-      "initial_floor: upper\n"));
+  const FloorsFile f = loadFloorsFile(
+      write("floors:\n  - {name: ground, map: maps/a.yaml}\n  - {name: upper, map: maps/b.yaml}\n"
+            "initial_floor: upper\n"));
   ASSERT_EQ(2u, f.floors.size());
   EXPECT_EQ("ground", f.floors[0].name);
   EXPECT_EQ((dir_ / "maps/a.yaml").string(), f.floors[0].map);
@@ -69,8 +70,9 @@ TEST_F(FloorsFileTest, SaysWhatIsWrong) {
   EXPECT_NE(std::string::npos, errorOf("floors: [\n").find("not YAML"));
   EXPECT_NE(std::string::npos,
             errorOf("floors:\n  - {map: maps/a.yaml}\n").find("floor 1: needs a non-empty 'name'"));
-  EXPECT_NE(std::string::npos, errorOf("floors:\n  - {name: a, map: maps/a.yaml}\n  - x\n")
-                                   .find("floor 2: must be a map"));
+  EXPECT_NE(
+      std::string::npos,
+      errorOf("floors:\n  - {name: a, map: maps/a.yaml}\n  - x\n").find("floor 2: must be a map"));
   EXPECT_NE(std::string::npos,
             errorOf("floors:\n  - {name: a, map: maps/none.yaml}\n").find("no map file"));
   EXPECT_NE(std::string::npos,

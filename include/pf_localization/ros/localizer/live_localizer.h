@@ -58,6 +58,26 @@ class LiveLocalizer {
   /// map, and `scheduler` lends it only to read what building needs and to
   /// swap the map in (prepared_map.h).
   bool installMap(const nav_msgs::OccupancyGrid& map, UpdateScheduler& scheduler);
+  /// installMap's part without the filter's lock: `map` checked and built
+  /// for the filter (ready.error says why it was refused), with the checksum
+  /// a saver or a saved pose will check.
+  struct BuiltMap {
+    ScanLocalizer::ReadyMap ready;
+    std::string signature;
+  };
+  BuiltMap buildMap(const nav_msgs::OccupancyGrid& map, UpdateScheduler& scheduler) const;
+  /// A building's floor (floors.h), with the filter's lock held and in one
+  /// hold of it, so that no update weighs the old floor's particles on the
+  /// new map and map -> odom goes from one floor's to the other's: `built`
+  /// (none: the floor stays) replaces the map, which goes to `*replaced`
+  /// with what its change layer learned; then the filter starts at `pose`
+  /// (moved on by the odometry since its stamp) or, without one, globally
+  /// (a first map without a pose: as installMap's first map). `floor` names
+  /// the floor on pf_status. False when refused (logged): a refused pose
+  /// leaves global localization on the new floor.
+  bool changeFloor(std::optional<BuiltMap> built, const std::string& floor,
+                   const std::optional<geometry_msgs::PoseWithCovarianceStamped>& pose,
+                   std::optional<pf::PreparedMap>* replaced);
   /// Whether a map was installed. Changed only by installMap(), which pf_node
   /// calls from its main spinner; read there without the mutex.
   bool haveMap() const { return have_map_; }
@@ -100,10 +120,11 @@ class LiveLocalizer {
 
  private:
   void logInitialPose() const;
-  // installMap's part with the filter's lock held: `ready`, built from `map`
-  // whose signature (mapSignature) is `signature`, replaces the filter's map.
-  bool install(ScanLocalizer::ReadyMap ready, const nav_msgs::OccupancyGrid& map,
-               const std::string& signature);
+  // installMap's part with the filter's lock held: `built`, from a map
+  // stamped `stamp`, replaces the filter's map (which goes to `replaced`, if
+  // any); `announce`: map -> odom and the estimate go out now.
+  bool install(BuiltMap built, const ros::Time& stamp,
+               std::optional<pf::PreparedMap>* replaced = nullptr, bool announce = true);
   void checkSavedPose(const std::string& map_signature);
   void restartAfterJump(double back_s);
   void applyParticleCap(std::size_t cap);

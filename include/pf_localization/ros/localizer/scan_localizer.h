@@ -89,8 +89,10 @@ class ScanLocalizer {
   static ReadyMap prepareMap(const nav_msgs::OccupancyGrid& map, const MapRecipe& recipe);
   static ReadyMap prepareMap(pf::OccupancyGrid grid, const std::string& frame_id,
                              const MapRecipe& recipe);
-  /// Installs a prepared map as setMap above does; `map.error` when it was refused.
-  std::string setMap(ReadyMap map);
+  /// Installs a prepared map as setMap above does; `map.error` when it was
+  /// refused. `replaced`: where the map it replaces goes, with what its
+  /// change layer learned (ParticleFilter::releaseMap); null: it is dropped.
+  std::string setMap(ReadyMap map, std::optional<pf::PreparedMap>* replaced = nullptr);
 
   /// Re-initialises around a pose given in the global frame, moved on by the
   /// odometry since its stamp (movedByOdometrySince). A pose in another

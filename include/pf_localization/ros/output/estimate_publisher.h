@@ -55,6 +55,11 @@ class EstimatePublisher {
                          const pf::UpdateReport& report, int config_generation,
                          const UpdateTiming& timing, std::uint64_t dropped, std::size_t cap);
 
+  /// The floor of a building the robot is on (floors.h): pf_status and
+  /// /diagnostics name it (a "floor" value, and "on floor NAME" after the
+  /// message); empty, as without a floors file: nothing is added.
+  void setFloor(const std::string& floor) { floor_ = floor; }
+
  private:
   // pf_map_changes when due and the layer learned something since.
   void publishMapChanges(const ScanLocalizer& localizer, const ros::Time& stamp);
@@ -69,6 +74,7 @@ class EstimatePublisher {
   ros::Publisher cloud_pub_, diagnostics_pub_;
   ros::Time last_cloud_stamp_;
   StateChangeLog state_log_;
+  std::string floor_;
 };
 
 }  // namespace pf_ros

@@ -70,6 +70,9 @@ struct LocalizerConfig {
   double max_update_time = 0.0;
   double save_pose_rate = 0.5;  // Hz the estimate is saved to ~initial_pose_*; <= 0: never
   bool first_map_only = false;  // keep the first map; ignore later ones on the map topic
+  // A building's floors file (core/map/floors_file.h): the maps come from it,
+  // not from the map topic, and change_floor moves between them (floors.h).
+  std::string floors_file;
 };
 
 /// config.scan_topics as a list: the words between spaces and commas.

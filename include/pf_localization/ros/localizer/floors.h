@@ -1,0 +1,102 @@
+// A building's floors in pf_node (~floors_file, core/map/floors_file.h):
+// which floor the robot is on (pf_floor, std_msgs/String, latched; and on
+// pf_status), the change_floor service (srv/ChangeFloor.srv: a lift ride,
+// with or without the pose on the new floor), and one prepared map per floor.
+//
+// A floor's map is loaded and prepared (pf::PreparedMap: the distance field,
+// the likelihood tables, the screening's rays, the look-alike places) on the
+// first visit, without the filter's lock, as a map on the map topic is
+// (LiveLocalizer::installMap); the swap then happens in one hold of the lock
+// (LiveLocalizer::changeFloor), so that map -> odom goes straight from one
+// floor's to the other's. The map left behind is kept with what its change
+// layer learned (ParticleFilter::releaseMap): a ride back installs it at
+// once, and the layer goes on where it stopped. Built on first use rather
+// than at start-up: a floor never visited costs neither the seconds nor the
+// memory a prepared map takes (about ten bytes a cell: some 500 MB on a
+// 200 x 600 m floor); a floor visited keeps its map for as long as the node
+// runs (docs/how-it-works/map.md, "A building's floors").
+//
+// Threads: the service runs on pf_node's main spinner, as set_map does; the
+// floors' maps are touched only there and, for the swap, under the filter's
+// lock.
+#pragma once
+
+#include <geometry_msgs/PoseWithCovarianceStamped.h>
+#include <nav_msgs/MapMetaData.h>
+#include <pf_localization/ChangeFloor.h>
+#include <ros/ros.h>
+
+#include <cstddef>
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "pf_localization/core/filter/prepared_map.h"
+#include "pf_localization/core/map/floors_file.h"
+#include "pf_localization/ros/localizer/live_localizer.h"
+#include "pf_localization/ros/scheduling/update_scheduler.h"
+
+namespace pf_ros {
+
+class Floors {
+ public:
+  /// A pose in the global frame, from one in any frame (pf_node: through
+  /// tf); none when it cannot be moved there (warned).
+  using ToGlobal = std::function<std::optional<geometry_msgs::PoseWithCovarianceStamped>(
+      const geometry_msgs::PoseWithCovarianceStamped&)>;
+
+  /// The floors file at `path`; none when it cannot be used (logged as
+  /// fatal: pf_node does not start with a floors file it cannot read).
+  static std::optional<pf::FloorsFile> read(const std::string& path);
+
+  /// `live` and `scheduler` must outlive it. Advertises pf_floor and
+  /// change_floor on `nh`; installs nothing yet (start()).
+  Floors(pf::FloorsFile file, LiveLocalizer* live, UpdateScheduler* scheduler, ToGlobal to_global,
+         ros::NodeHandle& nh);
+
+  /// Installs the initial floor's map, as the first map: the filter starts
+  /// from the configured initial pose, or globally. False when its map cannot
+  /// be loaded (logged; change_floor may still bring another floor's).
+  bool start();
+
+  /// Moves to floor `name`: at `pose` (any frame tf knows), or with global
+  /// localization on it without one. On the current floor only the pose
+  /// changes. Returns what was done, or why not (`ok` false), as the
+  /// service answers.
+  struct Outcome {
+    bool ok = false;
+    std::string message;
+  };
+  Outcome change(const std::string& name,
+                 const std::optional<geometry_msgs::PoseWithCovarianceStamped>& pose);
+
+  /// The current floor's name; empty before start().
+  std::string current() const;
+
+ private:
+  bool onChangeFloor(pf_localization::ChangeFloor::Request& req,
+                     pf_localization::ChangeFloor::Response& res);
+  // Floor `index`'s map built for the filter (loaded and prepared now, or
+  // kept from an earlier visit), or why it cannot be.
+  std::optional<LiveLocalizer::BuiltMap> mapOf(std::size_t index, std::string* error);
+  void publishFloor();
+
+  // A floor's map while another is in use, with what its change layer learned.
+  struct Kept {
+    std::optional<pf::PreparedMap> map;
+    nav_msgs::MapMetaData info;
+    std::string signature;
+  };
+
+  const pf::FloorsFile file_;
+  LiveLocalizer* live_;
+  UpdateScheduler* scheduler_;
+  ToGlobal to_global_;
+  std::vector<Kept> kept_;              // one per floor
+  std::optional<std::size_t> current_;  // the floor whose map the filter has
+  ros::Publisher floor_pub_;
+  ros::ServiceServer service_;
+};
+
+}  // namespace pf_ros
