@@ -67,6 +67,15 @@ void waitWall(double seconds) {
   }
 }
 
+// ~delay, 0 when it is not a non-negative number of seconds (warned).
+double readDelay(const ros::NodeHandle& pnh) {
+  const double delay = pnh.param("delay", 0.0);
+  if (delay >= 0.0 && std::isfinite(delay)) return delay;
+  ROS_WARN("map_publisher: ~delay must be a non-negative number of seconds, got %g; using 0",
+           delay);
+  return 0.0;
+}
+
 // The maps to offer: one, or every floor's (`names` then gives their names),
 // and the index of the one offered first. Throws pf::MapLoadError or
 // pf::FloorsFileError.
@@ -126,12 +135,7 @@ int main(int argc, char** argv) {
     return 2;
   }
   const std::string frame_id = pnh.param<std::string>("frame_id", "map");
-  double delay = pnh.param("delay", 0.0);
-  if (!(delay >= 0.0) || !std::isfinite(delay)) {
-    ROS_WARN("map_publisher: ~delay must be a non-negative number of seconds, got %g; using 0",
-             delay);
-    delay = 0.0;
-  }
+  const double delay = readDelay(pnh);
 
   Maps maps;
   try {

@@ -94,8 +94,7 @@ PathScript parsePathScript(std::istream& in, const std::string& file) {
       pose = {a[0], a[1], normalizeAngle(a[2])};
       script.motions.push_back({true, 0.0, 0.0, 0.0, pose, line, {}});
     } else if (cmd == "floor") {
-      if (words.size() != 2) p.fail("expected 'floor NAME'");
-      script.motions.push_back({false, 0.0, 0.0, 0.0, {}, line, words[1]});
+      script.motions.push_back({false, 0.0, 0.0, 0.0, {}, line, p.word("floor NAME")});
     } else if (cmd == "person") {
       const auto a = p.numbers(5, "person x1 y1 x2 y2 speed");
       if (a[4] < 0.0) p.fail("person speed must not be negative");
