@@ -39,9 +39,9 @@
 namespace pf {
 
 struct FloorSearchParams {
-  int found_updates = 5;         // updates in a row localized on the floor found
-  int fit_updates = 5;           // a floor's fit: averaged over this many updates
-  double fit_distance = 0.1;     // m: a beam ending this close to an obstacle is explained
+  int found_updates = 5;        // updates in a row localized on the floor found
+  int fit_updates = 5;          // a floor's fit: averaged over this many updates
+  double fit_distance = 0.1;    // m: a beam ending this close to an obstacle is explained
   double min_fit_margin = 0.1;  // the floor found explains this share more than every other
 };
 
