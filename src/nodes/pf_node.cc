@@ -167,7 +167,9 @@ class PfNode {
     return true;
   }
 
+  // With a building's floors, on every floor (floors.h), and meanwhile on the current one.
   bool onGlobalLocalization(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+    if (floors_) floors_->search();
     return scheduler_->withFilter([&] { return live_->startGlobalLocalization(); });
   }
 

@@ -32,6 +32,11 @@ Watches, while the bag plays (from the first to the last /ground_truth):
     /ground_truth pose; the call must succeed, every tracking error from
     ride_settle [s, default 2] after the ride at most ride_max_error [m],
     and pf_floor name the floor of the last ride;
+  - global localization on every floor, when asked (global_at [s of sim time
+    after the first ground truth], global_floor: the floor the robot is on):
+    /global_localization called once; pf_floor must then name global_floor,
+    and never another floor, and from ride_settle after it names it every
+    error must be at most ride_max_error;
 and that pf_node is alive at the end. Every figure is printed (rostest --text,
 or the XML result's <system-out>) whether the test passes or not.
 
@@ -44,7 +49,8 @@ Params (all optional; unset: only reported):
   min_dropped_scans, max_scan_age_p95_ms, max_rss_growth_mb, rss_after [s],
   rmse_below [m], start_after [s, default 5], min_samples (default 50),
   idle_timeout [s wall, default 8], wall_timeout [s wall, default 150],
-  pf_node (default /pf_node), ride_topic, ride_settle [s], ride_max_error [m].
+  pf_node (default /pf_node), ride_topic, ride_settle [s], ride_max_error [m],
+  global_at [s], global_floor.
 """
 
 import math
@@ -64,6 +70,7 @@ from nav_msgs.msg import OccupancyGrid
 from nav_msgs.srv import SetMap
 from pf_localization.srv import ChangeFloor
 from std_msgs.msg import String
+from std_srvs.srv import Empty
 from rosgraph_msgs.msg import Log
 from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
@@ -195,6 +202,7 @@ class OverloadChecker:
                     self.rss.append((t_rel, mb))
             if first is not None:
                 self.swaps.when_due(rospy.Time.now().to_sec() - first)
+                self.rides.when_due(rospy.Time.now().to_sec() - first)
             if last_wall is not None and time.time() - last_wall > idle:
                 break
         self._compare(flush=True)
@@ -387,18 +395,29 @@ class FloorRides:
 
     def __init__(self):
         self.topic = opt('ride_topic')
+        self.global_at, self.global_floor = opt('global_at'), opt('global_floor')
+        self.global_called = None  # sim s of the global_localization call
+        self.floors_named = []     # (sim s, floor) of every pf_floor after it
         self.truth = None      # the latest /ground_truth
         self.floor = None      # the bag's floor
         self.rides = []        # (sim s, floor, wall s the call took, success, message)
         self.pf_floor = None   # the last pf_floor
         self.threads = []
-        if self.topic is None:
-            return
-        rospy.Subscriber(self.topic, String, self._on_floor, queue_size=10)
-        rospy.Subscriber('/pf_floor', String, self._on_pf_floor, queue_size=10)
+        if self.topic is not None:
+            rospy.Subscriber(self.topic, String, self._on_floor, queue_size=10)
+        if self.topic is not None or self.global_at is not None:
+            rospy.Subscriber('/pf_floor', String, self._on_pf_floor, queue_size=10)
 
     def _on_pf_floor(self, msg):
         self.pf_floor = msg.data
+        if self.global_called is not None:
+            self.floors_named.append((rospy.Time.now().to_sec(), msg.data))
+
+    def when_due(self, t):
+        if self.global_at is None or self.global_called is not None or t < float(self.global_at):
+            return
+        self.global_called = rospy.Time.now().to_sec()
+        rospy.ServiceProxy('/global_localization', Empty)()
 
     def _on_floor(self, msg):
         first, self.floor = self.floor is None, msg.data
@@ -422,6 +441,7 @@ class FloorRides:
         self.rides.append((t, msg.data, time.time() - start, res.success, res.message))
 
     def evaluate(self, info, failures, errors, first_gt):
+        self._evaluate_global(info, failures, errors, first_gt)
         if self.topic is None:
             return
         for thread in self.threads:
@@ -446,6 +466,33 @@ class FloorRides:
         info.append('pf_floor: %s' % self.pf_floor)
         if self.pf_floor != self.rides[-1][1]:
             failures.append('pf_floor is %s, not %s' % (self.pf_floor, self.rides[-1][1]))
+
+
+    def _evaluate_global(self, info, failures, errors, first_gt):
+        if self.global_at is None:
+            return
+        if self.global_called is None:
+            failures.append('global_localization was never called')
+            return
+        named = [(t, f) for t, f in self.floors_named if f]
+        info.append('global localization on every floor at t=%.1f s; pf_floor then: %s' %
+                    (self.global_called - first_gt,
+                     ', '.join('%s at t=%.1f s' % (f, t - first_gt) for t, f in named) or 'none'))
+        wrong = [f for _, f in named if f != self.global_floor]
+        if wrong:
+            failures.append('pf_floor named %s, not %s' % (wrong[0], self.global_floor))
+        if not named:
+            failures.append('no floor found (pf_floor stayed empty)')
+            return
+        t_rel = named[0][0] - first_gt
+        after = [e for e in errors if e[0] >= t_rel + float(opt('ride_settle', 2.0))]
+        worst = max(after, key=lambda e: e[1]) if after else (float('nan'), float('nan'), 0.0)
+        info.append('from %.0f s after it was found, %d samples, max error %.3f m at t=%.1f s' %
+                    (float(opt('ride_settle', 2.0)), len(after), worst[1], worst[0]))
+        bound = opt('ride_max_error')
+        if bound is not None and not (after and worst[1] <= float(bound)):
+            failures.append('after the floor was found: error %.3f m > ride_max_error %s m' %
+                            (worst[1], bound))
 
 
 class OverloadCheckerTest(unittest.TestCase):

@@ -25,8 +25,8 @@ double explainedShare(const DistanceField& field, const ScanGroup& scans, const 
 }
 
 FloorSearch::FloorSearch(const ParticleFilterParams& params, std::vector<PreparedMap> maps,
-                         FloorSearchParams search)
-    : params_(search) {
+                         std::vector<std::string> names, FloorSearchParams search)
+    : params_(search), names_(std::move(names)) {
   if (maps.empty()) throw std::invalid_argument("floor search: no floor");
   for (PreparedMap& map : maps) {
     filters_.push_back(std::make_unique<ParticleFilter>(params));
@@ -58,31 +58,32 @@ double FloorSearch::fit(std::size_t floor) const {
   return fits.empty() ? 0.0 : sum / static_cast<double>(fits.size());
 }
 
+std::string FloorSearch::nameOf(std::size_t floor) const {
+  return floor < names_.size() ? "floor '" + names_[floor] + "'" : "floor " + std::to_string(floor);
+}
+
 FloorSearch::Verdict FloorSearch::verdict() const {
   std::size_t best = 0;  // the floor that explains the scans best
   for (std::size_t i = 1; i < filters_.size(); ++i) {
     if (fit(i) > fit(best)) best = i;
   }
-  char text[160];
   for (std::size_t i = 0; i < filters_.size(); ++i) {
     if (i == best || fit(best) - fit(i) >= params_.min_fit_margin) continue;
-    std::snprintf(text, sizeof text,
-                  "floor %zu explains %.0f %% of the beams, floor %zu %.0f %%: cannot tell them "
-                  "apart yet",
-                  best, 100.0 * fit(best), i, 100.0 * fit(i));
-    return {std::nullopt, text};
+    char shares[64];
+    std::snprintf(shares, sizeof shares, " %.0f %% of the beams, ", 100.0 * fit(best));
+    std::string reason = nameOf(best) + " explains" + shares + nameOf(i);
+    std::snprintf(shares, sizeof shares, " %.0f %%: cannot tell them apart yet", 100.0 * fit(i));
+    return {std::nullopt, reason + shares};
   }
   if (localized_run_[best] == 0) {
-    std::snprintf(text, sizeof text, "floor %zu explains the scans best, but is not localized yet",
-                  best);
-    return {std::nullopt, text};
+    return {std::nullopt, nameOf(best) + " explains the scans best, but is not localized yet"};
   }
   if (localized_run_[best] < params_.found_updates) {
-    return {std::nullopt, "floor " + std::to_string(best) + " fits; waiting for " +
+    return {std::nullopt, nameOf(best) + " fits; waiting for " +
                               std::to_string(params_.found_updates - localized_run_[best]) +
                               " more updates"};
   }
-  return {best, "floor " + std::to_string(best) + " fits, and no other does"};
+  return {best, nameOf(best) + " fits, and no other does"};
 }
 
 std::vector<PreparedMap> FloorSearch::release() {

@@ -8,6 +8,11 @@
 #include "pf_localization/ros/input/conversions.h"
 
 namespace pf_ros {
+namespace {
+
+constexpr double kSearchPeriod = 0.2;  // s of wall time between two looks at the search's verdict
+
+}  // namespace
 
 std::optional<pf::FloorsFile> Floors::read(const std::string& path) {
   try {
@@ -29,7 +34,10 @@ Floors::Floors(pf::FloorsFile file, LiveLocalizer* live, UpdateScheduler* schedu
       to_global_(std::move(to_global)),
       kept_(file_.floors.size()),
       floor_pub_(nh.advertise<std_msgs::String>("pf_floor", 1, true)),
-      service_(nh.advertiseService("change_floor", &Floors::onChangeFloor, this)) {}
+      service_(nh.advertiseService("change_floor", &Floors::onChangeFloor, this)),
+      search_timer_(nh.createWallTimer(
+          ros::WallDuration(kSearchPeriod), [this](const ros::WallTimerEvent&) { checkSearch(); },
+          false, false)) {}
 
 bool Floors::start() {
   const Outcome outcome = change(file_.floors[file_.initial].name, std::nullopt);
@@ -37,7 +45,9 @@ bool Floors::start() {
   return outcome.ok;
 }
 
-std::string Floors::current() const { return current_ ? file_.floors[*current_].name : ""; }
+std::string Floors::current() const {
+  return current_ && !search_ ? file_.floors[*current_].name : "";
+}
 
 Floors::Outcome Floors::change(
     const std::string& name, const std::optional<geometry_msgs::PoseWithCovarianceStamped>& pose) {
@@ -50,10 +60,21 @@ Floors::Outcome Floors::change(
     global = to_global_(given);
     if (!global) return {false, "the pose's frame '" + given.header.frame_id + "' is not in tf"};
   }
+  if (search_) {  // a floor given ends a search of every floor
+    search_timer_.stop();
+    scheduler_->withFilter([&] { stopSearch(); });
+    ROS_INFO("pf_node: the search of every floor ends: change_floor names the floor");
+  }
+  return moveTo(*index, global);
+}
+
+Floors::Outcome Floors::moveTo(
+    std::size_t index, const std::optional<geometry_msgs::PoseWithCovarianceStamped>& global) {
+  const std::string& name = file_.floors[index].name;
   std::optional<LiveLocalizer::BuiltMap> built;
   if (index != current_) {
     std::string error;
-    built = mapOf(*index, &error);
+    built = mapOf(index, &error);
     if (!built) return {false, "floor '" + name + "': " + error};
   }
   std::optional<pf::PreparedMap> replaced;
@@ -64,11 +85,11 @@ Floors::Outcome Floors::change(
   if (swaps) {
     if (current_) kept_[*current_].map = std::move(replaced);
     current_ = index;
-    publishFloor();
   }
+  publishFloor();
   const std::string where = "on floor '" + name + "'";
   if (!ok) return {false, where + ", but the pose was refused (logged): global localization"};
-  return {true, where + (pose ? ", at the pose given" : ": global localization")};
+  return {true, where + (global ? ", at the pose given" : ": global localization")};
 }
 
 std::optional<LiveLocalizer::BuiltMap> Floors::mapOf(std::size_t index, std::string* error) {
@@ -105,6 +126,79 @@ void Floors::publishFloor() {
   std_msgs::String msg;
   msg.data = current();
   floor_pub_.publish(msg);
+}
+
+bool Floors::search() {
+  // Every floor's map afresh: the kept ones' change layers stay out of
+  // filters that may be on the wrong floor.
+  std::vector<pf::PreparedMap> maps;
+  for (const pf::Floor& floor : file_.floors) {
+    std::string error;
+    try {
+      nav_msgs::OccupancyGrid map = toMsg(pf::loadMap(floor.map));
+      LiveLocalizer::BuiltMap built = live_->buildMap(map, *scheduler_);
+      error = built.ready.error;
+      if (built.ready.map) maps.push_back(std::move(*built.ready.map));
+    } catch (const pf::MapLoadError& e) {
+      error = e.what();
+    }
+    if (!error.empty()) {
+      ROS_ERROR("pf_node: no search of every floor: floor '%s': %s", floor.name.c_str(),
+                error.c_str());
+      return false;
+    }
+  }
+  scheduler_->withFilter([&] {
+    stopSearch();  // one running starts over
+    std::vector<std::string> names;
+    for (const pf::Floor& floor : file_.floors) names.push_back(floor.name);
+    search_ = std::make_unique<pf::FloorSearch>(live_->filterParams(), std::move(maps), names);
+    live_->observeUpdates(
+        [this](const pf::Pose2& odom, const pf::ScanGroup& scans, const ros::Time& stamp) {
+          search_->update(odom, scans);
+          search_stamp_ = stamp;
+        });
+    live_->showFloor("unknown", true);
+  });
+  std_msgs::String unknown;  // empty: no floor
+  floor_pub_.publish(unknown);
+  search_reason_.clear();
+  search_timer_.start();
+  ROS_INFO("pf_node: global localization on every floor (%s)", file_.names().c_str());
+  return true;
+}
+
+void Floors::stopSearch() {
+  live_->observeUpdates({});
+  search_.reset();
+}
+
+void Floors::checkSearch() {
+  if (!search_) return;
+  pf::FloorSearch::Verdict verdict;
+  std::optional<geometry_msgs::PoseWithCovarianceStamped> pose;
+  scheduler_->withFilter([&] {
+    verdict = search_->verdict();
+    if (!verdict.floor) return;
+    // Where the robot is on that floor: its search's estimate at the last
+    // update, moved on by the odometry since (setInitialPose).
+    const pf::ParticleFilter& found = search_->filter(*verdict.floor);
+    pose.emplace();
+    pose->header.stamp = search_stamp_;
+    pose->header.frame_id = live_->globalFrame();
+    pose->pose.pose = toPoseMsg(found.estimate().pose);
+    pose->pose.covariance = toRosCovariance(found.confidence().covariance);
+    stopSearch();
+  });
+  if (verdict.reason != search_reason_) {
+    ROS_INFO("pf_node: the search of every floor: %s", verdict.reason.c_str());
+    search_reason_ = verdict.reason;
+  }
+  if (!verdict.floor) return;
+  search_timer_.stop();
+  const Outcome outcome = moveTo(*verdict.floor, pose);
+  ROS_INFO("pf_node: the search of every floor found floor '%s': %s",
+           file_.floors[*verdict.floor].name.c_str(), outcome.message.c_str());
 }
 
 bool Floors::onChangeFloor(pf_localization::ChangeFloor::Request& req,

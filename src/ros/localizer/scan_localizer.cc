@@ -273,6 +273,7 @@ void ScanLocalizer::update(pf::LaserScan scan, std::size_t sensor, const ros::Ti
     group_.back().robot_offset = pf::between(*result->odom, s->odom);
   }
   result->report = filter_.update(*result->odom, group_);
+  if (observer_) observer_(*result->odom, group_, stamp);
   if (latest_.size() > 1) observeHealth(group_.front(), sensor, stamp);
   latest_[sensor] = SensorScan{std::move(group_.front()), *result->odom, stamp, false};
   if (result->report.updated) {

@@ -4,6 +4,8 @@
 #include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 
+#include <algorithm>
+
 #include "pf_localization/ros/diagnostics/diagnostic_status.h"
 #include "pf_localization/ros/input/conversions.h"
 
@@ -64,6 +66,11 @@ void EstimatePublisher::publishConfidence(const ScanLocalizer& localizer, const 
     floor.value = floor_;
     array.status.front().values.insert(array.status.front().values.begin(), floor);
     array.status.front().message += " on floor " + floor_;
+  }
+  if (searching_) {
+    diagnostic_msgs::DiagnosticStatus& s = array.status.front();
+    s.level = std::max<std::uint8_t>(s.level, diagnostic_msgs::DiagnosticStatus::WARN);
+    s.message = "searching every floor: " + s.message;
   }
   diagnostics_pub_.publish(array);
   status_pub_.publish(array.status.front());

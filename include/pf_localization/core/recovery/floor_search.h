@@ -53,10 +53,11 @@ double explainedShare(const DistanceField& field, const ScanGroup& scans, const 
 class FloorSearch {
  public:
   /// `maps[i]`: floor i's map, moved into floor i's filter (release()
-  /// hands them back). Each filter has `params`; starts them globally.
-  /// Throws std::invalid_argument for no map or invalid parameters.
+  /// hands them back), `names[i]` its name in the verdict's reason (none:
+  /// "floor i"). Each filter has `params`; starts them globally. Throws
+  /// std::invalid_argument for no map or invalid parameters.
   FloorSearch(const ParticleFilterParams& params, std::vector<PreparedMap> maps,
-              FloorSearchParams search = {});
+              std::vector<std::string> names = {}, FloorSearchParams search = {});
 
   /// One scan (or group of scans) at odometry pose `odom`: every floor's
   /// filter updates.
@@ -77,7 +78,11 @@ class FloorSearch {
   std::vector<PreparedMap> release();
 
  private:
+  // Floor `floor`'s name for the reasons.
+  std::string nameOf(std::size_t floor) const;
+
   FloorSearchParams params_;
+  std::vector<std::string> names_;
   std::vector<std::unique_ptr<ParticleFilter>> filters_;
   std::vector<int> localized_run_;         // per floor: updates in a row localized
   std::vector<std::vector<double>> fits_;  // per floor: the last updates' explained shares

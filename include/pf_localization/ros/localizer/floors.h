@@ -16,9 +16,23 @@
 // 200 x 600 m floor); a floor visited keeps its map for as long as the node
 // runs (docs/how-it-works/map.md, "A building's floors").
 //
-// Threads: the service runs on pf_node's main spinner, as set_map does; the
-// floors' maps are touched only there and, for the swap, under the filter's
-// lock.
+// Global localization without a floor (pf_node's global_localization with a
+// floors file) searches every floor (core/recovery/floor_search.h): each
+// floor's map is built afresh for the search (the kept ones, and their change
+// layers, are not touched by filters that may be on the wrong floor; the
+// search holds every floor's map once more while it runs), the search's
+// filters follow the filter's own scans (ScanLocalizer::observeUpdates), and
+// a timer on the main spinner reads the verdict: when a floor is found, the
+// robot moves there at the search's estimate, as change_floor would do, and
+// pf_floor names it. Until then pf_floor is empty, and pf_status, whose floor
+// is "unknown", is at least a warning led by "searching every floor: ": the
+// filter itself runs global localization on the floor it was on meanwhile,
+// and its verdict is about that floor's map.
+//
+// Threads: the services and the timer run on pf_node's main spinner, as
+// set_map does; the floors' maps are touched only there and, for the swap,
+// under the filter's lock; the search updates under the lock, on the
+// filter's thread.
 #pragma once
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
@@ -28,12 +42,14 @@
 
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "pf_localization/core/filter/prepared_map.h"
 #include "pf_localization/core/map/floors_file.h"
+#include "pf_localization/core/recovery/floor_search.h"
 #include "pf_localization/ros/localizer/live_localizer.h"
 #include "pf_localization/ros/scheduling/update_scheduler.h"
 
@@ -71,16 +87,29 @@ class Floors {
   Outcome change(const std::string& name,
                  const std::optional<geometry_msgs::PoseWithCovarianceStamped>& pose);
 
-  /// The current floor's name; empty before start().
+  /// Starts a search of every floor (global_localization without a floor):
+  /// false when a floor's map cannot be built (logged), and the filter's own
+  /// global localization on the current floor then goes on alone.
+  bool search();
+
+  /// The current floor's name; empty before start() and during a search.
   std::string current() const;
 
  private:
   bool onChangeFloor(pf_localization::ChangeFloor::Request& req,
                      pf_localization::ChangeFloor::Response& res);
+  // change()'s work, `pose` in the global frame already.
+  Outcome moveTo(std::size_t index,
+                 const std::optional<geometry_msgs::PoseWithCovarianceStamped>& pose);
   // Floor `index`'s map built for the filter (loaded and prepared now, or
   // kept from an earlier visit), or why it cannot be.
   std::optional<LiveLocalizer::BuiltMap> mapOf(std::size_t index, std::string* error);
   void publishFloor();
+  // The search's verdict, every kSearchPeriod on the main spinner: a floor
+  // found ends the search there.
+  void checkSearch();
+  // Ends the search, with the filter's lock held: the search's maps dropped.
+  void stopSearch();
 
   // A floor's map while another is in use, with what its change layer learned.
   struct Kept {
@@ -97,6 +126,10 @@ class Floors {
   std::optional<std::size_t> current_;  // the floor whose map the filter has
   ros::Publisher floor_pub_;
   ros::ServiceServer service_;
+  std::unique_ptr<pf::FloorSearch> search_;  // while a search of every floor runs
+  ros::Time search_stamp_;                   // of the last update the search followed
+  std::string search_reason_;                // its last verdict's, as logged
+  ros::WallTimer search_timer_;
 };
 
 }  // namespace pf_ros

@@ -82,6 +82,16 @@ class LiveLocalizer {
   /// calls from its main spinner; read there without the mutex.
   bool haveMap() const { return have_map_; }
 
+  /// For a search of every floor (floors.h), with the filter's lock held:
+  /// the filter's live parameters, every update's odometry and scans
+  /// (ScanLocalizer::observeUpdates), and the floor pf_status names.
+  const pf::ParticleFilterParams& filterParams() const { return localizer_.filter().params(); }
+  void observeUpdates(ScanLocalizer::UpdateObserver observer) {
+    localizer_.observeUpdates(std::move(observer));
+  }
+  void showFloor(const std::string& floor, bool searching) { output_.setFloor(floor, searching); }
+  const std::string& globalFrame() const { return config_.global_frame; }
+
   /// Re-initialises at `pose`, in the global frame. False when refused (warned).
   bool setInitialPose(const geometry_msgs::PoseWithCovarianceStamped& pose);
   bool startGlobalLocalization();
