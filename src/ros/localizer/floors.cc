@@ -39,6 +39,11 @@ Floors::Floors(pf::FloorsFile file, LiveLocalizer* live, UpdateScheduler* schedu
           ros::WallDuration(kSearchPeriod), [this](const ros::WallTimerEvent&) { checkSearch(); },
           false, false)) {}
 
+Floors::~Floors() {
+  search_timer_.stop();
+  if (search_) scheduler_->withFilter([&] { stopSearch(); });
+}
+
 bool Floors::start() {
   const Outcome outcome = change(file_.floors[file_.initial].name, std::nullopt);
   if (!outcome.ok) ROS_ERROR("pf_node: %s", outcome.message.c_str());

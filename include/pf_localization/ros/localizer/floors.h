@@ -70,6 +70,10 @@ class Floors {
   /// change_floor on `nh`; installs nothing yet (start()).
   Floors(pf::FloorsFile file, LiveLocalizer* live, UpdateScheduler* scheduler, ToGlobal to_global,
          ros::NodeHandle& nh);
+  /// Ends a search still running: the filter's updates stop feeding it.
+  ~Floors();
+  Floors(const Floors&) = delete;
+  Floors& operator=(const Floors&) = delete;
 
   /// Installs the initial floor's map, as the first map: the filter starts
   /// from the configured initial pose, or globally. False when its map cannot

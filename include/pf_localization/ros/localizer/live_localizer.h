@@ -7,11 +7,12 @@
 // saved by an earlier run on the first map (saved_pose.h).
 //
 // Threads (docs/ros-interface.md, "Threads, latency and overload"): every
-// method but saver(), haveMap() and installMap() must be called with the
-// filter's lock held (UpdateScheduler); an update holds it whole (on the
-// filter thread, or on roscpp's poll thread when it is short), the main
-// spinner's callbacks that touch the filter wait for it; installMap() takes
-// it itself, only around the swap of a map it built without it. What runs at a steady rate never
+// method but saver(), haveMap(), installMap() and buildMap() must be called
+// with the filter's lock held (UpdateScheduler); an update holds it whole (on
+// the filter thread, or on roscpp's poll thread when it is short), the main
+// spinner's callbacks that touch the filter wait for it; installMap() and
+// buildMap() take it themselves, only to read the recipe and, for
+// installMap(), around the swap of a map built without it. What runs at a steady rate never
 // does: the republisher and the saver get their data under small locks of their own.
 #pragma once
 
