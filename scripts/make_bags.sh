@@ -47,7 +47,8 @@ bags="tracking           building  1
       changed_20         building  15
       changed_30         building  16
       crowd_changed      building  17
-      warehouse_changed  warehouse 18    --rig warehouse --scan-period 0.2"
+      warehouse_changed  warehouse 18    --rig warehouse --scan-period 0.2
+      floors             building_floors 19"
 # The bags' path scripts are bags/BAG.path, but for these, which share one.
 path_of() {
   case "$1" in
@@ -135,6 +136,7 @@ if $check; then
   status=0
   for f in maps/building.yaml maps/building.pgm maps/small.yaml maps/small.pgm \
            maps/corridor.yaml maps/corridor.pgm maps/warehouse.yaml maps/warehouse.pgm \
+           maps/building_upper.yaml maps/building_upper.pgm maps/building_floors.yaml \
            $(awk '{print "bags/" $1 ".bag"}' <<<"$bags") \
            $(while read -r bag _; do changes_of "$bag"; done <<<"$bags" | sort -u |
                awk '{print "bags/" $1 "_mask.yaml bags/" $1 "_mask.pgm"}'); do

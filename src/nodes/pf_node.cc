@@ -6,7 +6,8 @@
 // update runs, and the filter's lock), LiveLocalizer (the filter and what goes
 // with it: time jumping back, the saved pose, pf_pose, amcl_pose,
 // particlecloud, the map's changes and clear_map_changes), MapToOdomRepublisher
-// (map -> odom on tf), ReconfigureServer.
+// (map -> odom on tf), ReconfigureServer, and with ~floors_file Floors (the
+// maps of a building's floors, change_floor).
 //
 // Threads (docs/ros-interface.md, "Threads, latency and overload"): tf, the
 // scans, short updates and map -> odom's timer or /clock on roscpp's poll
@@ -27,6 +28,7 @@
 #include "pf_localization/ros/input/pose_transform.h"
 #include "pf_localization/ros/input/scan_inputs.h"
 #include "pf_localization/ros/input/tf_input.h"
+#include "pf_localization/ros/localizer/floors.h"
 #include "pf_localization/ros/localizer/live_localizer.h"
 #include "pf_localization/ros/output/map_to_odom_republisher.h"
 #include "pf_localization/ros/params/parameter_docs.h"
@@ -46,8 +48,8 @@ volatile std::sig_atomic_t g_node_running = 0;
 class PfNode {
  public:
   // `saved`: config.initial_pose was saved by an earlier run (readSavedPose()).
-  PfNode(const LocalizerConfig& config, std::optional<SavedPoseMap> saved, ros::NodeHandle nh,
-         ros::NodeHandle pnh)
+  PfNode(const LocalizerConfig& config, std::optional<SavedPoseMap> saved,
+         std::optional<pf::FloorsFile> floors, ros::NodeHandle nh, ros::NodeHandle pnh)
       : config_(config) {
     tf_ = std::make_unique<TfInput>(nh);
     republisher_ = std::make_unique<MapToOdomRepublisher>(
@@ -97,11 +99,21 @@ class PfNode {
             scheduler_->withFilter([&] { live_->scanDropped(header, reason); });
           });
         });
+    if (floors) {
+      floors_ = std::make_unique<Floors>(
+          std::move(*floors), live_.get(), scheduler_.get(),
+          [this](const auto& pose) {
+            return initialPoseInFrame(tf_->buffer(), pose, config_.global_frame, &warn_);
+          },
+          nh);
+      floors_->start();
+    }
     scans_->subscribe(nh);  // last: their callbacks may run at once, on the poll thread
   }
 
   // First what brings scans, then the filter thread, then what its updates use.
   ~PfNode() {
+    floors_.reset();
     scans_.reset();
     ros::getGlobalCallbackQueue()->removeByID(reinterpret_cast<uint64_t>(this));
     scheduler_->stop();
@@ -128,10 +140,10 @@ class PfNode {
 
  private:
   void onMap(const nav_msgs::OccupancyGridConstPtr& msg) {
-    if (config_.first_map_only && live_->haveMap()) {
+    if (floors_ || (config_.first_map_only && live_->haveMap())) {
       if (warn_.due("first_map_only")) {
-        ROS_INFO("pf_node: first_map_only: ignoring a new map on %s (set_map still replaces it)",
-                 map_sub_.getTopic().c_str());
+        ROS_INFO("pf_node: %s: ignoring a new map on %s",
+                 floors_ ? "floors_file" : "first_map_only", map_sub_.getTopic().c_str());
       }
       return;
     }
@@ -150,11 +162,15 @@ class PfNode {
   // installed even when first_map_only is set, which guards against map topic updates only.
   bool onSetMap(nav_msgs::SetMap::Request& req, nav_msgs::SetMap::Response& res) {
     if (req.initial_pose.header.stamp.isZero()) req.initial_pose.header.stamp = ros::Time::now();
-    res.success = live_->installMap(req.map, *scheduler_) && applyInitialPose(req.initial_pose);
+    if (floors_) ROS_WARN("pf_node: set_map refused: the maps are floors_file's (change_floor)");
+    res.success =
+        !floors_ && live_->installMap(req.map, *scheduler_) && applyInitialPose(req.initial_pose);
     return true;
   }
 
+  // With a building's floors, on every floor (floors.h), and meanwhile on the current one.
   bool onGlobalLocalization(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
+    if (floors_) floors_->search();
     return scheduler_->withFilter([&] { return live_->startGlobalLocalization(); });
   }
 
@@ -178,6 +194,7 @@ class PfNode {
   std::unique_ptr<OdometryInput> odometry_;
   std::unique_ptr<ReconfigureServer> reconfigure_;
   std::unique_ptr<ScanInputs> scans_;
+  std::unique_ptr<Floors> floors_;  // with ~floors_file only
   ros::Subscriber map_sub_, initial_pose_sub_;
   std::vector<ros::ServiceServer> services_;
 };
@@ -198,7 +215,10 @@ int main(int argc, char** argv) {
   ros::NodeHandle nh, pnh("~");
   const std::optional<pf_ros::LocalizerConfig> config = pf_ros::readNodeConfig(pnh);
   if (!config) return 1;
-  pf_ros::PfNode node(*config, pf_ros::readSavedPose(pnh, *config), nh, pnh);
+  std::optional<pf::FloorsFile> floors;
+  if (!config->floors_file.empty() && !(floors = pf_ros::Floors::read(config->floors_file)))
+    return 1;
+  pf_ros::PfNode node(*config, pf_ros::readSavedPose(pnh, *config), std::move(floors), nh, pnh);
   pf_ros::g_node_running = 1;
   node.spin();
   return 0;

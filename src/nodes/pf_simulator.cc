@@ -45,6 +45,9 @@
 // depends on nothing but the map, the script, the seed and the options: the
 // same inputs give the same bytes.
 //
+// --map may name a floors file (floors_file.h; neato, amr rigs): a script's `floor NAME` (a
+// lift ride) shows the sensors that floor's map; /floor (std_msgs/String) names it, and the first.
+//
 // --changes FILE makes the world differ from the map (map_changes.h): every
 // sensor of every rig looks at the changed world (the 3D worlds' walls
 // included), the path must keep clear of it, and the changed share is
@@ -60,6 +63,7 @@
 #include <sensor_msgs/LaserScan.h>
 #include <sensor_msgs/PointCloud2.h>
 #include <sensor_msgs/PointField.h>
+#include <std_msgs/String.h>
 #include <tf2_msgs/TFMessage.h>
 
 #include <algorithm>
@@ -79,6 +83,7 @@
 #include "pf_localization/sim/amr_rig.h"
 #include "pf_localization/sim/building_clutter.h"
 #include "pf_localization/sim/diff_drive_robot.h"
+#include "pf_localization/sim/floor_worlds.h"
 #include "pf_localization/sim/map_changes.h"
 #include "pf_localization/sim/path_script.h"
 #include "pf_localization/sim/planar_lidar.h"
@@ -106,7 +111,6 @@ constexpr int kWarehouseEvery = 10;       // the warehouse lidar's 10 Hz by defa
 constexpr double kNeatoRadius = 0.17;     // m, a Neato is 0.33 m across
 
 enum class RigKind { kNeato, kAmr, kCloud, kWarehouse };
-
 struct Options {
   std::string map, path, out;
   uint64_t seed = 0;
@@ -124,7 +128,7 @@ struct Options {
 };
 
 constexpr char kUsage[] =
-    "usage: pf_simulator --map MAP.yaml --path SCRIPT.path --out OUT.bag\n"
+    "usage: pf_simulator --map MAP.yaml|FLOORS.yaml --path SCRIPT.path --out OUT.bag\n"
     "                    [--seed N] [--compression bz2|lz4|none]\n"
     "                    [--rig neato|amr|cloud|warehouse]  the robot and its sensors\n"
     "                         (default neato):\n"
@@ -468,17 +472,18 @@ bool isValidReading(float r) { return r > 0.0f && std::isfinite(r); }
 
 // Writes the run into the bag; returns the fraction of invalid beams of the
 // planar lidars (covered ones included).
-double simulate(const Options& o, const pf::OccupancyGrid& world, const pf::sim::PathScript& script,
-                rosbag::Bag* bag) {
+double simulate(const Options& o, const pf::sim::FloorWorlds& floors,
+                const pf::sim::PathScript& script, rosbag::Bag* bag) {
   const std::vector<pf::sim::Person> people =
       o.people ? script.people : std::vector<pf::sim::Person>{};
-  Rig rig = makeRig(o, world, people);
+  Rig rig = makeRig(o, floors.grids[floors.initial], people);
   // Separate streams, so that changing a sensor model leaves the odometry alone.
   pf::sim::SimRandom odom_random(o.seed * 2 + 1);
   pf::sim::DiffDriveParams odometry = odometryErrors(o.odom_error);
   odometry.unsigned_translation = o.unsigned_odometry;
   pf::sim::DiffDriveRobot robot(odometry, script.start);
-  const pf::sim::RayCaster walls(world);
+  const std::vector<pf::sim::RayCaster> worlds(floors.grids.begin(), floors.grids.end());
+  std::size_t on = floors.initial;  // the floor's world the sensors see
 
   const int64_t start_ns = std::llround(o.start_time * 1e9);
   const int64_t last_tick = static_cast<int64_t>(std::ceil(script.duration() / kTick - 1e-9));
@@ -493,6 +498,13 @@ double simulate(const Options& o, const pf::OccupancyGrid& world, const pf::sim:
     const int64_t t_ns = tick * kTickNs;
     ros::Time stamp;
     stamp.fromNSec(start_ns + t_ns);
+    const std::size_t now_on = player.floor().empty() ? on : floors.index(player.floor());
+    if (floors.isBuilding() && (tick == 0 || now_on != on)) {
+      on = now_on;
+      std_msgs::String floor;
+      floor.data = floors.names[on];
+      bag->write("/floor", stamp, floor);
+    }
     if (tick % kOdomEvery == 0) writeOdometry(stamp, robot, rig, odom_seq++, bag);
     if (tick % kTruthEvery == 0) writeGroundTruth(stamp, robot, truth_seq++, bag);
     if (rig.ring && rig.ring->schedule.scansAt(t_ns)) {
@@ -505,7 +517,7 @@ double simulate(const Options& o, const pf::OccupancyGrid& world, const pf::sim:
       const PlanarLidar& lidar = sensor.lidar();
       if (!lidar.schedule.scansAt(t_ns)) continue;
       const std::vector<double> ideal =
-          idealRanges(lidar, rig, walls, people, robot.truePose(), t_ns * 1e-9);
+          idealRanges(lidar, rig, worlds[on], people, robot.truePose(), t_ns * 1e-9);
       const sensor_msgs::LaserScan scan =
           scanMessage(stamp, scan_seq[k]++, lidar, sensor.read(ideal, t_ns));
       for (float r : scan.ranges) invalid += !isValidReading(r);
@@ -560,9 +572,15 @@ pf::OccupancyGrid worldOf(const Options& o, pf::OccupancyGrid map) {
 int main(int argc, char** argv) {
   const Options o = parseOptions(argc, argv);
   try {
-    const pf::OccupancyGrid world = worldOf(o, pf::loadMap(o.map));
+    pf::sim::FloorWorlds floors = pf::sim::FloorWorlds::load(o.map);
+    const bool scene = o.rig == RigKind::kCloud || o.rig == RigKind::kWarehouse;
+    if (floors.isBuilding() && (scene || !o.changes.empty())) usage("floors: neato or amr only");
+    pf::OccupancyGrid& world = floors.grids[floors.initial];
+    world = worldOf(o, world);
     const pf::sim::PathScript script = pf::sim::loadPathScript(o.path);
-    if (const auto error = pf::sim::checkClearance(script, world, clearanceRadius(o.rig))) {
+    if (const auto error = pf::sim::checkClearance(
+            script, world, clearanceRadius(o.rig),
+            [&floors](const std::string& name) { return floors.grid(name); })) {
       std::cerr << "pf_simulator: " << *error << "\n";
       return 1;
     }
@@ -570,7 +588,7 @@ int main(int argc, char** argv) {
     bag.setCompression(o.compression == "bz2"   ? rosbag::compression::BZ2
                        : o.compression == "lz4" ? rosbag::compression::LZ4
                                                 : rosbag::compression::Uncompressed);
-    const double invalid = simulate(o, world, script, &bag);
+    const double invalid = simulate(o, floors, script, &bag);
     bag.close();
     std::printf("wrote %s: %.1f s, %zu motions, %.1f %% invalid beams\n", o.out.c_str(),
                 script.duration(), script.motions.size(), 100.0 * invalid);

@@ -79,6 +79,41 @@ OccupancyGrid makeBuildingMap() {
   return c.grid();
 }
 
+OccupancyGrid makeUpperFloorMap() {
+  MapCanvas c({-1.0, -1.0, 21.0, 16.0}, kResolution);
+  c.fill({0.0, 0.0, 20.0, 11.5}, kWall);
+  c.fill({0.0, 11.5, 15.5, 15.0}, kWall);
+  c.fill(kLiftLobby, kFree);
+  c.fill({17.6, 0.3, 19.7, 6.5}, kFree);    // server room
+  c.fill({18.3, 6.5, 19.1, 6.65}, kFree);   // its door
+  c.fill({17.6, 0.3, 19.7, 1.1}, kWall);    // a rack along its south wall
+  c.fill({17.6, 8.65, 19.7, 11.2}, kFree);  // kitchenette
+  c.fill({17.8, 8.5, 18.6, 8.65}, kFree);   // its door
+  c.fill({19.0, 9.6, 19.7, 11.2}, kWall);   // counter
+
+  // The open-plan office, its door to the lobby, desks in uneven rows.
+  c.fill({0.3, 0.3, 17.45, 11.35}, kFree);
+  c.fill({17.45, 7.0, 17.6, 8.2}, kFree);
+  for (double x : {1.5, 4.3, 9.2, 12.0}) c.fill({x, 1.5, x + 1.6, 2.3}, kWall);
+  for (double x : {2.1, 6.4, 11.0}) c.fill({x, 4.4, x + 1.6, 5.2}, kWall);
+  for (double x : {1.2, 5.1, 13.4}) c.fill({x, 8.6, x + 0.8, 10.0}, kWall);
+  c.disc(7.5, 7.3, 0.3, kWall);
+  c.disc(14.6, 4.6, 0.3, kWall);
+  c.segment(9.0, 6.8, 11.4, 9.9, 0.15, kWall);  // a partition at an angle
+  c.fill({15.6, 0.3, 17.45, 1.4}, kWall);       // copier corner
+
+  // Two meeting rooms north of the office, with their tables.
+  c.fill({0.3, 11.5, 7.55, 14.7}, kFree);
+  c.fill({7.7, 11.5, 15.2, 14.7}, kFree);
+  c.fill({0.3, 11.35, 7.55, 11.5}, kWall);
+  c.fill({7.7, 11.35, 15.2, 11.5}, kWall);
+  c.fill({5.2, 11.35, 6.2, 11.5}, kFree);
+  c.fill({8.5, 11.35, 9.5, 11.5}, kFree);
+  c.fill({2.0, 12.6, 4.6, 13.6}, kWall);
+  c.disc(11.8, 13.1, 0.7, kWall);
+  return c.grid();
+}
+
 OccupancyGrid makeSmallMap() {
   MapCanvas c({-0.5, -0.5, 6.5, 4.5}, kResolution);
   c.fill({0.0, 0.0, 6.0, 4.0}, kWall);

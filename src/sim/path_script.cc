@@ -46,7 +46,7 @@ PathScript parsePathScript(std::istream& in, const std::string& file) {
     }
     const auto drive = [&](double v, double w, double duration) {
       if (duration <= 0.0) return;
-      script.motions.push_back({false, v, w, duration, {}, line});
+      script.motions.push_back({false, v, w, duration, {}, line, {}});
       pose = integrateArc(pose, v * duration, w * duration);
     };
     const auto turnBy = [&](double angle) {
@@ -92,14 +92,16 @@ PathScript parsePathScript(std::istream& in, const std::string& file) {
     } else if (cmd == "teleport") {
       const auto a = p.numbers(3, "teleport x y yaw");
       pose = {a[0], a[1], normalizeAngle(a[2])};
-      script.motions.push_back({true, 0.0, 0.0, 0.0, pose, line});
+      script.motions.push_back({true, 0.0, 0.0, 0.0, pose, line, {}});
+    } else if (cmd == "floor") {
+      script.motions.push_back({false, 0.0, 0.0, 0.0, {}, line, p.word("floor NAME")});
     } else if (cmd == "person") {
       const auto a = p.numbers(5, "person x1 y1 x2 y2 speed");
       if (a[4] < 0.0) p.fail("person speed must not be negative");
       script.people.push_back({a[0], a[1], a[2], a[3], a[4]});
     } else {
       p.fail("unknown command '" + cmd +
-             "' (expected start, speed, goto, turn, wait, velocity, teleport or person)");
+             "' (expected start, speed, goto, turn, wait, velocity, teleport, floor or person)");
     }
   }
   if (!started) throw PathScriptError(file + ": no 'start x y yaw' line");
@@ -136,8 +138,9 @@ bool footprintFree(const OccupancyGrid& grid, double x, double y, double radius)
 
 }  // namespace
 
-std::optional<std::string> checkClearance(const PathScript& script, const OccupancyGrid& grid,
-                                          double radius) {
+std::optional<std::string> checkClearance(
+    const PathScript& script, const OccupancyGrid& grid, double radius,
+    const std::function<const OccupancyGrid*(const std::string&)>& floor_grid) {
   constexpr double kSampleStep = 0.01;  // m
   const auto blocked = [&](int line, const Pose2& at) {
     char message[128];
@@ -147,11 +150,18 @@ std::optional<std::string> checkClearance(const PathScript& script, const Occupa
     return script.file + message;
   };
   Pose2 pose = script.start;
-  if (!footprintFree(grid, pose.x, pose.y, radius)) return blocked(script.start_line, pose);
+  const OccupancyGrid* on = &grid;
+  if (!footprintFree(*on, pose.x, pose.y, radius)) return blocked(script.start_line, pose);
   for (const Motion& m : script.motions) {
+    if (!m.floor.empty()) {
+      on = floor_grid ? floor_grid(m.floor) : nullptr;
+      if (!on) return script.file + ":" + std::to_string(m.line) + ": no floor '" + m.floor + "'";
+      if (!footprintFree(*on, pose.x, pose.y, radius)) return blocked(m.line, pose);
+      continue;
+    }
     if (m.teleport) {
       pose = m.target;
-      if (!footprintFree(grid, pose.x, pose.y, radius)) return blocked(m.line, pose);
+      if (!footprintFree(*on, pose.x, pose.y, radius)) return blocked(m.line, pose);
       continue;
     }
     const double length = std::abs(m.v) * m.duration;
@@ -159,7 +169,7 @@ std::optional<std::string> checkClearance(const PathScript& script, const Occupa
     for (int i = 1; i <= samples; ++i) {
       const double t = m.duration * i / samples;
       const Pose2 at = integrateArc(pose, m.v * t, m.w * t);
-      if (!footprintFree(grid, at.x, at.y, radius)) return blocked(m.line, at);
+      if (!footprintFree(*on, at.x, at.y, radius)) return blocked(m.line, at);
     }
     pose = integrateArc(pose, m.v * m.duration, m.w * m.duration);
   }
@@ -173,9 +183,12 @@ PathPlayer::PathPlayer(const PathScript& script) : script_(script) {
 void PathPlayer::advance(double dt, DiffDriveRobot* robot, SimRandom* random) {
   // Times below a picosecond are rounding noise from splitting steps.
   constexpr double kEps = 1e-12;
-  while (!finished() && (dt > kEps || script_.motions[next_].teleport)) {
+  while (!finished() &&
+         (dt > kEps || script_.motions[next_].teleport || !script_.motions[next_].floor.empty())) {
     const Motion& m = script_.motions[next_];
-    if (m.teleport) {
+    if (!m.floor.empty()) {
+      floor_ = m.floor;
+    } else if (m.teleport) {
       robot->teleport(m.target);
     } else {
       const double h = std::min(dt, left_);

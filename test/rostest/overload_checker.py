@@ -27,6 +27,16 @@ Watches, while the bag plays (from the first to the last /ground_truth):
     or sent to set_map with the pose on amcl_pose; the new maps must be
     installed (pf_node's "map W x H cells" lines on /rosout) and set_map
     must succeed;
+  - a lift ride, when asked (ride_topic, the bag's floor topic: a new name
+    on it is a ride): change_floor with that floor and the latest
+    /ground_truth pose; the call must succeed, every tracking error from
+    ride_settle [s, default 2] after the ride at most ride_max_error [m],
+    and pf_floor name the floor of the last ride;
+  - global localization on every floor, when asked (global_at [s of sim time
+    after the first ground truth], global_floor: the floor the robot is on):
+    /global_localization called once; pf_floor must then name global_floor,
+    and never another floor, and from ride_settle after it names it every
+    error must be at most ride_max_error;
 and that pf_node is alive at the end. Every figure is printed (rostest --text,
 or the XML result's <system-out>) whether the test passes or not.
 
@@ -39,7 +49,8 @@ Params (all optional; unset: only reported):
   min_dropped_scans, max_scan_age_p95_ms, max_rss_growth_mb, rss_after [s],
   rmse_below [m], start_after [s, default 5], min_samples (default 50),
   idle_timeout [s wall, default 8], wall_timeout [s wall, default 150],
-  pf_node (default /pf_node).
+  pf_node (default /pf_node), ride_topic, ride_settle [s], ride_max_error [m],
+  global_at [s], global_floor.
 """
 
 import math
@@ -57,6 +68,9 @@ from diagnostic_msgs.msg import DiagnosticStatus
 from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
 from nav_msgs.msg import OccupancyGrid
 from nav_msgs.srv import SetMap
+from pf_localization.srv import ChangeFloor
+from std_msgs.msg import String
+from std_srvs.srv import Empty
 from rosgraph_msgs.msg import Log
 from rosgraph_msgs.msg import Clock
 from tf2_msgs.msg import TFMessage
@@ -114,6 +128,7 @@ class OverloadChecker:
         self.clock = []       # /clock values (sim s), in order of arrival
         rospy.Subscriber('/clock', Clock, self._on_clock, queue_size=1000)
         self.swaps = MapSwaps(self.node)
+        self.rides = FloorRides()
 
     def _on_clock(self, msg):
         with self.lock:
@@ -126,6 +141,7 @@ class OverloadChecker:
                 self.first_gt = t
             self.last_gt_wall = time.time()
             self.gt.append((t, msg.pose.position.x, msg.pose.position.y, yaw_of(msg.pose.orientation)))
+            self.rides.truth = msg
 
     def _on_tf(self, msg):
         with self.lock:
@@ -186,6 +202,7 @@ class OverloadChecker:
                     self.rss.append((t_rel, mb))
             if first is not None:
                 self.swaps.when_due(rospy.Time.now().to_sec() - first)
+                self.rides.when_due(rospy.Time.now().to_sec() - first)
             if last_wall is not None and time.time() - last_wall > idle:
                 break
         self._compare(flush=True)
@@ -292,6 +309,7 @@ class OverloadChecker:
         if n < int(opt('min_samples', 50)):
             failures.append('only %d tracking samples' % n)
         self.swaps.evaluate(info, failures)
+        self.rides.evaluate(info, failures, self.errors, self.first_gt)
         if node_pid(self.node) is None:
             failures.append('%s is not alive at the end' % self.node)
         text = '\n'.join(info + ['FAIL: ' + f for f in failures] or ['ok'])
@@ -370,6 +388,111 @@ class MapSwaps:
         info.append('pf_node installed %d maps since' % self.installed)
         if self.installed != len(asked):
             failures.append('pf_node installed %d maps, not %d' % (self.installed, len(asked)))
+
+
+class FloorRides:
+    """Calls change_floor at each ride on the bag's floor topic, with the true pose then."""
+
+    def __init__(self):
+        self.topic = opt('ride_topic')
+        self.global_at, self.global_floor = opt('global_at'), opt('global_floor')
+        self.global_called = None  # sim s of the global_localization call
+        self.floors_named = []     # (sim s, floor) of every pf_floor after it
+        self.truth = None      # the latest /ground_truth
+        self.floor = None      # the bag's floor
+        self.rides = []        # (sim s, floor, wall s the call took, success, message)
+        self.pf_floor = None   # the last pf_floor
+        self.threads = []
+        if self.topic is not None:
+            rospy.Subscriber(self.topic, String, self._on_floor, queue_size=10)
+        if self.topic is not None or self.global_at is not None:
+            rospy.Subscriber('/pf_floor', String, self._on_pf_floor, queue_size=10)
+
+    def _on_pf_floor(self, msg):
+        self.pf_floor = msg.data
+        if self.global_called is not None:
+            self.floors_named.append((rospy.Time.now().to_sec(), msg.data))
+
+    def when_due(self, t):
+        if self.global_at is None or self.global_called is not None or t < float(self.global_at):
+            return
+        self.global_called = rospy.Time.now().to_sec()
+        rospy.ServiceProxy('/global_localization', Empty)()
+
+    def _on_floor(self, msg):
+        first, self.floor = self.floor is None, msg.data
+        if first or self.truth is None:
+            return
+        # The ride's time: the bag's clock as the floor's name arrives.
+        thread = threading.Thread(target=self._ride,
+                                  args=(rospy.Time.now().to_sec(), msg, self.truth))
+        thread.start()
+        self.threads.append(thread)
+
+    def _ride(self, t, msg, truth):
+        pose = PoseWithCovarianceStamped()
+        pose.header = truth.header
+        pose.pose.pose = truth.pose
+        for i, v in ((0, 0.05 ** 2), (7, 0.05 ** 2), (35, 0.05 ** 2)):
+            pose.pose.covariance[i] = v
+        start = time.time()
+        rospy.wait_for_service('/change_floor', timeout=10.0)
+        res = rospy.ServiceProxy('/change_floor', ChangeFloor)(msg.data, pose)
+        self.rides.append((t, msg.data, time.time() - start, res.success, res.message))
+
+    def evaluate(self, info, failures, errors, first_gt):
+        self._evaluate_global(info, failures, errors, first_gt)
+        if self.topic is None:
+            return
+        for thread in self.threads:
+            thread.join(30.0)
+        if not self.rides:
+            failures.append('no ride on %s' % self.topic)
+            return
+        settle, bound = float(opt('ride_settle', 2.0)), opt('ride_max_error')
+        for t, floor, took, ok, message in self.rides:
+            t_rel = t - first_gt
+            after = [e for e in errors if e[0] >= t_rel + settle]
+            worst = max(after, key=lambda e: e[1]) if after else (float('nan'), float('nan'), 0.0)
+            info.append('ride to %s at t=%.1f s: change_floor took %.2f s wall, %s: %s; '
+                        'from %.0f s after it, %d samples, max error %.3f m at t=%.1f s' %
+                        (floor, t_rel, took, 'ok' if ok else 'FAILED', message, settle,
+                         len(after), worst[1], worst[0]))
+            if not ok:
+                failures.append('change_floor to %s failed: %s' % (floor, message))
+            if bound is not None and not (after and worst[1] <= float(bound)):
+                failures.append('after the ride to %s: error %.3f m > ride_max_error %s m' %
+                                (floor, worst[1], bound))
+        info.append('pf_floor: %s' % self.pf_floor)
+        if self.pf_floor != self.rides[-1][1]:
+            failures.append('pf_floor is %s, not %s' % (self.pf_floor, self.rides[-1][1]))
+
+
+    def _evaluate_global(self, info, failures, errors, first_gt):
+        if self.global_at is None:
+            return
+        if self.global_called is None:
+            failures.append('global_localization was never called')
+            return
+        named = [(t, f) for t, f in self.floors_named if f]
+        info.append('global localization on every floor at t=%.1f s; pf_floor then: %s' %
+                    (self.global_called - first_gt,
+                     ', '.join('%s at t=%.1f s' % (f, t - first_gt) for t, f in named) or 'none'))
+        wrong = [f for _, f in named if f != self.global_floor]
+        if wrong:
+            failures.append('pf_floor named %s, not %s' % (wrong[0], self.global_floor))
+        if not named:
+            failures.append('no floor found (pf_floor stayed empty)')
+            return
+        t_rel = named[0][0] - first_gt
+        after = [e for e in errors if e[0] >= t_rel + float(opt('ride_settle', 2.0))]
+        worst = max(after, key=lambda e: e[1]) if after else (float('nan'), float('nan'), 0.0)
+        info.append('from %.0f s after it was found, %d samples, max error %.3f m at t=%.1f s' %
+                    (float(opt('ride_settle', 2.0)), len(after), worst[1], worst[0]))
+        bound = opt('ride_max_error')
+        if bound is not None and not (after and worst[1] <= float(bound)):
+            failures.append('after the floor was found: error %.3f m > ride_max_error %s m' %
+                            (worst[1], bound))
 
 
 class OverloadCheckerTest(unittest.TestCase):

@@ -83,7 +83,7 @@ TEST(PersonTest, WalksToAndFro) {
 TEST(PathScriptTest, ErrorsNameFileAndLine) {
   EXPECT_EQ(errorOf("start 0 0 0\n\nfly 1 2\n"),
             "test.path:3: unknown command 'fly' (expected start, speed, goto, turn, wait, "
-            "velocity, teleport or person)");
+            "velocity, teleport, floor or person)");
   EXPECT_EQ(errorOf("start 0 0 0\ngoto 1 x\n"), "test.path:2: 'x' is not a number (in 'goto')");
   EXPECT_EQ(errorOf("start 0 0 0\ngoto 1 2e\n"), "test.path:2: '2e' is not a number (in 'goto')");
   EXPECT_EQ(errorOf("start 0 0 0\ngoto 1\n"), "test.path:2: 'goto' takes 2 number(s): goto x y");
@@ -121,6 +121,29 @@ TEST(CheckClearanceTest, ChecksTheStartAndTeleportTargets) {
   EXPECT_EQ(
       checkClearance(parse("start 0.2 0.25 0\nteleport 0.55 0.3 0\n"), room(), 0.045).value_or(""),
       "test.path:2: the robot (radius 0.045 m) leaves free space at (0.55, 0.30)");
+}
+
+// A lift ride: the path after `floor NAME` is checked on that floor's grid,
+// and the player says which floor the robot is on.
+TEST(CheckClearanceTest, ChecksEachFloorOnItsOwnGrid) {
+  const OccupancyGrid open = pf::test::room(1.0, 0.6, 0.1, {});
+  const PathScript s = parse("start 0.2 0.3 0\nwait 1\nfloor up\nwait 1\ngoto 0.8 0.3\n");
+  ASSERT_EQ(4u, s.motions.size());  // wait, floor, wait, goto straight ahead
+  EXPECT_EQ("up", s.motions[1].floor);
+  EXPECT_DOUBLE_EQ(0.0, s.motions[1].duration);
+  const auto floors = [&](const std::string& name) { return name == "up" ? &open : nullptr; };
+  // On the ground floor's grid the goto would hit the pillar; upstairs it is clear.
+  EXPECT_EQ(checkClearance(s, room(), 0.045, floors), std::nullopt);
+  EXPECT_EQ(checkClearance(s, open, 0.045).value_or(""), "test.path:3: no floor 'up'");
+  EXPECT_EQ(errorOf("start 0 0 0\nfloor\n"), "test.path:2: expected 'floor NAME'");
+
+  DiffDriveRobot robot({}, s.start);
+  PathPlayer player(s);
+  player.advance(0.5, &robot, nullptr);
+  EXPECT_EQ("", player.floor());
+  player.advance(0.6, &robot, nullptr);
+  EXPECT_EQ("up", player.floor());
+  EXPECT_NEAR(robot.truePose().x, 0.2, 1e-12);  // the ride moves nothing
 }
 
 TEST(PathPlayerTest, StepSizeDoesNotChangeThePath) {

@@ -39,6 +39,28 @@ inline constexpr Box kTwinRoomB{5.05, 8.65, 9.65, 14.7};
 /// The building map (0.05 m cells).
 OccupancyGrid makeBuildingMap();
 
+/// The building's upper floor (0.05 m cells): the same L-shaped outline, laid
+/// out otherwise. The lift lobby at the east end is where the ground floor's
+/// corridor ends (kLiftLobby: a robot there is in free space on both floors);
+/// west of it, through a door, an open-plan office of desks and two columns;
+/// north, two meeting rooms; beside the lobby, a server room and a
+/// kitchenette. maps/building_floors.yaml names the two floors.
+///
+///   y=15 +-----------------+-----------------+
+///        | meeting room 1  | meeting room 2  |
+///        +--door-----------+--door-----------+----+ y=11.5
+///        |  open-plan office: desks,         |kit.|
+///        |  two columns, a partition         +----+ y=8.65
+///        |                                 door lift|
+///        |                                   +----+ y=6.5
+///        |                                   |srv.|
+///   y=0  +-----------------------------------+----+
+///       x=0                                 17.45 20
+OccupancyGrid makeUpperFloorMap();
+/// The lift lobby's free space on the upper floor; on the ground floor the
+/// corridor's east end.
+inline constexpr Box kLiftLobby{17.6, 6.65, 19.7, 8.5};
+
 /// A small asymmetric room, 6 x 4 m, with a cabinet, a column and a wall stub
 /// (0.05 m cells), for fast tests.
 OccupancyGrid makeSmallMap();

@@ -52,6 +52,12 @@ class LineParser {
     return out;
   }
 
+  /// The one word after the command, as `usage` names it.
+  const std::string& word(const std::string& usage) const {
+    if (words_.size() != 2) fail("expected '" + usage + "'");
+    return words_[1];
+  }
+
   void requirePositive(double value, const std::string& what) const {
     if (!(value > 0.0)) fail(what + " must be positive, got " + std::to_string(value));
   }

@@ -12,6 +12,9 @@
 //   wait t                 stand still for t seconds
 //   velocity v w t         drive at v m/s turning at w rad/s for t seconds (an arc)
 //   teleport x y yaw       move the true pose instantly, wheels still (a kidnapping)
+//   floor NAME             from here on the robot is on floor NAME of the building
+//                          (a lift ride: wait in the lift before and after it);
+//                          the world the sensors see is that floor's map
 //   person x1 y1 x2 y2 v   a person (seen as a 0.2 m radius circle) walking to
 //                          and fro between two points at v m/s, for the whole
 //                          run; people are not on the map and may cross the robot
@@ -21,6 +24,7 @@
 // checked on the map before anything is simulated (checkClearance).
 #pragma once
 
+#include <functional>
 #include <istream>
 #include <optional>
 #include <stdexcept>
@@ -48,6 +52,7 @@ struct Motion {
   double duration = 0.0;  // s
   Pose2 target;           // teleports only
   int line = 0;           // script line that produced it
+  std::string floor;      // non-empty: no motion, the robot is now on this floor
 };
 
 /// A circular obstacle that is not on the map, walking back and forth.
@@ -82,8 +87,11 @@ PathScript loadPathScript(const std::string& path);
 /// Checks that a robot of `radius` metres stays in free cells of `grid` along
 /// the whole true path (sampled every 1 cm), teleport targets included.
 /// Returns "file:line: ..." naming the first motion that leaves free space.
-std::optional<std::string> checkClearance(const PathScript& script, const OccupancyGrid& grid,
-                                          double radius);
+/// After a `floor NAME` the path is checked on `floor_grid(NAME)`, which
+/// is null for a floor that does not exist (also when floor_grid is empty).
+std::optional<std::string> checkClearance(
+    const PathScript& script, const OccupancyGrid& grid, double radius,
+    const std::function<const OccupancyGrid*(const std::string&)>& floor_grid = {});
 
 /// Plays a script's motions on a robot in steps of any length: a step that
 /// spans the end of one motion finishes it and goes on with the next, so the
@@ -98,11 +106,14 @@ class PathPlayer {
   /// end the robot stands still.
   void advance(double dt, DiffDriveRobot* robot, SimRandom* random);
   bool finished() const { return next_ >= script_.motions.size(); }
+  /// The floor of the last `floor NAME` played; empty before any.
+  const std::string& floor() const { return floor_; }
 
  private:
   const PathScript& script_;
   std::size_t next_ = 0;  // the motion under way
   double left_ = 0.0;     // seconds left of it
+  std::string floor_;
 };
 
 }  // namespace pf::sim

@@ -27,6 +27,14 @@ void BeamScreen::setMap(MapParts parts) {
   layer_.emplace(std::move(parts.layer));
 }
 
+BeamScreen::MapParts BeamScreen::releaseMap() {
+  MapParts parts{std::move(*evidence_), std::move(*layer_)};
+  evidence_.reset();
+  layer_.reset();
+  changes_.clear();
+  return parts;
+}
+
 void BeamScreen::setField(const DistanceField& field) {
   evidence_.emplace(field);
   shareMapChanges(true);

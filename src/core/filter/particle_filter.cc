@@ -112,6 +112,14 @@ bool ParticleFilter::setMap(PreparedMap map) {
   return false;
 }
 
+std::optional<PreparedMap> ParticleFilter::releaseMap() {
+  if (!hasMap()) return std::nullopt;
+  // In this order: the model holds the field the screen's parts refer to.
+  std::vector<MapSymmetry> symmetries = estimate_.symmetries();
+  BeamScreen::MapParts screen = screen_.releaseMap();
+  return PreparedMap{sensor_.releaseModel(), std::move(screen), std::move(symmetries), params_};
+}
+
 void ParticleFilter::expectScanRange(double range_max) {
   if (!std::isfinite(range_max) || !(range_max > 0.0)) return;
   sensor_.expectRange(scoredRangeMax(range_max, params_.sensor.range_max));

@@ -60,6 +60,11 @@ void SensorUpdate::setModel(std::unique_ptr<SensorModel> model) {
   }
 }
 
+std::unique_ptr<SensorModel> SensorUpdate::releaseModel() {
+  search_.forgetModel();
+  return std::move(model_);
+}
+
 void SensorUpdate::expectRange(double range_max) {
   if (!std::isfinite(range_max) || !(range_max > 0.0)) return;
   if (std::find(ranges_.begin(), ranges_.end(), range_max) != ranges_.end()) return;

@@ -50,19 +50,45 @@ void LiveLocalizer::logInitialPose() const {
 }
 
 bool LiveLocalizer::installMap(const nav_msgs::OccupancyGrid& map, UpdateScheduler& scheduler) {
-  const auto recipe = scheduler.withFilter([&] { return localizer_.mapRecipe(); });
-  ScanLocalizer::ReadyMap ready = ScanLocalizer::prepareMap(map, recipe);
-  // The checksum of the map's cells (48 MB on a 200 x 600 m floor) only for
-  // a saver or a saved pose to check.
-  const bool signs = ready.map && (config_.save_pose_rate > 0.0 || saved_pose_.has_value());
-  const std::string signature = signs ? mapSignature(map) : "";
-  return scheduler.withFilter([&] { return install(std::move(ready), map, signature); });
+  BuiltMap built = buildMap(map, scheduler);
+  return scheduler.withFilter([&] { return install(std::move(built), map.header.stamp); });
 }
 
-bool LiveLocalizer::install(ScanLocalizer::ReadyMap ready, const nav_msgs::OccupancyGrid& map,
-                            const std::string& signature) {
+LiveLocalizer::BuiltMap LiveLocalizer::buildMap(const nav_msgs::OccupancyGrid& map,
+                                                UpdateScheduler& scheduler) const {
+  const auto recipe = scheduler.withFilter([&] { return localizer_.mapRecipe(); });
+  BuiltMap built{ScanLocalizer::prepareMap(map, recipe), ""};
+  // The checksum of the map's cells (48 MB on a 200 x 600 m floor) only for
+  // a saver or a saved pose to check.
+  if (built.ready.map && (config_.save_pose_rate > 0.0 || saved_pose_.has_value())) {
+    built.signature = mapSignature(map);
+  }
+  return built;
+}
+
+bool LiveLocalizer::changeFloor(std::optional<BuiltMap> built, const std::string& floor,
+                                const std::optional<geometry_msgs::PoseWithCovarianceStamped>& pose,
+                                std::optional<pf::PreparedMap>* replaced) {
+  const ros::Time stamp = pose ? pose->header.stamp : ros::Time::now();
+  // A first map without a pose starts as any first map does: from the
+  // configured initial pose (or a saved one, checked), or globally.
+  const bool starts = !have_map_ && !pose;
+  if (built && !install(std::move(*built), stamp, replaced, starts)) return false;
+  output_.setFloor(floor);
+  if (starts) return true;
+  if (!pose) return startGlobalLocalization();
+  if (setInitialPose(*pose)) return true;
+  // Refused (warned): not the old floor's particles on this floor's map.
+  startGlobalLocalization();
+  return false;
+}
+
+bool LiveLocalizer::install(BuiltMap built, const ros::Time& stamp,
+                            std::optional<pf::PreparedMap>* replaced, bool announce) {
   const bool first = !have_map_;
-  const std::string error = localizer_.setMap(std::move(ready));
+  const nav_msgs::MapMetaData info = built.ready.info;
+  const std::string& signature = built.signature;
+  const std::string error = localizer_.setMap(std::move(built.ready), replaced);
   if (!error.empty()) {
     ROS_ERROR("pf_node: %s", error.c_str());
     return false;
@@ -73,10 +99,11 @@ bool LiveLocalizer::install(ScanLocalizer::ReadyMap ready, const nav_msgs::Occup
     saver_.setMap(signature);
     if (first && saved_pose_) checkSavedPose(signature);
   }
-  if (changes_saver_.enabled()) mapChangesOnNewMap(signature, first, map.header.stamp);
-  ROS_INFO("pf_node: map %u x %u cells at %.3f m; %zu particles", map.info.width, map.info.height,
-           map.info.resolution, localizer_.filter().particles().size());
-  output_.publishEstimate(localizer_, map.header.stamp, true);
+  if (changes_saver_.enabled()) mapChangesOnNewMap(signature, first, stamp);
+  ROS_INFO("pf_node: map %u x %u cells at %.3f m; %zu particles", info.width, info.height,
+           info.resolution, localizer_.filter().particles().size());
+  if (!announce) return true;
+  output_.publishEstimate(localizer_, stamp, true);
   filterChanged(ros::Time());
   return true;
 }

@@ -95,8 +95,9 @@ ScanLocalizer::ReadyMap ScanLocalizer::prepareMap(pf::OccupancyGrid grid,
   return {"", pf::PreparedMap::build(std::move(grid), recipe.filter), info};
 }
 
-std::string ScanLocalizer::setMap(ReadyMap ready) {
+std::string ScanLocalizer::setMap(ReadyMap ready, std::optional<pf::PreparedMap>* replaced) {
   if (!ready.map) return ready.error;
+  if (replaced) *replaced = filter_.releaseMap();
   const bool kept = filter_.setMap(std::move(*ready.map));
   if (!kept) given_map_to_odom_.reset();
   map_info_ = ready.info;
@@ -272,6 +273,7 @@ void ScanLocalizer::update(pf::LaserScan scan, std::size_t sensor, const ros::Ti
     group_.back().robot_offset = pf::between(*result->odom, s->odom);
   }
   result->report = filter_.update(*result->odom, group_);
+  if (observer_) observer_(*result->odom, group_, stamp);
   if (latest_.size() > 1) observeHealth(group_.front(), sensor, stamp);
   latest_[sensor] = SensorScan{std::move(group_.front()), *result->odom, stamp, false};
   if (result->report.updated) {

@@ -4,6 +4,8 @@
 #include <geometry_msgs/PoseArray.h>
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 
+#include <algorithm>
+
 #include "pf_localization/ros/diagnostics/diagnostic_status.h"
 #include "pf_localization/ros/input/conversions.h"
 
@@ -59,6 +61,18 @@ void EstimatePublisher::publishConfidence(const ScanLocalizer& localizer, const 
   addHypotheses(&array.status.front(), hypotheses);
   addSensors(&array.status.front(), localizer.sensorHealth(), stamp.toSec());
   addMapChanges(&array.status.front(), localizer.mapChanges());
+  if (!floor_.empty()) {
+    diagnostic_msgs::KeyValue floor;
+    floor.key = "floor";
+    floor.value = floor_;
+    array.status.front().values.insert(array.status.front().values.begin(), floor);
+    array.status.front().message += " on floor " + floor_;
+  }
+  if (searching_) {
+    diagnostic_msgs::DiagnosticStatus& s = array.status.front();
+    s.level = std::max<std::uint8_t>(s.level, diagnostic_msgs::DiagnosticStatus::WARN);
+    s.message = "searching every floor: " + s.message;
+  }
   diagnostics_pub_.publish(array);
   status_pub_.publish(array.status.front());
   publishMapChanges(localizer, stamp);

@@ -111,7 +111,12 @@ pf::ParameterTable<C> outputParameters() {
       pf::computed<C, bool>(
           [](const C&) { return true; }, [](C&, const bool&) {},
           I("use_map_topic", "", "false: keep the first map, as amcl does without the topic")
-              .amcl())};
+              .amcl()),
+      pf::member(&C::floors_file,
+                 I("floors_file", "path",
+                   "a building's floors (name and map of each): the maps come from it, not the "
+                   "map topic, and change_floor moves between them")
+                     .unsetMeans("one map, from the map topic or set_map"))};
 }
 
 pf::ParameterTable<C> initialPoseParameters() {

@@ -2,7 +2,9 @@
 // estimate is still on free space of the new map, and are dropped otherwise.
 #include <gtest/gtest.h>
 
+#include <optional>
 #include <stdexcept>
+#include <vector>
 
 #include "core/filter/particle_filter_world.h"
 #include "pf_localization/core/filter/particle_filter.h"
@@ -14,6 +16,7 @@ namespace {
 using filter_world::asymmetricRoom;
 using filter_world::baseParams;
 using filter_world::diag;
+using filter_world::distance;
 using filter_world::odomOf;
 using filter_world::room;
 using filter_world::simulateScan;
@@ -115,6 +118,50 @@ TEST(ParticleFilter, AMapBuiltBeforeAReconfigureIsBuiltAgain) {
   filter.setMap(std::move(prepared));
   const auto& model = dynamic_cast<const LikelihoodFieldModel&>(*filter.sensorModel());
   EXPECT_EQ(params.sensor.sigma_hit, model.params().sigma_hit);
+}
+
+// A building's floors (ros/localizer/floors.h): a map taken out with
+// releaseMap and set again later is back as it was, with what its change
+// layer learned, while another map was in use.
+TEST(ParticleFilter, AReleasedMapComesBackWithWhatItsLayerLearned) {
+  const OccupancyGrid map = room(4.0, 3.0, {{2.5, 0.5, 3.0, 1.2}});
+  // The world has a box the map lacks, in view of the drive below.
+  const OccupancyGrid world = room(4.0, 3.0, {{2.5, 0.5, 3.0, 1.2}, {3.2, 2.2, 3.6, 2.6}});
+  ParticleFilter filter(baseParams());
+  EXPECT_FALSE(filter.releaseMap().has_value());  // none yet
+  filter.setMap(map);
+  filter.initializeGaussian({0.8, 1.5, 0.0}, diag(0.02, 0.02, 0.02));
+  for (double x = 0.8; x < 2.3; x += 0.25) {
+    ASSERT_TRUE(filter.update(odomOf({x, 1.5, 0.0}), simulateScan(world, {x, 1.5, 0.0})).updated);
+  }
+  const MapChangeLayer::Summary learned = filter.mapChanges()->summary();
+  const std::vector<std::int8_t> cells = filter.mapChanges()->occupancy();
+  ASSERT_GT(learned.added, 0u);
+  const OccupancyGrid* grid = filter.map();
+
+  std::optional<PreparedMap> first = filter.releaseMap();
+  ASSERT_TRUE(first.has_value());
+  EXPECT_FALSE(filter.hasMap());
+  EXPECT_EQ(nullptr, filter.mapChanges());
+  // Another floor, learned on from scratch.
+  const OccupancyGrid other = asymmetricRoom();
+  filter.setMap(other);
+  filter.initializeGaussian({1.0, 1.5, 0.0}, diag(0.02, 0.02, 0.02));
+  EXPECT_EQ(0u, filter.mapChanges()->summary().seen);
+  ASSERT_TRUE(filter.update(odomOf({2.5, 1.5, 0.0}), simulateScan(other, {1.0, 1.5, 0.0})).updated);
+
+  // Back: the same grid, and the layer as it was when the filter left it.
+  const std::optional<PreparedMap> second = filter.releaseMap();
+  ASSERT_TRUE(second.has_value());
+  filter.setMap(std::move(*first));
+  EXPECT_EQ(grid, filter.map());
+  EXPECT_EQ(learned.added, filter.mapChanges()->summary().added);
+  EXPECT_EQ(learned.seen, filter.mapChanges()->summary().seen);
+  EXPECT_EQ(cells, filter.mapChanges()->occupancy());
+  filter.initializeGaussian({2.3, 1.5, 0.0}, diag(0.02, 0.02, 0.02));
+  // The odometry moves 0.1 m on from the other floor's last update.
+  EXPECT_TRUE(filter.update(odomOf({2.6, 1.5, 0.0}), simulateScan(world, {2.4, 1.5, 0.0})).updated);
+  EXPECT_LT(distance(filter.estimate().pose, {2.4, 1.5, 0.0}), 0.1);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <iostream>
 #include <limits>
+#include <optional>
 
 #include "pf_localization/ros/input/conversions.h"
 #include "support/rooms.h"
@@ -274,6 +275,33 @@ TEST_F(ScanLocalizerTest, AMapIsCheckedAndBuiltApartThenInstalled) {
   const auto a = direct.mapChangesMsg(ros::Time(1.0)), b = localizer.mapChangesMsg(ros::Time(1.0));
   ASSERT_TRUE(a && b);
   EXPECT_EQ(a->info, b->info);
+}
+
+TEST_F(ScanLocalizerTest, AReplacedMapComesOutForALaterFloorChange) {
+  // A building's floors (floors.h): the map a new one replaces is handed
+  // back, its grid and metadata whole, and installs again as it was.
+  ScanLocalizer localizer(config_, &tf_);
+  std::optional<pf::PreparedMap> replaced;
+  ScanLocalizer::ReadyMap ground = ScanLocalizer::prepareMap(map_, localizer.mapRecipe());
+  ASSERT_EQ(localizer.setMap(std::move(ground), &replaced), "");
+  EXPECT_FALSE(replaced);  // the first map replaces none
+  const pf::OccupancyGrid* ground_grid = localizer.filter().map();
+  const nav_msgs::MapMetaData ground_info = map_.info;
+
+  const nav_msgs::OccupancyGrid upper =
+      mapMsg(pf::test::room(3.0, 3.0, 0.05, {{1.0, 1.0, 1.5, 1.5}}));
+  ASSERT_EQ(localizer.setMap(ScanLocalizer::prepareMap(upper, localizer.mapRecipe()), &replaced),
+            "");
+  ASSERT_TRUE(replaced);
+  EXPECT_EQ(ground_grid, &replaced->model->field().grid());  // the same grid, not a copy
+  EXPECT_EQ(upper.info.width, localizer.mapChangesMsg(ros::Time(1.0))->info.width);
+
+  ScanLocalizer::ReadyMap back{"", std::move(replaced), ground_info};
+  ASSERT_EQ(localizer.setMap(std::move(back), &replaced), "");
+  EXPECT_EQ(ground_grid, localizer.filter().map());
+  EXPECT_EQ(ground_info.width, localizer.mapChangesMsg(ros::Time(1.0))->info.width);
+  ASSERT_TRUE(replaced);
+  EXPECT_EQ(upper.info.width, static_cast<unsigned>(replaced->model->field().grid().width()));
 }
 
 TEST(ScanInconsistency, ConsistentScanHasNone) {

@@ -54,6 +54,8 @@ class EstimateUpdate {
   /// A new map, with its look-alike places (findMapSymmetries); the last
   /// fit and the places listed are forgotten.
   void setMap(std::vector<MapSymmetry> symmetries);
+  /// The map's look-alike places, as setMap took them.
+  const std::vector<MapSymmetry>& symmetries() const { return look_alikes_.symmetries(); }
   /// No estimate (a map the robot is not on).
   void forget() { estimate_ = PoseEstimate(); }
   /// After an initialisation: `estimate` is the new cloud's; "uncertain",

@@ -89,6 +89,10 @@ class BeamScreen {
   /// A new map: the judging casts rays on it, and the layer of its changes
   /// starts empty (`parts`, prepared from its field).
   void setMap(MapParts parts);
+  /// Takes the map's parts out, with what the layer learned
+  /// (ParticleFilter::releaseMap); setMap(parts) later goes on from them.
+  /// None are left. Precondition: a map was set.
+  MapParts releaseMap();
   /// The same map under a new likelihood field (new sensor parameters): the
   /// judging casts on it, with what the layer learned.
   void setField(const DistanceField& field);

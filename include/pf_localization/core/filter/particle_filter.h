@@ -107,6 +107,11 @@ class ParticleFilter {
   /// (prepared_map.h): only a swap, unless a sensor parameter changed since
   /// the recipe was taken, which builds them again.
   bool setMap(PreparedMap map);
+  /// Takes the map out, with what its change layer learned and its
+  /// look-alike places, for a later setMap to install again as it was (a
+  /// building's floors keep theirs: ros/localizer/floors.h); none without a
+  /// map. The particles stay; the filter has no map until the next setMap.
+  std::optional<PreparedMap> releaseMap();
   /// What building a map for this filter needs, to build it elsewhere.
   PreparedMap::Recipe mapRecipe() const { return {params_, sensor_.ranges()}; }
   bool hasMap() const { return sensor_.hasModel(); }

@@ -46,6 +46,8 @@ class SensorUpdate {
   /// range expected (expectRange), so that the next update does not build
   /// its tables.
   void setModel(std::unique_ptr<SensorModel> model);
+  /// Takes the model out (ParticleFilter::releaseMap): none is left.
+  std::unique_ptr<SensorModel> releaseModel();
   /// Scans of `range_max` are to be weighed (a sensor's, seen before the
   /// map or with the last one): the model, and every later one, builds what
   /// they need now. Up to LikelihoodTables::kMaxTables ranges are kept, the

@@ -9,11 +9,12 @@
 // was learned on it, and cleared on request (map_changes_saver.h).
 //
 // Threads (docs/ros-interface.md, "Threads, latency and overload"): every
-// method but saver(), haveMap() and installMap() must be called with the
-// filter's lock held (UpdateScheduler); an update holds it whole (on the
-// filter thread, or on roscpp's poll thread when it is short), the main
-// spinner's callbacks that touch the filter wait for it; installMap() takes
-// it itself, only around the swap of a map it built without it, and
+// method but saver(), haveMap(), installMap() and buildMap() must be called
+// with the filter's lock held (UpdateScheduler); an update holds it whole (on
+// the filter thread, or on roscpp's poll thread when it is short), the main
+// spinner's callbacks that touch the filter wait for it; installMap() and
+// buildMap() take it themselves, only to read the recipe and, for
+// installMap(), around the swap of a map built without it, and
 // saveAtShutdown() around the copy of the layer. What runs at a steady rate never
 // does: the republisher and the saver get their data under small locks of their own.
 #pragma once
@@ -62,9 +63,39 @@ class LiveLocalizer {
   /// map, and `scheduler` lends it only to read what building needs and to
   /// swap the map in (prepared_map.h).
   bool installMap(const nav_msgs::OccupancyGrid& map, UpdateScheduler& scheduler);
+  /// installMap's part without the filter's lock: `map` checked and built
+  /// for the filter (ready.error says why it was refused), with the checksum
+  /// a saver or a saved pose will check.
+  struct BuiltMap {
+    ScanLocalizer::ReadyMap ready;
+    std::string signature;
+  };
+  BuiltMap buildMap(const nav_msgs::OccupancyGrid& map, UpdateScheduler& scheduler) const;
+  /// A building's floor (floors.h), with the filter's lock held and in one
+  /// hold of it, so that no update weighs the old floor's particles on the
+  /// new map and map -> odom goes from one floor's to the other's: `built`
+  /// (none: the floor stays) replaces the map, which goes to `*replaced`
+  /// with what its change layer learned; then the filter starts at `pose`
+  /// (moved on by the odometry since its stamp) or, without one, globally
+  /// (a first map without a pose: as installMap's first map). `floor` names
+  /// the floor on pf_status. False when refused (logged): a refused pose
+  /// leaves global localization on the new floor.
+  bool changeFloor(std::optional<BuiltMap> built, const std::string& floor,
+                   const std::optional<geometry_msgs::PoseWithCovarianceStamped>& pose,
+                   std::optional<pf::PreparedMap>* replaced);
   /// Whether a map was installed. Changed only by installMap(), which pf_node
   /// calls from its main spinner; read there without the mutex.
   bool haveMap() const { return have_map_; }
+
+  /// For a search of every floor (floors.h), with the filter's lock held:
+  /// the filter's live parameters, every update's odometry and scans
+  /// (ScanLocalizer::observeUpdates), and the floor pf_status names.
+  const pf::ParticleFilterParams& filterParams() const { return localizer_.filter().params(); }
+  void observeUpdates(ScanLocalizer::UpdateObserver observer) {
+    localizer_.observeUpdates(std::move(observer));
+  }
+  void showFloor(const std::string& floor, bool searching) { output_.setFloor(floor, searching); }
+  const std::string& globalFrame() const { return config_.global_frame; }
 
   /// Re-initialises at `pose`, in the global frame. False when refused (warned).
   bool setInitialPose(const geometry_msgs::PoseWithCovarianceStamped& pose);
@@ -113,10 +144,11 @@ class LiveLocalizer {
 
  private:
   void logInitialPose() const;
-  // installMap's part with the filter's lock held: `ready`, built from `map`
-  // whose signature (mapSignature) is `signature`, replaces the filter's map.
-  bool install(ScanLocalizer::ReadyMap ready, const nav_msgs::OccupancyGrid& map,
-               const std::string& signature);
+  // installMap's part with the filter's lock held: `built`, from a map
+  // stamped `stamp`, replaces the filter's map (which goes to `replaced`, if
+  // any); `announce`: map -> odom and the estimate go out now.
+  bool install(BuiltMap built, const ros::Time& stamp,
+               std::optional<pf::PreparedMap>* replaced = nullptr, bool announce = true);
   void checkSavedPose(const std::string& map_signature);
   // A new map of signature `signature` for the layer's saver; on the first
   // (`first`), the layer saved on it restored and published.

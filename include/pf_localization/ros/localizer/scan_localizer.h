@@ -14,6 +14,7 @@
 #include <sensor_msgs/PointCloud2.h>
 #include <tf2/buffer_core.h>
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -89,8 +90,17 @@ class ScanLocalizer {
   static ReadyMap prepareMap(const nav_msgs::OccupancyGrid& map, const MapRecipe& recipe);
   static ReadyMap prepareMap(pf::OccupancyGrid grid, const std::string& frame_id,
                              const MapRecipe& recipe);
-  /// Installs a prepared map as setMap above does; `map.error` when it was refused.
-  std::string setMap(ReadyMap map);
+  /// Installs a prepared map as setMap above does; `map.error` when it was
+  /// refused. `replaced`: where the map it replaces goes, with what its
+  /// change layer learned (ParticleFilter::releaseMap); null: it is dropped.
+  std::string setMap(ReadyMap map, std::optional<pf::PreparedMap>* replaced = nullptr);
+
+  /// Told of every filter update's odometry, scans and stamp, after it: a
+  /// search on other maps follows the same scans (floors.h).
+  using UpdateObserver = std::function<void(const pf::Pose2& odom, const pf::ScanGroup& scans,
+                                            const ros::Time& stamp)>;
+  /// Empty: none (the default).
+  void observeUpdates(UpdateObserver observer) { observer_ = std::move(observer); }
 
   /// Re-initialises around a pose given in the global frame, moved on by the
   /// odometry since its stamp (movedByOdometrySince). A pose in another
@@ -180,6 +190,7 @@ class ScanLocalizer {
   pf::SensorHealth health_;
   std::vector<double> weights_;               // of sensorTopics()' sensors (scan_weights)
   std::vector<pf::CloudPoint> cloud_points_;  // scratch of processCloud
+  UpdateObserver observer_;
 };
 
 /// s: a scan of another sensor older than this is not used (a sensor that

@@ -57,6 +57,18 @@ class EstimatePublisher {
   /// pf_map_changes now, whatever learned or due (restored, or cleared).
   void publishMapChangesNow(const ScanLocalizer& localizer, const ros::Time& stamp);
 
+  /// The floor of a building the robot is on (floors.h): pf_status and
+  /// /diagnostics name it (a "floor" value, and "on floor NAME" after the
+  /// message); empty, as without a floors file: nothing is added.
+  /// `searching`: no floor is known while every floor is searched; the
+  /// status is then at least a warning, its message led by "searching every
+  /// floor: ", since the filter's verdict is about a floor that may not be
+  /// the robot's.
+  void setFloor(const std::string& floor, bool searching = false) {
+    floor_ = floor;
+    searching_ = searching;
+  }
+
  private:
   // pf_map_changes when due and the layer learned something since.
   void publishMapChanges(const ScanLocalizer& localizer, const ros::Time& stamp);
@@ -71,6 +83,8 @@ class EstimatePublisher {
   ros::Publisher cloud_pub_, diagnostics_pub_;
   ros::Time last_cloud_stamp_;
   StateChangeLog state_log_;
+  std::string floor_;
+  bool searching_ = false;
 };
 
 }  // namespace pf_ros

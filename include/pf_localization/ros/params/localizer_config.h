@@ -73,6 +73,9 @@ struct LocalizerConfig {
   // (map_changes_saver.h); empty: defaultMapChangesPath().
   std::string map_changes_file;
   bool first_map_only = false;  // keep the first map; ignore later ones on the map topic
+  // A building's floors file (core/map/floors_file.h): the maps come from it,
+  // not from the map topic, and change_floor moves between them (floors.h).
+  std::string floors_file;
 };
 
 /// config.scan_topics as a list: the words between spaces and commas.
