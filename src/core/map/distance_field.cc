@@ -163,13 +163,31 @@ void DistanceField::transformOutside(const ValueClasses& values, int threads) {
 
 void DistanceField::transformInside(const ValueClasses& values, int threads) {
   const int w = grid_.width(), h = grid_.height();
+  const std::size_t n = grid_.data().size();
   const int8_t* map = grid_.data().data();
   const auto occupied = [map](std::size_t i) { return DistanceField::occupied(map[i]); };
-  const auto open = [map](std::size_t i) { return !DistanceField::occupied(map[i]); };
-  std::vector<uint16_t> column(grid_.data().size());
+  uint16_t* cells = classes_.data();
+  // The column pass (cappedColumnDistances' to the cells that are not
+  // occupied) kept in the occupied cells' own entries, whose classes come
+  // after it: a cell that is not occupied is 0 from itself.
+  const uint16_t cap = values.inside_reach;
+  const auto column = [&](std::size_t i) { return occupied(i) ? cells[i] : uint16_t{0}; };
+  const auto below = [cap](uint16_t g) { return static_cast<uint16_t>(g < cap ? g + 1 : cap); };
   inSlices(threads, static_cast<std::size_t>(w), [&](std::size_t begin, std::size_t end) {
-    cappedColumnDistances(open, w, h, values.inside_reach, static_cast<int>(begin),
-                          static_cast<int>(end), column.data());
+    for (std::size_t x = begin; x < end; ++x) {
+      if (occupied(x)) cells[x] = cap;
+    }
+    for (std::size_t row = w; row < n; row += w) {
+      for (std::size_t i = row + begin; i < row + end; ++i) {
+        if (occupied(i)) cells[i] = below(column(i - w));
+      }
+    }
+    for (std::size_t row = n - w; row >= static_cast<std::size_t>(w);) {
+      row -= w;
+      for (std::size_t i = row + begin; i < row + end; ++i) {
+        if (occupied(i)) cells[i] = std::min(cells[i], below(column(i + w)));
+      }
+    }
   });
   // Along a row, the cell that is not occupied just before (after) a run of
   // occupied cells is nearer than any before (after) it: each run's row pass
@@ -188,9 +206,8 @@ void DistanceField::transformInside(const ValueClasses& values, int threads) {
         int b = a;
         while (b + 1 < w && occupied(row + b + 1)) ++b;
         const int first = std::max(a - 1, 0), last = std::min(b + 1, w - 1);
-        const int n = last - first + 1;
-        std::copy(&column[row + first], &column[row + first] + n, g.begin());
-        pass.run(g.data(), n, values.inside_reach, d.data());
+        for (int x = first; x <= last; ++x) g[x - first] = column(row + x);
+        pass.run(g.data(), last - first + 1, cap, d.data());
         for (int x = a; x <= b; ++x) {
           classes_[row + x] = ValueClasses::classOf(d[x - first], values.inside_cap,
                                                     values.of_inside, values.inside_cap_class);
