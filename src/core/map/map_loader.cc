@@ -142,6 +142,8 @@ struct RawImage {
   int height = 0;
   int channels = 0;
   std::vector<uint16_t> color_sum;
+  // An 8-bit grey image's pixels, in the file's bytes, in place of color_sum.
+  const unsigned char* gray = nullptr;
 };
 
 class PnmParser {
@@ -211,14 +213,14 @@ class PnmParser {
              std::to_string(available) + " (only " + std::to_string(available / row_bytes) +
              " of " + std::to_string(h) + " rows complete)");
       }
-      img.color_sum.assign(w * h, 0);
       const auto* p = reinterpret_cast<const unsigned char*>(buf_.data()) + pos_;
       if (bytes_per_sample == 1 && channels == 1 && maxval == 255) {
         // What map_saver writes: each byte is its own sum, and none can
-        // exceed maxval (a plain copy, at memory speed on a large map).
-        std::copy(p, p + samples, img.color_sum.begin());
+        // exceed maxval; read where it lies.
+        img.gray = p;
         return img;
       }
+      img.color_sum.assign(w * h, 0);
       for (uint64_t i = 0; i < samples; ++i) {
         // Netpbm stores 16-bit samples most significant byte first.
         const uint64_t v = bytes_per_sample == 2 ? (uint64_t{p[2 * i]} << 8) | p[2 * i + 1] : p[i];
@@ -469,11 +471,16 @@ OccupancyGrid loadMapImage(const MapMetadata& meta) {
   for (int s = 0; s < static_cast<int>(lut.size()); ++s) lut[s] = cellValue(s, img.channels, meta);
 
   // Image rows run top to bottom, grid rows bottom to top.
-  std::vector<int8_t> data(img.color_sum.size());
   const std::size_t w = img.width;
+  std::vector<int8_t> data(w * img.height);
   for (std::size_t row = 0; row < static_cast<std::size_t>(img.height); ++row) {
     const std::size_t src = (img.height - 1 - row) * w;
-    for (std::size_t col = 0; col < w; ++col) data[row * w + col] = lut[img.color_sum[src + col]];
+    int8_t* out = &data[row * w];
+    if (img.gray) {
+      for (std::size_t col = 0; col < w; ++col) out[col] = lut[img.gray[src + col]];
+    } else {
+      for (std::size_t col = 0; col < w; ++col) out[col] = lut[img.color_sum[src + col]];
+    }
   }
   try {
     return OccupancyGrid(img.width, img.height, meta.resolution, meta.origin, std::move(data));
