@@ -148,7 +148,7 @@ void DistanceField::transformOutside(const ValueClasses& values, int threads) {
   inSlices(threads, static_cast<std::size_t>(h), [&](std::size_t begin, std::size_t end) {
     CappedRowPass pass;
     std::vector<uint16_t> g(static_cast<std::size_t>(w));
-    std::vector<int64_t> d(static_cast<std::size_t>(w));
+    std::vector<int32_t> d(static_cast<std::size_t>(w));
     for (std::size_t y = begin; y < end; ++y) {
       uint16_t* row = cells + y * w;
       std::copy(row, row + w, g.begin());
@@ -195,7 +195,7 @@ void DistanceField::transformInside(const ValueClasses& values, int threads) {
   inSlices(threads, static_cast<std::size_t>(h), [&](std::size_t begin, std::size_t end) {
     CappedRowPass pass;
     std::vector<uint16_t> g(static_cast<std::size_t>(w));
-    std::vector<int64_t> d(static_cast<std::size_t>(w));
+    std::vector<int32_t> d(static_cast<std::size_t>(w));
     for (std::size_t y = begin; y < end; ++y) {
       const std::size_t row = y * w;
       for (int a = 0; a < w;) {

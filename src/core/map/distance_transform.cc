@@ -1,6 +1,7 @@
 #include "pf_localization/core/map/distance_transform.h"
 
 #include <algorithm>
+#include <cstdlib>
 #include <limits>
 #include <stdexcept>
 
@@ -82,7 +83,7 @@ std::vector<float> squaredDistanceTransform(const std::vector<bool>& is_source, 
   return out;
 }
 
-void CappedRowPass::run(const uint16_t* g, int n, uint16_t cap, int64_t* d) {
+void CappedRowPass::run(const uint16_t* g, int n, uint16_t cap, int32_t* d) {
   v_.resize(static_cast<std::size_t>(n));
   z_.resize(static_cast<std::size_t>(n) + 1);
   const auto f = [g](int p) { return static_cast<double>(g[p]) * g[p]; };
@@ -112,8 +113,8 @@ void CappedRowPass::run(const uint16_t* g, int n, uint16_t cap, int64_t* d) {
   int j = 0;
   for (int q = 0; q < n; ++q) {
     while (z_[j + 1] < q) ++j;
-    const int64_t dq = q - v_[j];
-    d[q] = dq * dq + static_cast<int64_t>(g[v_[j]]) * g[v_[j]];
+    const int dq = std::abs(q - v_[j]);
+    d[q] = dq < cap ? dq * dq + int32_t{g[v_[j]]} * g[v_[j]] : -1;
   }
 }
 

@@ -134,14 +134,14 @@ TEST(SquaredDistanceTransform, FarCornersOfALargerGridAreExact) {
 }
 
 // The capped passes on a whole grid: -1 where nothing is nearer than `cap` cells.
-std::vector<int64_t> cappedTransform(const std::vector<bool>& grid, int width, int height,
+std::vector<int32_t> cappedTransform(const std::vector<bool>& grid, int width, int height,
                                      uint16_t cap) {
   std::vector<uint16_t> column(grid.size());
   // In two slices of columns, as two threads would.
   const auto is_source = [&grid](std::size_t i) { return grid[i]; };
   cappedColumnDistances(is_source, width, height, cap, 0, width / 3, column.data());
   cappedColumnDistances(is_source, width, height, cap, width / 3, width, column.data());
-  std::vector<int64_t> out(grid.size());
+  std::vector<int32_t> out(grid.size());
   CappedRowPass pass;
   for (int y = 0; y < height; ++y) {
     pass.run(&column[static_cast<std::size_t>(y) * width], width, cap, &out[y * width]);
@@ -159,16 +159,16 @@ TEST(CappedDistanceTransform, ExactBelowTheCapOnRandomGrids) {
         std::vector<bool> grid(width * height);
         for (std::size_t i = 0; i < grid.size(); ++i) grid[i] = is_source(rng);
         const std::vector<float> exact = bruteForce(grid, width, height);
-        const std::vector<int64_t> capped = cappedTransform(grid, width, height, cap);
+        const std::vector<int32_t> capped = cappedTransform(grid, width, height, cap);
         for (std::size_t i = 0; i < grid.size(); ++i) {
           // Below cap^2 the value itself; at or past it, -1 or any value
           // at least cap^2 (a source in reach, another out of it).
           const std::string at = "cell (" + std::to_string(i % width) + ", " +
                                  std::to_string(i / width) + "), cap " + std::to_string(cap);
           if (exact[i] < static_cast<float>(cap) * cap) {
-            ASSERT_EQ(static_cast<int64_t>(exact[i]), capped[i]) << at;
+            ASSERT_EQ(static_cast<int32_t>(exact[i]), capped[i]) << at;
           } else {
-            ASSERT_TRUE(capped[i] == -1 || capped[i] >= int64_t{cap} * cap) << at;
+            ASSERT_TRUE(capped[i] == -1 || capped[i] >= int32_t{cap} * cap) << at;
           }
         }
       }
@@ -177,9 +177,9 @@ TEST(CappedDistanceTransform, ExactBelowTheCapOnRandomGrids) {
 }
 
 TEST(CappedDistanceTransform, NoSourceInReachIsMinusOne) {
-  const std::vector<int64_t> d = cappedTransform(sources(9, 1, {{0, 0}}), 9, 1, 3);
-  EXPECT_EQ((std::vector<int64_t>{0, 1, 4, 9, 16, 25, 36, 49, 64}), d);  // in the row: no cap
-  const std::vector<int64_t> none = cappedTransform(sources(3, 9, {{0, 0}}), 3, 9, 3);
+  const std::vector<int32_t> d = cappedTransform(sources(9, 1, {{0, 0}}), 9, 1, 3);
+  EXPECT_EQ((std::vector<int32_t>{0, 1, 4, -1, -1, -1, -1, -1, -1}), d);  // 3 columns: out of reach
+  const std::vector<int32_t> none = cappedTransform(sources(3, 9, {{0, 0}}), 3, 9, 3);
   EXPECT_EQ(0, none[0]);
   EXPECT_EQ(4, none[2 * 3]);
   EXPECT_EQ(-1, none[3 * 3]);  // three rows up: out of the column pass's reach

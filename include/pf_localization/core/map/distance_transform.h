@@ -60,11 +60,13 @@ void cappedColumnDistances(const IsSource& is_source, int width, int height, uin
 
 /// The row pass over one row of column distances g[0, n) from
 /// cappedColumnDistances with the same `cap`: d[x] = min over x' of
-/// (x - x')^2 + g[x']^2 over the sources with g[x'] < cap, or -1 where
-/// there is none. Keeps its scratch between rows.
+/// (x - x')^2 + g[x']^2 over the sources with g[x'] < cap, where that is
+/// below cap^2; -1 where there is no such source, and maybe where it is
+/// cap^2 or more (a source cap or more columns away). Keeps its scratch
+/// between rows.
 class CappedRowPass {
  public:
-  void run(const uint16_t* g, int n, uint16_t cap, int64_t* d);
+  void run(const uint16_t* g, int n, uint16_t cap, int32_t* d);
 
  private:
   std::vector<int> v_;     // the lower envelope's parabolas: their columns
