@@ -91,14 +91,18 @@ class NearObstacle {
  public:
   explicit NearObstacle(const DistanceField& field) : grid_(field.grid()) {
     const std::vector<float>& distances = field.classDistances();
-    std::vector<bool> near_class(distances.size());
+    std::vector<uint64_t> near_class(distances.size());
     for (std::size_t c = 0; c < distances.size(); ++c) {
-      near_class[c] = distances[c] <= 1.01 * grid_.resolution();
+      near_class[c] = distances[c] <= 1.01 * grid_.resolution() ? 1 : 0;
     }
+    // A word at a time, built in a register.
     bits_.assign((field.size() + 63) / 64, 0);
     const uint16_t* classes = field.classes();
-    for (std::size_t i = 0; i < field.size(); ++i) {
-      if (near_class[classes[i]]) bits_[i / 64] |= uint64_t{1} << (i % 64);
+    for (std::size_t w = 0; w < bits_.size(); ++w) {
+      const std::size_t first = w * 64, end = std::min(first + 64, field.size());
+      uint64_t word = 0;
+      for (std::size_t i = first; i < end; ++i) word |= near_class[classes[i]] << (i - first);
+      bits_[w] = word;
     }
   }
   const OccupancyGrid& grid() const { return grid_; }
@@ -161,10 +165,22 @@ Candidate refine(const NearObstacle& near, const std::vector<Eigen::Vector2d>& s
 std::vector<std::uint32_t> obstacleCells(const OccupancyGrid& grid) {
   std::vector<std::uint32_t> obstacles;
   const std::vector<int8_t>& cells = grid.data();
-  for (std::size_t i = 0; i < cells.size(); ++i) {
-    if (OccupancyGrid::classify(cells[i]) == CellState::kOccupied) {
-      obstacles.push_back(static_cast<std::uint32_t>(i));
+  const auto occupied = [&cells](std::size_t i) {
+    return OccupancyGrid::classify(cells[i]) == CellState::kOccupied;
+  };
+  // Most cells are not obstacles: 32 at a time are looked at together first.
+  constexpr std::size_t kChunk = 32;
+  std::size_t i = 0;
+  for (; i + kChunk <= cells.size(); i += kChunk) {
+    bool any = false;
+    for (std::size_t k = 0; k < kChunk; ++k) any |= occupied(i + k);
+    if (!any) continue;
+    for (std::size_t k = i; k < i + kChunk; ++k) {
+      if (occupied(k)) obstacles.push_back(static_cast<std::uint32_t>(k));
     }
+  }
+  for (; i < cells.size(); ++i) {
+    if (occupied(i)) obstacles.push_back(static_cast<std::uint32_t>(i));
   }
   return obstacles;
 }
