@@ -332,7 +332,7 @@ void BM_LikelihoodField(benchmark::State& state) {
   const pf::OccupancyGrid grid = pillarMap(static_cast<int>(state.range(0)));
   for (auto _ : state) {
     const pf::DistanceField field(grid, 2.0);
-    benchmark::DoNotOptimize(field.signedDistances().data());
+    benchmark::DoNotOptimize(field.classes());
   }
 }
 BENCHMARK(BM_LikelihoodField)->Arg(1000)->Arg(2000)->Arg(4000)->Unit(benchmark::kMillisecond);
