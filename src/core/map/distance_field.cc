@@ -146,13 +146,13 @@ void DistanceField::transformOutside(const ValueClasses& values, int threads) {
                           static_cast<int>(end), cells);
   });
   inSlices(threads, static_cast<std::size_t>(h), [&](std::size_t begin, std::size_t end) {
-    CappedRowPass pass;
+    RowPassScratch scratch;
     std::vector<uint16_t> g(static_cast<std::size_t>(w));
     std::vector<int32_t> d(static_cast<std::size_t>(w));
     for (std::size_t y = begin; y < end; ++y) {
       uint16_t* row = cells + y * w;
       std::copy(row, row + w, g.begin());
-      pass.run(g.data(), w, values.outside_reach, d.data());
+      cappedRowPass(g.data(), w, values.outside_reach, &scratch, d.data());
       for (int x = 0; x < w; ++x) {
         row[x] = ValueClasses::classOf(d[x], values.outside_cap, values.of_outside,
                                        values.outside_cap_class);
@@ -193,7 +193,7 @@ void DistanceField::transformInside(const ValueClasses& values, int threads) {
   // occupied cells is nearer than any before (after) it: each run's row pass
   // needs only the run and those two cells.
   inSlices(threads, static_cast<std::size_t>(h), [&](std::size_t begin, std::size_t end) {
-    CappedRowPass pass;
+    RowPassScratch scratch;
     std::vector<uint16_t> g(static_cast<std::size_t>(w));
     std::vector<int32_t> d(static_cast<std::size_t>(w));
     for (std::size_t y = begin; y < end; ++y) {
@@ -207,7 +207,7 @@ void DistanceField::transformInside(const ValueClasses& values, int threads) {
         while (b + 1 < w && occupied(row + b + 1)) ++b;
         const int first = std::max(a - 1, 0), last = std::min(b + 1, w - 1);
         for (int x = first; x <= last; ++x) g[x - first] = column(row + x);
-        pass.run(g.data(), last - first + 1, cap, d.data());
+        cappedRowPass(g.data(), last - first + 1, cap, &scratch, d.data());
         for (int x = a; x <= b; ++x) {
           classes_[row + x] = ValueClasses::classOf(d[x - first], values.inside_cap,
                                                     values.of_inside, values.inside_cap_class);

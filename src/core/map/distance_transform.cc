@@ -83,12 +83,14 @@ std::vector<float> squaredDistanceTransform(const std::vector<bool>& is_source, 
   return out;
 }
 
-void CappedRowPass::run(const uint16_t* g, int n, uint16_t cap, int32_t* d) {
-  v_.resize(static_cast<std::size_t>(n));
-  z_.resize(static_cast<std::size_t>(n) + 1);
+void cappedRowPass(const uint16_t* g, int n, uint16_t cap, RowPassScratch* scratch, int32_t* d) {
+  std::vector<int>& v = scratch->v;
+  std::vector<double>& z = scratch->z;
+  v.resize(static_cast<std::size_t>(n));
+  z.resize(static_cast<std::size_t>(n) + 1);
   const auto f = [g](int p) { return static_cast<double>(g[p]) * g[p]; };
   // Felzenszwalb-Huttenlocher's envelope (transform1d above), over the
-  // sources that can reach below the cap only; z_[0] is -inf, so once a
+  // sources that can reach below the cap only; z[0] is -inf, so once a
   // source is in, k never drops below 0.
   int k = -1;
   for (int q = 0; q < n; ++q) {
@@ -96,25 +98,25 @@ void CappedRowPass::run(const uint16_t* g, int n, uint16_t cap, int32_t* d) {
     const double fq = f(q) + static_cast<double>(q) * q;
     double s = -std::numeric_limits<double>::infinity();
     while (k >= 0) {
-      const int p = v_[k];
+      const int p = v[k];
       s = (fq - (f(p) + static_cast<double>(p) * p)) / (2.0 * (q - p));
-      if (s > z_[k]) break;
+      if (s > z[k]) break;
       --k;
     }
     ++k;
-    v_[k] = q;
-    z_[k] = s;
+    v[k] = q;
+    z[k] = s;
   }
   if (k < 0) {
     std::fill(d, d + n, -1);
     return;
   }
-  z_[k + 1] = std::numeric_limits<double>::infinity();
+  z[k + 1] = std::numeric_limits<double>::infinity();
   int j = 0;
   for (int q = 0; q < n; ++q) {
-    while (z_[j + 1] < q) ++j;
-    const int dq = std::abs(q - v_[j]);
-    d[q] = dq < cap ? dq * dq + int32_t{g[v_[j]]} * g[v_[j]] : -1;
+    while (z[j + 1] < q) ++j;
+    const int dq = std::abs(q - v[j]);
+    d[q] = dq < cap ? dq * dq + int32_t{g[v[j]]} * g[v[j]] : -1;
   }
 }
 

@@ -142,9 +142,10 @@ std::vector<int32_t> cappedTransform(const std::vector<bool>& grid, int width, i
   cappedColumnDistances(is_source, width, height, cap, 0, width / 3, column.data());
   cappedColumnDistances(is_source, width, height, cap, width / 3, width, column.data());
   std::vector<int32_t> out(grid.size());
-  CappedRowPass pass;
+  RowPassScratch scratch;
   for (int y = 0; y < height; ++y) {
-    pass.run(&column[static_cast<std::size_t>(y) * width], width, cap, &out[y * width]);
+    cappedRowPass(&column[static_cast<std::size_t>(y) * width], width, cap, &scratch,
+                  &out[y * width]);
   }
   return out;
 }

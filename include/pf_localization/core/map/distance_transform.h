@@ -58,19 +58,18 @@ void cappedColumnDistances(const IsSource& is_source, int width, int height, uin
   }
 }
 
+/// The scratch of cappedRowPass, kept between rows: the lower envelope's
+/// parabolas (their columns) and the boundaries between them.
+struct RowPassScratch {
+  std::vector<int> v;
+  std::vector<double> z;
+};
+
 /// The row pass over one row of column distances g[0, n) from
 /// cappedColumnDistances with the same `cap`: d[x] = min over x' of
 /// (x - x')^2 + g[x']^2 over the sources with g[x'] < cap, where that is
 /// below cap^2; -1 where there is no such source, and maybe where it is
-/// cap^2 or more (a source cap or more columns away). Keeps its scratch
-/// between rows.
-class CappedRowPass {
- public:
-  void run(const uint16_t* g, int n, uint16_t cap, int32_t* d);
-
- private:
-  std::vector<int> v_;     // the lower envelope's parabolas: their columns
-  std::vector<double> z_;  // the boundaries between them
-};
+/// cap^2 or more (a source cap or more columns away).
+void cappedRowPass(const uint16_t* g, int n, uint16_t cap, RowPassScratch* scratch, int32_t* d);
 
 }  // namespace pf
