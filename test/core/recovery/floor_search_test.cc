@@ -64,8 +64,8 @@ TEST(FloorSearch, NamesTheFloorTheScansComeFromAndNeverAnother) {
     ASSERT_NE(std::optional<std::size_t>(0), v.floor) << "step " << k << ": " << v.reason;
     if (v.floor && found_at < 0) found_at = static_cast<int>(k);
   }
-  // Once the filter on floor 1 has been localized for five updates while it
-  // explains every beam and floor 0's filter, localized too, 86-89 %.
+  // Once floor 1 has explained every beam for five updates while floor 0's
+  // filter, localized too, explains 86-89 %, and floor 1's is localized.
   EXPECT_GE(found_at, 0) << search.verdict().reason;
   EXPECT_LE(found_at, 20);
   EXPECT_LT(distance(path.back(), search.filter(1).estimate().pose), 0.2);
@@ -86,6 +86,29 @@ TEST(FloorSearch, NeverNamesOneOfTwoFloorsThatLookAlike) {
   EXPECT_TRUE(reason.find("cannot tell") != std::string::npos ||
               reason.find("not localized") != std::string::npos)
       << reason;
+}
+
+// Each floor's filter draws its own stream, from the filter's seed: floor 0
+// the seed itself; the same seed gives the same search, another seed another.
+TEST(FloorSearch, EachFloorDrawsItsOwnStreamFromTheSeed) {
+  EXPECT_EQ(7u, floorSeed(7, 0));
+  EXPECT_NE(floorSeed(7, 1), floorSeed(7, 0));
+  EXPECT_NE(floorSeed(7, 1), floorSeed(8, 1));
+  const OccupancyGrid b = floorB();
+  const auto run = [&](uint64_t seed) {
+    ParticleFilterParams params = searchParams();
+    params.seed = seed;
+    FloorSearch search(params, prepared({b, b}));
+    const std::vector<Pose2> path = drive();
+    for (std::size_t k = 0; k < 3; ++k) search.update(odomOf(path[k]), simulateScan(b, path[k]));
+    return std::vector<Pose2>{search.filter(0).estimate().pose, search.filter(1).estimate().pose};
+  };
+  const std::vector<Pose2> one = run(7), again = run(7), other = run(8);
+  EXPECT_EQ(one[0].x, again[0].x);
+  EXPECT_EQ(one[1].y, again[1].y);
+  // The same map on both floors: only the seeds tell their filters apart.
+  EXPECT_NE(one[0].x, one[1].x);
+  EXPECT_NE(one[0].x, other[0].x);
 }
 
 }  // namespace

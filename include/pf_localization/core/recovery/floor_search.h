@@ -8,8 +8,12 @@
 // that end within `fit_distance` of an obstacle of its map, seen from its
 // filter's estimate, averaged over its last `fit_updates` updates: how much
 // of the scans the floor's best hypothesis explains. The search names a
-// floor only when its filter has been localized for `found_updates` updates
-// in a row and its fit exceeds every other floor's by `min_fit_margin`.
+// floor only when its fit has exceeded every other floor's by
+// `min_fit_margin` for `found_updates` updates in a row and its filter is
+// localized. The two confirmations run side by side, not one after the
+// other: "localized" already holds a new place for settle_updates updates
+// (confidence.h, holdAfterJump), and a run counted only from then on would
+// repeat that wait.
 // Being localized alone does not tell floors apart: on a floor of the same
 // outline laid out otherwise, a filter finds a pose where the beams end
 // within confidence.h's hit distance (0.4 m) as well (in the test, both
@@ -27,6 +31,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -39,7 +44,7 @@
 namespace pf {
 
 struct FloorSearchParams {
-  int found_updates = 5;        // updates in a row localized on the floor found
+  int found_updates = 5;        // updates in a row the floor found fits best by the margin
   int fit_updates = 5;          // a floor's fit: averaged over this many updates
   double fit_distance = 0.1;    // m: a beam ending this close to an obstacle is explained
   double min_fit_margin = 0.1;  // the floor found explains this share more than every other
@@ -50,12 +55,19 @@ struct FloorSearchParams {
 double explainedShare(const DistanceField& field, const ScanGroup& scans, const Pose2& robot,
                       double distance);
 
+/// Floor `floor`'s filter's seed in a search with `seed` (the filter's):
+/// floor 0 takes it, each other floor its own stream (the seed moved by the
+/// golden-ratio increment splitmix64 steps by), so that the floors' filters
+/// draw independently, and the same seed gives the same search.
+uint64_t floorSeed(uint64_t seed, std::size_t floor);
+
 class FloorSearch {
  public:
   /// `maps[i]`: floor i's map, moved into floor i's filter (release()
   /// hands them back), `names[i]` its name in the verdict's reason (none:
-  /// "floor i"). Each filter has `params`; starts them globally. Throws
-  /// std::invalid_argument for no map or invalid parameters.
+  /// "floor i"). Each filter has `params`, with floorSeed(params.seed, i)
+  /// for its seed; starts them globally. Throws std::invalid_argument for no
+  /// map or invalid parameters.
   FloorSearch(const ParticleFilterParams& params, std::vector<PreparedMap> maps,
               std::vector<std::string> names = {}, FloorSearchParams search = {});
 
@@ -84,10 +96,14 @@ class FloorSearch {
   FloorSearchParams params_;
   std::vector<std::string> names_;
   std::vector<std::unique_ptr<ParticleFilter>> filters_;
-  std::vector<int> localized_run_;         // per floor: updates in a row localized
+  std::vector<int> lead_run_;              // per floor: updates in a row ahead by the margin
   std::vector<std::vector<double>> fits_;  // per floor: the last updates' explained shares
   // Floor `floor`'s fit: the mean of fits_[floor] (0 before an update).
   double fit(std::size_t floor) const;
+  // The floor with the highest fit (the first of equals).
+  std::size_t bestFit() const;
+  // A floor other than `best` whose fit is within the margin of best's.
+  std::optional<std::size_t> closeTo(std::size_t best) const;
 };
 
 }  // namespace pf
