@@ -167,13 +167,9 @@ MapChangeLayer::MapChangeLayer(const DistanceField& field)
       frame_(field.grid()),
       tiles_x_((width_ + kTileSize - 1) >> kTileBits) {
   const OccupancyGrid& grid = field.grid();
-  // What a free cell is by its distance's class (distance_field.h), then a
-  // cell at a time without a branch on its state.
-  const std::vector<float>& distances = field.classDistances();
-  std::vector<std::uint8_t> free_as(distances.size());
-  for (std::size_t c = 0; c < distances.size(); ++c) {
-    free_as[c] = distances[c] <= kBesideObstacle ? kMapBeside : kMapFree;
-  }
+  // A free cell is beside an obstacle when its distance's class is below
+  // `beside` (distance_field.h); a cell at a time, without a branch on its state.
+  const std::size_t beside = field.classesWithin(kBesideObstacle);
   std::uint8_t as[3] = {};
   as[static_cast<int>(CellState::kOccupied)] = kMapOccupied;
   as[static_cast<int>(CellState::kUnknown)] = kMapUnknown;
@@ -182,7 +178,8 @@ MapChangeLayer::MapChangeLayer(const DistanceField& field)
   cells_.resize(grid.data().size());
   for (std::size_t i = 0; i < cells_.size(); ++i) {
     const CellState state = OccupancyGrid::classify(data[i]);
-    cells_[i] = state == CellState::kFree ? free_as[classes[i]] : as[static_cast<int>(state)];
+    const std::uint8_t free = classes[i] < beside ? kMapBeside : kMapFree;
+    cells_[i] = state == CellState::kFree ? free : as[static_cast<int>(state)];
   }
   tiles_.resize(static_cast<std::size_t>(tiles_x_) * ((height_ + kTileSize - 1) >> kTileBits));
 }

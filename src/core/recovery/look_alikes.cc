@@ -90,18 +90,17 @@ void peaks(const std::vector<double>& values, int p, double threshold, Keep keep
 class NearObstacle {
  public:
   explicit NearObstacle(const DistanceField& field) : grid_(field.grid()) {
-    const std::vector<float>& distances = field.classDistances();
-    std::vector<uint64_t> near_class(distances.size());
-    for (std::size_t c = 0; c < distances.size(); ++c) {
-      near_class[c] = distances[c] <= 1.01 * grid_.resolution() ? 1 : 0;
-    }
+    // Within 1.01 cells: a class below `within` (distance_field.h).
+    const std::size_t within = field.classesWithin(1.01 * grid_.resolution());
     // A word at a time, built in a register.
     bits_.assign((field.size() + 63) / 64, 0);
     const uint16_t* classes = field.classes();
     for (std::size_t w = 0; w < bits_.size(); ++w) {
       const std::size_t first = w * 64, end = std::min(first + 64, field.size());
       uint64_t word = 0;
-      for (std::size_t i = first; i < end; ++i) word |= near_class[classes[i]] << (i - first);
+      for (std::size_t i = first; i < end; ++i) {
+        word |= static_cast<uint64_t>(classes[i] < within) << (i - first);
+      }
       bits_[w] = word;
     }
   }

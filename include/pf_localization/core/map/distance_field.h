@@ -22,6 +22,7 @@
 // cells would need more, and then neighbouring values share a class.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -73,7 +74,15 @@ class DistanceField {
   /// classSurfaceDistances()[class]. One more entry follows the last cell,
   /// so that a four-byte read at any cell stays inside.
   const uint16_t* classes() const { return classes_.data(); }
+  /// Classes are numbered in increasing order of their values, so their
+  /// distances never decrease: a cell lies within `d` metres of an
+  /// obstacle exactly when its class is below classesWithin(d).
   const std::vector<float>& classDistances() const { return distances_; }
+  std::size_t classesWithin(double d) const {
+    return static_cast<std::size_t>(std::upper_bound(distances_.begin(), distances_.end(), d,
+                                                     [](double v, float c) { return v < c; }) -
+                                    distances_.begin());
+  }
   const std::vector<float>& classSurfaceDistances() const { return surfaces_; }
 
  private:
