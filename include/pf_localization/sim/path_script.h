@@ -12,9 +12,11 @@
 //   wait t                 stand still for t seconds
 //   velocity v w t         drive at v m/s turning at w rad/s for t seconds (an arc)
 //   teleport x y yaw       move the true pose instantly, wheels still (a kidnapping)
-//   person x1 y1 x2 y2 v   a person (seen as a 0.2 m radius circle) walking to
+//   person x1 y1 x2 y2 v [pause]
+//                          a person (seen as a 0.2 m radius circle) walking to
 //                          and fro between two points at v m/s, for the whole
-//                          run; people are not on the map and may cross the robot
+//                          run, standing `pause` s at each end (default 0);
+//                          people are not on the map and may cross the robot
 //
 // A script compiles to a list of constant-velocity motions. The true pose
 // follows them exactly, so whether the robot stays in free space can be
@@ -55,7 +57,9 @@ struct Person {
   double x1 = 0.0, y1 = 0.0, x2 = 0.0, y2 = 0.0;  // m
   double speed = 0.0;                             // m/s
   double radius = 0.2;                            // m
-  /// Centre at time t (s): a triangle wave between the two end points.
+  double pause = 0.0;  // s standing at each end before turning back
+  /// Centre at time t (s): a triangle wave between the two end points,
+  /// flat for `pause` at each end (a person lingering there).
   void positionAt(double t, double* x, double* y) const;
 };
 
