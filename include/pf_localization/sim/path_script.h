@@ -57,7 +57,7 @@ struct Person {
   double x1 = 0.0, y1 = 0.0, x2 = 0.0, y2 = 0.0;  // m
   double speed = 0.0;                             // m/s
   double radius = 0.2;                            // m
-  double pause = 0.0;  // s standing at each end before turning back
+  double pause = 0.0;                             // s standing at each end before turning back
   /// Centre at time t (s): a triangle wave between the two end points,
   /// flat for `pause` at each end (a person lingering there).
   void positionAt(double t, double* x, double* y) const;

@@ -28,6 +28,17 @@ void putReal(std::string* out, double d) {
   for (int k = 0; k < 8; ++k) out->push_back(static_cast<char>(bits >> (8 * k) & 0xff));
 }
 
+// A place's coordinate as an unsigned number, small for small magnitudes
+// (protocol buffers' zigzag), and back.
+std::uint64_t zigzag(std::int16_t v) {
+  return static_cast<std::uint64_t>(v < 0 ? -2 * static_cast<int>(v) - 1 : 2 * static_cast<int>(v));
+}
+
+std::int16_t unzigzag(std::uint64_t u) {
+  return static_cast<std::int16_t>(u & 1 ? -static_cast<int>((u + 1) / 2)
+                                         : static_cast<int>(u / 2));
+}
+
 // Reads what putNumber and putReal wrote; past the end, or a number longer
 // than 64 bits, it stops being ok() and gives zeros.
 class ByteReader {
@@ -102,10 +113,19 @@ void MapChangeLayer::count(std::size_t i, Kind kind) {
   weigh(shown(i), c, false);
   switch (kind) {
     case kHit:
+      if (c.hits == 0) {
+        c.hit_x = place_x_;
+        c.hit_y = place_y_;
+      } else if (std::hypot(place_x_ - c.hit_x, place_y_ - c.hit_y) * kPlaceUnit >= kMinBaseline) {
+        c.apart = 1;
+      }
       bump(&c.hits);
+      c.clear = 0;
       break;
     case kFree:
       bump(&c.free);
+      // A scan that also hit the cell leaves it hit.
+      if (!(c.counted & kHit) && c.clear < std::numeric_limits<std::uint8_t>::max()) ++c.clear;
       break;
     case kPass:
       bump(&c.passes);
@@ -200,6 +220,11 @@ bool MapChangeLayer::wants(const Pose2& robot) const {
 }
 
 void MapChangeLayer::add(const ScanGroup& scans, const Pose2& robot) {
+  const auto place = [](double v) {
+    return static_cast<std::int16_t>(std::clamp(std::lround(v / kPlaceUnit), -32767L, 32767L));
+  };
+  place_x_ = place(robot.x);
+  place_y_ = place(robot.y);
   for (const LaserScan& scan : scans) {
     const std::size_t n = scan.ranges.size();
     const Pose2 base = compose(robot, scan.robot_offset);
@@ -288,7 +313,9 @@ MapChangeLayer::Cell MapChangeLayer::classify(std::size_t i) const {
   const Counts& c = countsAt(i);
   const int hits = c.hits, passes = c.passes;
   const int stopped = hits + c.free, reached = passes + c.ends;
-  if (hits >= kMinScans && hits >= kChangedShare * stopped) return Cell::kAdded;
+  if (hits >= kMinScans && hits >= kChangedShare * stopped && c.apart && c.clear < kClearScans) {
+    return Cell::kAdded;
+  }
   if (passes >= kMinScans && passes >= kChangedShare * reached) return Cell::kRemoved;
   return Cell::kAsMapped;
 }
@@ -346,6 +373,10 @@ std::string MapChangeLayer::encode() const {
       if (c.hits == 0 && c.free == 0 && c.passes == 0 && c.ends == 0) continue;
       putNumber(&cells, k - last_cell);
       for (const std::uint16_t v : {c.hits, c.free, c.passes, c.ends}) putNumber(&cells, v);
+      putNumber(&cells, c.clear);
+      putNumber(&cells, c.apart);
+      putNumber(&cells, zigzag(c.hit_x));
+      putNumber(&cells, zigzag(c.hit_y));
       last_cell = k;
       ++counted;
     }
@@ -417,7 +448,13 @@ std::string MapChangeLayer::restore(const std::string& bytes) {
       const std::uint64_t cell_step = in.number();
       std::uint64_t v[4];
       for (std::uint64_t& x : v) x = in.number();
+      const std::uint64_t clear = in.number(), apart = in.number();
+      const std::uint64_t hit_x = in.number(), hit_y = in.number();
       if (!in.ok()) return "truncated in the counts";
+      if (clear > std::numeric_limits<std::uint8_t>::max() || apart > 1 || hit_x > 0xffff ||
+          hit_y > 0xffff || (v[0] == 0 && (apart || hit_x || hit_y)) || (v[1] == 0 && clear)) {
+        return "corrupt: a cell's places or clear scans are not ones the layer gives";
+      }
       j += cell_step;
       const std::size_t x = (t % tiles_x_) * kTileSize + (j & (kTileSize - 1));
       const std::size_t y = (t / tiles_x_) * kTileSize + (j >> kTileBits);
@@ -431,6 +468,10 @@ std::string MapChangeLayer::restore(const std::string& bytes) {
       c.free = static_cast<std::uint16_t>(v[1]);
       c.passes = static_cast<std::uint16_t>(v[2]);
       c.ends = static_cast<std::uint16_t>(v[3]);
+      c.clear = static_cast<std::uint8_t>(clear);
+      c.apart = static_cast<std::uint8_t>(apart);
+      c.hit_x = unzigzag(hit_x);
+      c.hit_y = unzigzag(hit_y);
       // Counted in an earlier scan than the next one added.
       c.scan = static_cast<std::uint16_t>(scans - 1);
     }
