@@ -17,7 +17,7 @@
 # The cases after the committed bags are simulated here, not committed
 # (pf_simulator from bags/CASE.path, bags/CASE.changes and the seed below,
 # into DIR/CASE/CASE.bag): maps out of date both ways with people walking
-# through. Their rows must meet the targets of docs/how-it-works/map.md,
+# through. Their rows must meet the targets of docs/design.md,
 # "People are not walls" (TARGETS below); the script exits 1 when one does
 # not.
 #
@@ -130,7 +130,7 @@ out, seeds = sys.argv[2], int(sys.argv[3])
 bags = [b.lstrip('+') for b in sys.argv[4:] if b not in ('', '+')]
 simulated = {b[1:] for b in sys.argv[4:] if b.startswith('+') and len(b) > 1}
 LOST_M = 0.5
-# The targets of the simulated cases (docs/how-it-works/map.md, "People are
+# The targets of the simulated cases (docs/design.md, "People are
 # not walls"): each seed's figure, the lowest over the seeds for precision
 # and recall, the highest for ATE (after the first 10 s for its max).
 TARGETS = {'added_precision_min': 0.9, 'added_recall_min': 0.6, 'removed_precision_min': 0.95,

@@ -114,6 +114,7 @@ void MapChangeLayer::count(std::size_t i, Kind kind) {
   switch (kind) {
     case kHit:
       if (c.hits == 0) {
+        c.moved_in = (cells_[i] & kPassedBits) >= kMovedInPasses * kPassedOne;
         c.hit_x = place_x_;
         c.hit_y = place_y_;
       } else if (std::hypot(place_x_ - c.hit_x, place_y_ - c.hit_y) * kPlaceUnit >= kMinBaseline) {
@@ -257,6 +258,7 @@ void MapChangeLayer::walk(double x, double y, double ux, double uy, double range
   const double delta_y = uy != 0.0 ? std::abs(1.0 / uy) : inf;
   double next_x = ux != 0.0 ? (cx + (step_x > 0 ? 1 : 0) - x) / ux : inf;
   double next_y = uy != 0.0 ? (cy + (step_y > 0 ? 1 : 0) - y) / uy : inf;
+  const double moved_in_reach = kMovedInRange * frame_.cellsPerMetre();
   double t = 0.0;
   while (t <= length && cx >= 0 && cy >= 0 && cx < width_ && cy < height_) {
     // Most cells are free, and only their byte is touched.
@@ -269,6 +271,8 @@ void MapChangeLayer::walk(double x, double y, double ux, double uy, double range
         count(i, kPass);
       } else if (cell & kWasHit) {
         count(i, kFree);
+      } else if (map == kMapFree && (cell & kPassedBits) != kPassedBits && t <= moved_in_reach) {
+        cell = static_cast<std::uint8_t>(cell + kPassedOne);
       }
     }
     if (next_x < next_y) {
@@ -313,7 +317,8 @@ MapChangeLayer::Cell MapChangeLayer::classify(std::size_t i) const {
   const Counts& c = countsAt(i);
   const int hits = c.hits, passes = c.passes;
   const int stopped = hits + c.free, reached = passes + c.ends;
-  if (hits >= kMinScans && hits >= kChangedShare * stopped && c.apart && c.clear < kClearScans) {
+  if (hits >= kMinScans && hits >= kChangedShare * stopped && c.apart && c.clear < kClearScans &&
+      (!c.moved_in || hits >= kMovedInScans)) {
     return Cell::kAdded;
   }
   if (passes >= kMinScans && passes >= kChangedShare * reached) return Cell::kRemoved;
@@ -374,7 +379,7 @@ std::string MapChangeLayer::encode() const {
       putNumber(&cells, k - last_cell);
       for (const std::uint16_t v : {c.hits, c.free, c.passes, c.ends}) putNumber(&cells, v);
       putNumber(&cells, c.clear);
-      putNumber(&cells, c.apart);
+      putNumber(&cells, c.apart | c.moved_in << 1);
       putNumber(&cells, zigzag(c.hit_x));
       putNumber(&cells, zigzag(c.hit_y));
       last_cell = k;
@@ -418,13 +423,13 @@ std::string MapChangeLayer::restore(const std::string& bytes) {
     const std::uint8_t cell = static_cast<std::uint8_t>(state << kStateShift);
     const auto shown_as = static_cast<Cell>(cell >> kShownShift & 3);
     const bool seen = cell & kSeen;
-    if (cell >> kStateShift != state || (cell & ~(kSeen | kWasHit | kShownBits)) ||
-        seen != (shown_as != Cell::kUnseen) || ((cell & kWasHit) && !seen)) {
+    if (cell >> kStateShift != state || (cell & ~(kSeen | kWasHit | kShownBits | kPassedBits)) ||
+        seen != (shown_as != Cell::kUnseen) || ((cell & (kWasHit | kPassedBits)) && !seen)) {
       return "corrupt: a cell's state is not one the layer gives";
     }
     for (std::size_t k = i; state != 0 && k < i + run; ++k) {
       const std::uint8_t map = cells_[k] & kMapBits;
-      if (map == kMapUnknown || ((cell & kWasHit) && map != kMapFree)) {
+      if (map == kMapUnknown || ((cell & (kWasHit | kPassedBits)) && map != kMapFree)) {
         return "a cell seen here is unknown on this map, or a beam ended in an obstacle";
       }
       cells_[k] = map | cell;
@@ -451,7 +456,7 @@ std::string MapChangeLayer::restore(const std::string& bytes) {
       const std::uint64_t clear = in.number(), apart = in.number();
       const std::uint64_t hit_x = in.number(), hit_y = in.number();
       if (!in.ok()) return "truncated in the counts";
-      if (clear > std::numeric_limits<std::uint8_t>::max() || apart > 1 || hit_x > 0xffff ||
+      if (clear > std::numeric_limits<std::uint8_t>::max() || apart > 3 || hit_x > 0xffff ||
           hit_y > 0xffff || (v[0] == 0 && (apart || hit_x || hit_y)) || (v[1] == 0 && clear)) {
         return "corrupt: a cell's places or clear scans are not ones the layer gives";
       }
@@ -469,7 +474,8 @@ std::string MapChangeLayer::restore(const std::string& bytes) {
       c.passes = static_cast<std::uint16_t>(v[2]);
       c.ends = static_cast<std::uint16_t>(v[3]);
       c.clear = static_cast<std::uint8_t>(clear);
-      c.apart = static_cast<std::uint8_t>(apart);
+      c.apart = static_cast<std::uint8_t>(apart & 1);
+      c.moved_in = static_cast<std::uint8_t>(apart >> 1);
       c.hit_x = unzigzag(hit_x);
       c.hit_y = unzigzag(hit_y);
       // Counted in an earlier scan than the next one added.

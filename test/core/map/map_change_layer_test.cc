@@ -117,17 +117,49 @@ TEST(MapChangeLayer, SomeoneStandingByIsNotAWall) {
   EXPECT_GE(cellsIn(layer, map, kAdded, MapChangeLayer::Cell::kAdded), 5);
   EXPECT_EQ(static_cast<std::size_t>(cellsIn(layer, map, kAdded, MapChangeLayer::Cell::kAdded)),
             added);
-  // ...and once the place is seen empty (kClearScans scans), from wherever,
-  // it is gone from the layer, however many scans hit it before: the person
-  // left. One scan through it is not enough (a beam grazing a face).
+  // ...and once the place is seen empty (kClearScans scans in a row), from
+  // wherever, it is gone from the layer, however many scans hit it before:
+  // the person left. Fewer scans through it are not enough (a beam grazing
+  // a face).
   const Pose2 r{p.x - 0.3, p.y + 0.2, 0.4};
-  layer.add(scan360(map, r), r);
-  EXPECT_EQ(added, layer.summary().added);
+  for (int k = 1; k < MapChangeLayer::kClearScans; ++k) {
+    layer.add(scan360(map, r), r);
+    EXPECT_EQ(added, layer.summary().added) << k;
+  }
   layer.add(scan360(map, p), p);
   EXPECT_EQ(0u, layer.summary().added);
   // Seen again from two places, it is back.
   layer.add(scan360(world(), p), p);
   EXPECT_GT(layer.summary().added, 0u);
+}
+
+TEST(MapChangeLayer, WhatMovedInWhileTheRobotLookedIsNotAWall) {
+  // The box's place seen empty from nearby (within kMovedInRange) before
+  // anything stood there: what stops the beams there later came while the
+  // robot looked, a person walking up, and is added only after
+  // kMovedInScans scans hit it, however many places they came from.
+  const OccupancyGrid map = mapOf();
+  const DistanceField field(map, 2.0);
+  MapChangeLayer layer(field);
+  const Pose2 near{3.2, 2.0, 0.0};  // 0.8 m from the box's west face
+  for (int k = 0; k < MapChangeLayer::kMovedInPasses; ++k) {
+    const Pose2 p{near.x, near.y + 0.05 * k, 0.6 * k};
+    layer.add(scan360(map, p), p);
+  }
+  const std::vector<Pose2> places = {{3.0, 2.0, 0.0},  {2.6, 1.2, 0.5}, {2.0, 1.0, 1.6},
+                                     {3.2, 2.8, -2.0}, {2.5, 2.2, 3.0}, {3.0, 1.0, 0.3},
+                                     {2.2, 2.9, -0.5}, {3.1, 3.1, -1.0}};
+  for (std::size_t k = 0; k + 1 < static_cast<std::size_t>(MapChangeLayer::kMovedInScans); ++k) {
+    layer.add(scan360(world(), places[k]), places[k]);
+  }
+  // The west face, passed from near before, is not added yet...
+  const Box west{kAdded.x0 - 0.05, kAdded.y0 + 0.1, kAdded.x0 + 0.05, kAdded.y1 - 0.1};
+  EXPECT_EQ(0, cellsIn(layer, map, west, MapChangeLayer::Cell::kAdded));
+  // ...and is, a pallet put down for good, once kMovedInScans hit it.
+  for (int round = 0; round < 3; ++round) {
+    for (const Pose2& p : places) layer.add(scan360(world(), p), p);
+  }
+  EXPECT_GT(cellsIn(layer, map, west, MapChangeLayer::Cell::kAdded), 5);
 }
 
 TEST(MapChangeLayer, ListsEachCellThatBecameOrStoppedBeingAChange) {
