@@ -101,10 +101,9 @@ PathScript parsePathScript(std::istream& in, const std::string& file) {
       pose = {a[0], a[1], normalizeAngle(a[2])};
       script.motions.push_back({true, 0.0, 0.0, 0.0, pose, line});
     } else if (cmd == "person") {
-      const auto a = words.size() == 7 ? p.numbers(6, "person x1 y1 x2 y2 speed [pause]")
-                                       : p.numbers(5, "person x1 y1 x2 y2 speed [pause]");
+      const auto a = p.numbers(words.size() == 7 ? 6 : 5, "person x1 y1 x2 y2 speed [pause]");
       if (a[4] < 0.0) p.fail("person speed must not be negative");
-      if (a.size() == 6 && a[5] < 0.0) p.fail("person pause must not be negative");
+      if (a.back() < 0.0) p.fail("person pause must not be negative");
       script.people.push_back({a[0], a[1], a[2], a[3], a[4]});
       if (a.size() == 6) script.people.back().pause = a[5];
     } else {

@@ -74,6 +74,28 @@ class ByteReader {
   bool ok_ = true;
 };
 
+// A cell's counts as encode() writes them, after the cell's index: hits,
+// free, passes, ends, clear, apart | moved_in << 1, hit_x and hit_y
+// zigzagged; into *c when they are ones the layer gives.
+template <class Counts>
+bool fillCounts(const std::uint64_t (&v)[8], Counts* c) {
+  if (*std::max_element(v, v + 4) > std::numeric_limits<std::uint16_t>::max() ||
+      v[4] > std::numeric_limits<std::uint8_t>::max() || v[5] > 3 || v[6] > 0xffff ||
+      v[7] > 0xffff || (v[0] == 0 && (v[5] || v[6] || v[7])) || (v[1] == 0 && v[4])) {
+    return false;
+  }
+  c->hits = static_cast<std::uint16_t>(v[0]);
+  c->free = static_cast<std::uint16_t>(v[1]);
+  c->passes = static_cast<std::uint16_t>(v[2]);
+  c->ends = static_cast<std::uint16_t>(v[3]);
+  c->clear = static_cast<std::uint8_t>(v[4]);
+  c->apart = static_cast<std::uint8_t>(v[5] & 1);
+  c->moved_in = static_cast<std::uint8_t>(v[5] >> 1);
+  c->hit_x = unzigzag(v[6]);
+  c->hit_y = unzigzag(v[7]);
+  return true;
+}
+
 // The bits of a cell's byte encode() keeps: all but what the map has there.
 constexpr int kStateShift = 2;
 constexpr std::uint64_t kStateBytes = 0xfcfcfcfcfcfcfcfcull;  // of 8 cells at once
@@ -451,33 +473,18 @@ std::string MapChangeLayer::restore(const std::string& bytes) {
     std::size_t j = 0;
     for (std::uint64_t m = 0; m < counted; ++m) {
       const std::uint64_t cell_step = in.number();
-      std::uint64_t v[4];
+      std::uint64_t v[8];
       for (std::uint64_t& x : v) x = in.number();
-      const std::uint64_t clear = in.number(), apart = in.number();
-      const std::uint64_t hit_x = in.number(), hit_y = in.number();
       if (!in.ok()) return "truncated in the counts";
-      if (clear > std::numeric_limits<std::uint8_t>::max() || apart > 3 || hit_x > 0xffff ||
-          hit_y > 0xffff || (v[0] == 0 && (apart || hit_x || hit_y)) || (v[1] == 0 && clear)) {
-        return "corrupt: a cell's places or clear scans are not ones the layer gives";
-      }
       j += cell_step;
       const std::size_t x = (t % tiles_x_) * kTileSize + (j & (kTileSize - 1));
       const std::size_t y = (t / tiles_x_) * kTileSize + (j >> kTileBits);
       if ((m > 0 && cell_step == 0) || j >= kTileSize * kTileSize || x >= std::size_t(width_) ||
-          y >= std::size_t(height_) || !(cells_[y * width_ + x] & kSeen) ||
-          *std::max_element(v, v + 4) > std::numeric_limits<std::uint16_t>::max()) {
+          y >= std::size_t(height_) || !(cells_[y * width_ + x] & kSeen)) {
         return "corrupt: counts out of order, out of the map or of an unseen cell";
       }
       Counts& c = tiles_[t][j];
-      c.hits = static_cast<std::uint16_t>(v[0]);
-      c.free = static_cast<std::uint16_t>(v[1]);
-      c.passes = static_cast<std::uint16_t>(v[2]);
-      c.ends = static_cast<std::uint16_t>(v[3]);
-      c.clear = static_cast<std::uint8_t>(clear);
-      c.apart = static_cast<std::uint8_t>(apart & 1);
-      c.moved_in = static_cast<std::uint8_t>(apart >> 1);
-      c.hit_x = unzigzag(hit_x);
-      c.hit_y = unzigzag(hit_y);
+      if (!fillCounts(v, &c)) return "corrupt: a cell's counts are not ones the layer gives";
       // Counted in an earlier scan than the next one added.
       c.scan = static_cast<std::uint16_t>(scans - 1);
     }
