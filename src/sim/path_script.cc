@@ -12,7 +12,14 @@ namespace pf::sim {
 void Person::positionAt(double t, double* x, double* y) const {
   const double length = std::hypot(x2 - x1, y2 - y1);
   double s = 0.0;
-  if (length > 0.0 && speed > 0.0) {
+  if (length > 0.0 && speed > 0.0 && pause > 0.0) {
+    const double leg = length / speed;
+    const double u = std::fmod(t, 2.0 * (leg + pause));  // out, stand, back, stand
+    s = u < leg                 ? u / leg
+        : u < leg + pause       ? 1.0
+        : u < 2.0 * leg + pause ? 1.0 - (u - leg - pause) / leg
+                                : 0.0;
+  } else if (length > 0.0 && speed > 0.0) {
     s = std::fmod(speed * t, 2.0 * length);
     if (s > length) s = 2.0 * length - s;  // on the way back
     s /= length;
@@ -96,9 +103,11 @@ PathScript parsePathScript(std::istream& in, const std::string& file) {
     } else if (cmd == "floor") {
       script.motions.push_back({false, 0.0, 0.0, 0.0, {}, line, p.word("floor NAME")});
     } else if (cmd == "person") {
-      const auto a = p.numbers(5, "person x1 y1 x2 y2 speed");
+      const auto a = p.numbers(words.size() == 7 ? 6 : 5, "person x1 y1 x2 y2 speed [pause]");
       if (a[4] < 0.0) p.fail("person speed must not be negative");
+      if (a.back() < 0.0) p.fail("person pause must not be negative");
       script.people.push_back({a[0], a[1], a[2], a[3], a[4]});
+      if (a.size() == 6) script.people.back().pause = a[5];
     } else {
       p.fail("unknown command '" + cmd +
              "' (expected start, speed, goto, turn, wait, velocity, teleport, floor or person)");

@@ -80,6 +80,25 @@ TEST(PersonTest, WalksToAndFro) {
   EXPECT_DOUBLE_EQ(y, 0.0);
 }
 
+TEST(PersonTest, StandsAtEachEndForItsPause) {
+  const PathScript s = parse("person 0 0 2 0 0.5 3\nstart 0 0 0\n");
+  ASSERT_EQ(s.people.size(), 1u);
+  const Person& p = s.people[0];
+  EXPECT_DOUBLE_EQ(p.pause, 3.0);
+  double x, y;
+  p.positionAt(2.0, &x, &y);  // 1 m out
+  EXPECT_DOUBLE_EQ(x, 1.0);
+  p.positionAt(4.5, &x, &y);  // standing at the far end (4 to 7 s)
+  EXPECT_DOUBLE_EQ(x, 2.0);
+  p.positionAt(9.0, &x, &y);  // 1 m back
+  EXPECT_DOUBLE_EQ(x, 1.0);
+  p.positionAt(13.0, &x, &y);  // standing at the near end (11 to 14 s)
+  EXPECT_DOUBLE_EQ(x, 0.0);
+  p.positionAt(16.0, &x, &y);  // out again
+  EXPECT_DOUBLE_EQ(x, 1.0);
+  EXPECT_DOUBLE_EQ(y, 0.0);
+}
+
 TEST(PathScriptTest, ErrorsNameFileAndLine) {
   EXPECT_EQ(errorOf("start 0 0 0\n\nfly 1 2\n"),
             "test.path:3: unknown command 'fly' (expected start, speed, goto, turn, wait, "

@@ -15,9 +15,11 @@
 //   floor NAME             from here on the robot is on floor NAME of the building
 //                          (a lift ride: wait in the lift before and after it);
 //                          the world the sensors see is that floor's map
-//   person x1 y1 x2 y2 v   a person (seen as a 0.2 m radius circle) walking to
+//   person x1 y1 x2 y2 v [pause]
+//                          a person (seen as a 0.2 m radius circle) walking to
 //                          and fro between two points at v m/s, for the whole
-//                          run; people are not on the map and may cross the robot
+//                          run, standing `pause` s at each end (default 0);
+//                          people are not on the map and may cross the robot
 //
 // A script compiles to a list of constant-velocity motions. The true pose
 // follows them exactly, so whether the robot stays in free space can be
@@ -60,7 +62,9 @@ struct Person {
   double x1 = 0.0, y1 = 0.0, x2 = 0.0, y2 = 0.0;  // m
   double speed = 0.0;                             // m/s
   double radius = 0.2;                            // m
-  /// Centre at time t (s): a triangle wave between the two end points.
+  double pause = 0.0;                             // s standing at each end before turning back
+  /// Centre at time t (s): a triangle wave between the two end points,
+  /// flat for `pause` at each end (a person lingering there).
   void positionAt(double t, double* x, double* y) const;
 };
 

@@ -28,6 +28,17 @@ void putReal(std::string* out, double d) {
   for (int k = 0; k < 8; ++k) out->push_back(static_cast<char>(bits >> (8 * k) & 0xff));
 }
 
+// A place's coordinate as an unsigned number, small for small magnitudes
+// (protocol buffers' zigzag), and back.
+std::uint64_t zigzag(std::int16_t v) {
+  return static_cast<std::uint64_t>(v < 0 ? -2 * static_cast<int>(v) - 1 : 2 * static_cast<int>(v));
+}
+
+std::int16_t unzigzag(std::uint64_t u) {
+  return static_cast<std::int16_t>(u & 1 ? -static_cast<int>((u + 1) / 2)
+                                         : static_cast<int>(u / 2));
+}
+
 // Reads what putNumber and putReal wrote; past the end, or a number longer
 // than 64 bits, it stops being ok() and gives zeros.
 class ByteReader {
@@ -62,6 +73,28 @@ class ByteReader {
   std::size_t pos_ = 0;
   bool ok_ = true;
 };
+
+// A cell's counts as encode() writes them, after the cell's index: hits,
+// free, passes, ends, clear, apart | moved_in << 1, hit_x and hit_y
+// zigzagged; into *c when they are ones the layer gives.
+template <class Counts>
+bool fillCounts(const std::uint64_t (&v)[8], Counts* c) {
+  if (*std::max_element(v, v + 4) > std::numeric_limits<std::uint16_t>::max() ||
+      v[4] > std::numeric_limits<std::uint8_t>::max() || v[5] > 3 || v[6] > 0xffff ||
+      v[7] > 0xffff || (v[0] == 0 && (v[5] || v[6] || v[7])) || (v[1] == 0 && v[4])) {
+    return false;
+  }
+  c->hits = static_cast<std::uint16_t>(v[0]);
+  c->free = static_cast<std::uint16_t>(v[1]);
+  c->passes = static_cast<std::uint16_t>(v[2]);
+  c->ends = static_cast<std::uint16_t>(v[3]);
+  c->clear = static_cast<std::uint8_t>(v[4]);
+  c->apart = static_cast<std::uint8_t>(v[5] & 1);
+  c->moved_in = static_cast<std::uint8_t>(v[5] >> 1);
+  c->hit_x = unzigzag(v[6]);
+  c->hit_y = unzigzag(v[7]);
+  return true;
+}
 
 // The bits of a cell's byte encode() keeps: all but what the map has there.
 constexpr int kStateShift = 2;
@@ -102,10 +135,20 @@ void MapChangeLayer::count(std::size_t i, Kind kind) {
   weigh(shown(i), c, false);
   switch (kind) {
     case kHit:
+      if (c.hits == 0) {
+        c.moved_in = (cells_[i] & kPassedBits) >= kMovedInPasses * kPassedOne;
+        c.hit_x = place_x_;
+        c.hit_y = place_y_;
+      } else if (std::hypot(place_x_ - c.hit_x, place_y_ - c.hit_y) * kPlaceUnit >= kMinBaseline) {
+        c.apart = 1;
+      }
       bump(&c.hits);
+      c.clear = 0;
       break;
     case kFree:
       bump(&c.free);
+      // A scan that also hit the cell leaves it hit.
+      if (!(c.counted & kHit) && c.clear < std::numeric_limits<std::uint8_t>::max()) ++c.clear;
       break;
     case kPass:
       bump(&c.passes);
@@ -200,6 +243,11 @@ bool MapChangeLayer::wants(const Pose2& robot) const {
 }
 
 void MapChangeLayer::add(const ScanGroup& scans, const Pose2& robot) {
+  const auto place = [](double v) {
+    return static_cast<std::int16_t>(std::clamp(std::lround(v / kPlaceUnit), -32767L, 32767L));
+  };
+  place_x_ = place(robot.x);
+  place_y_ = place(robot.y);
   for (const LaserScan& scan : scans) {
     const std::size_t n = scan.ranges.size();
     const Pose2 base = compose(robot, scan.robot_offset);
@@ -232,6 +280,7 @@ void MapChangeLayer::walk(double x, double y, double ux, double uy, double range
   const double delta_y = uy != 0.0 ? std::abs(1.0 / uy) : inf;
   double next_x = ux != 0.0 ? (cx + (step_x > 0 ? 1 : 0) - x) / ux : inf;
   double next_y = uy != 0.0 ? (cy + (step_y > 0 ? 1 : 0) - y) / uy : inf;
+  const double moved_in_reach = kMovedInRange * frame_.cellsPerMetre();
   double t = 0.0;
   while (t <= length && cx >= 0 && cy >= 0 && cx < width_ && cy < height_) {
     // Most cells are free, and only their byte is touched.
@@ -244,6 +293,8 @@ void MapChangeLayer::walk(double x, double y, double ux, double uy, double range
         count(i, kPass);
       } else if (cell & kWasHit) {
         count(i, kFree);
+      } else if (map == kMapFree && (cell & kPassedBits) != kPassedBits && t <= moved_in_reach) {
+        cell = static_cast<std::uint8_t>(cell + kPassedOne);
       }
     }
     if (next_x < next_y) {
@@ -288,7 +339,10 @@ MapChangeLayer::Cell MapChangeLayer::classify(std::size_t i) const {
   const Counts& c = countsAt(i);
   const int hits = c.hits, passes = c.passes;
   const int stopped = hits + c.free, reached = passes + c.ends;
-  if (hits >= kMinScans && hits >= kChangedShare * stopped) return Cell::kAdded;
+  if (hits >= kMinScans && hits >= kChangedShare * stopped && c.apart && c.clear < kClearScans &&
+      (!c.moved_in || hits >= kMovedInScans)) {
+    return Cell::kAdded;
+  }
   if (passes >= kMinScans && passes >= kChangedShare * reached) return Cell::kRemoved;
   return Cell::kAsMapped;
 }
@@ -346,6 +400,10 @@ std::string MapChangeLayer::encode() const {
       if (c.hits == 0 && c.free == 0 && c.passes == 0 && c.ends == 0) continue;
       putNumber(&cells, k - last_cell);
       for (const std::uint16_t v : {c.hits, c.free, c.passes, c.ends}) putNumber(&cells, v);
+      putNumber(&cells, c.clear);
+      putNumber(&cells, c.apart | c.moved_in << 1);
+      putNumber(&cells, zigzag(c.hit_x));
+      putNumber(&cells, zigzag(c.hit_y));
       last_cell = k;
       ++counted;
     }
@@ -387,13 +445,13 @@ std::string MapChangeLayer::restore(const std::string& bytes) {
     const std::uint8_t cell = static_cast<std::uint8_t>(state << kStateShift);
     const auto shown_as = static_cast<Cell>(cell >> kShownShift & 3);
     const bool seen = cell & kSeen;
-    if (cell >> kStateShift != state || (cell & ~(kSeen | kWasHit | kShownBits)) ||
-        seen != (shown_as != Cell::kUnseen) || ((cell & kWasHit) && !seen)) {
+    if (cell >> kStateShift != state || (cell & ~(kSeen | kWasHit | kShownBits | kPassedBits)) ||
+        seen != (shown_as != Cell::kUnseen) || ((cell & (kWasHit | kPassedBits)) && !seen)) {
       return "corrupt: a cell's state is not one the layer gives";
     }
     for (std::size_t k = i; state != 0 && k < i + run; ++k) {
       const std::uint8_t map = cells_[k] & kMapBits;
-      if (map == kMapUnknown || ((cell & kWasHit) && map != kMapFree)) {
+      if (map == kMapUnknown || ((cell & (kWasHit | kPassedBits)) && map != kMapFree)) {
         return "a cell seen here is unknown on this map, or a beam ended in an obstacle";
       }
       cells_[k] = map | cell;
@@ -415,22 +473,18 @@ std::string MapChangeLayer::restore(const std::string& bytes) {
     std::size_t j = 0;
     for (std::uint64_t m = 0; m < counted; ++m) {
       const std::uint64_t cell_step = in.number();
-      std::uint64_t v[4];
+      std::uint64_t v[8];
       for (std::uint64_t& x : v) x = in.number();
       if (!in.ok()) return "truncated in the counts";
       j += cell_step;
       const std::size_t x = (t % tiles_x_) * kTileSize + (j & (kTileSize - 1));
       const std::size_t y = (t / tiles_x_) * kTileSize + (j >> kTileBits);
       if ((m > 0 && cell_step == 0) || j >= kTileSize * kTileSize || x >= std::size_t(width_) ||
-          y >= std::size_t(height_) || !(cells_[y * width_ + x] & kSeen) ||
-          *std::max_element(v, v + 4) > std::numeric_limits<std::uint16_t>::max()) {
+          y >= std::size_t(height_) || !(cells_[y * width_ + x] & kSeen)) {
         return "corrupt: counts out of order, out of the map or of an unseen cell";
       }
       Counts& c = tiles_[t][j];
-      c.hits = static_cast<std::uint16_t>(v[0]);
-      c.free = static_cast<std::uint16_t>(v[1]);
-      c.passes = static_cast<std::uint16_t>(v[2]);
-      c.ends = static_cast<std::uint16_t>(v[3]);
+      if (!fillCounts(v, &c)) return "corrupt: a cell's counts are not ones the layer gives";
       // Counted in an earlier scan than the next one added.
       c.scan = static_cast<std::uint16_t>(scans - 1);
     }

@@ -136,8 +136,8 @@ TEST(MapChangeFile, RefusesAFileCutShortOrAltered) {
   EXPECT_NE(std::string::npos, readMapChangesFile(altered).error.find("checksum"));
   EXPECT_EQ("not a map changes file", readMapChangesFile("P5\n6 4\n255\n").error);
   std::string newer = bytes;
-  newer[newer.find('\n') + 1] = 2;  // the version's lowest byte
-  EXPECT_NE(std::string::npos, readMapChangesFile(newer).error.find("version 2"));
+  newer[newer.find('\n') + 1] = 3;  // the version's lowest byte
+  EXPECT_NE(std::string::npos, readMapChangesFile(newer).error.find("version 3"));
 
   // The state itself cut short, past the checksum's guard: refused, the
   // layer left empty, never read past its end.

@@ -16,7 +16,7 @@
 namespace pf {
 
 /// The version mapChangesFile() writes and readMapChangesFile() reads.
-constexpr int kMapChangesFileVersion = 1;
+constexpr int kMapChangesFileVersion = 2;
 
 /// `layer`'s state as a file's bytes, learned on the map `map_signature` names.
 std::string mapChangesFile(const MapChangeLayer& layer, const std::string& map_signature);

@@ -12,9 +12,21 @@
 // when most beams that reached it went through: the counting of occupancy
 // mapping (Moravec & Elfes, ICRA 1985) kept beside the map, as the temporary
 // maps of Meyer-Delius et al. (IROS 2010) do, instead of merged into it.
-// People walking through are hit for a moment and passed for the rest of the
-// run, so they do not stay. See docs/design.md, "A map out of date is not a
-// wrong pose".
+// People are not walls: a person who stands a while is hit by the beams of
+// several scans as much as a cupboard is, so a cell is added only on what a
+// person does not give. Its hits came from robot places at least
+// kMinBaseline apart (a surface seen from several places, not from one
+// place while something stood there); the scans since its last hit did not
+// see through it (kClearScans: a static surface stops the beams that
+// reach it; where a person stood, the beams run through once they have
+// left: the latest evidence wins, as in occupancy mapping with clamping,
+// Hornung et al., "OctoMap", Autonomous Robots 2013); and, when the robot
+// saw its place empty from nearby before the first hit (kMovedInPasses:
+// something moved in while it looked, the free-space violation of moving
+// object detection), many scans hit it (kMovedInScans). What moves is the
+// transient screening's (transient_beams.h) and the judging's, which masks
+// beams that end short of the map. See docs/design.md, "A map out of date
+// is not a wrong pose", and its "People are not walls".
 #pragma once
 
 #include <cstddef>
@@ -54,6 +66,29 @@ class MapChangeLayer {
   /// Share of those that must say it changed: stopped there (added) or went
   /// through (removed).
   static constexpr double kChangedShare = 0.5;
+  /// m: an added cell's hits came from robot places at least this far apart
+  /// (the first hit's place and a later one): two scans added while the
+  /// robot drove (kMinStep), not the scans added while it turned in place
+  /// beside someone standing there.
+  static constexpr double kMinBaseline = 0.4;
+  /// Scans in a row whose beams went through a cell, none ending there,
+  /// since its last hit that take it out of the added cells (until it is hit
+  /// again): where a person stood, the beams run through once they have
+  /// left. Fewer are not enough: a beam grazing a surface's face passes the
+  /// cells just before it (a pallet along an aisle, seen down the aisle).
+  static constexpr int kClearScans = 3;
+  /// Beams through a free cell before its first hit that make what it hit
+  /// something that moved in while the robot looked (a person walking up):
+  /// such a cell is added only after kMovedInScans hits, a pallet put down
+  /// for good, not a person who stopped a while.
+  static constexpr int kMovedInPasses = 3;
+  static constexpr int kMovedInScans = 8;
+  /// m: only beams within this of the sensor count those passes: further,
+  /// a beam grazes the side of what it later hits (a pallet seen down an
+  /// aisle).
+  static constexpr double kMovedInRange = 3.0;
+  /// m: the robot's place at a hit is kept in units of this.
+  static constexpr double kPlaceUnit = 0.1;
 
   /// An empty layer of `field`'s map.
   explicit MapChangeLayer(const DistanceField& field);
@@ -111,8 +146,11 @@ class MapChangeLayer {
   /// What the layer learned as bytes, to restore on the same map after a
   /// restart: the map's size, the scans added and the last one's pose, the
   /// state of each cell run-length coded (a building's millions of unseen
-  /// cells are a few bytes) and the counts of the cells that have any, as
-  /// variable-length integers (map_change_file.h frames them in a file).
+  /// cells are a few bytes; with the beams through it before its first hit)
+  /// and the counts of the cells that have any (with the place of the first
+  /// hit, whether one came from afar, whether it moved in and the clear
+  /// scans since the last hit), as variable-length integers
+  /// (map_change_file.h frames them in a file).
   std::string encode() const;
   /// The state encode() wrote, on a layer of a map of the same size: empty,
   /// or why the bytes were refused (another map's size, truncated, corrupt)
@@ -131,13 +169,23 @@ class MapChangeLayer {
     std::uint16_t ends = 0;    // a beam ended on this mapped obstacle
     std::uint16_t scan = 0;    // the last scan that counted here (scans_, wrapping)
     std::uint8_t counted = 0;  // of that scan: a bit per kind already counted
+    // Since the last hit: scans in a row whose beams passed (free), none hit.
+    std::uint8_t clear = 0;
+    // Whether a hit came from kMinBaseline or further from the first's place.
+    std::uint8_t apart = 0;
+    // Whether kMovedInPasses beams went through the cell before its first hit.
+    std::uint8_t moved_in = 0;
+    // The robot's place at the first hit, in kPlaceUnit of the map's frame.
+    std::int16_t hit_x = 0, hit_y = 0;
   };
   enum Kind : std::uint8_t { kHit = 1, kFree = 2, kPass = 4, kEnd = 8 };
   // Each cell's byte: what the map has there (the low two bits), whether a
   // beam reached it, whether one ever ended there short of the map, and the
   // Cell it is shown as (two bits from kShownShift).
   enum MapCell : std::uint8_t { kMapFree, kMapBeside, kMapOccupied, kMapUnknown, kMapBits = 3 };
-  enum Flag : std::uint8_t { kSeen = 4, kWasHit = 8 };
+  // kPassedOne counts (to 3, in kPassedBits) the beams that went through a
+  // cell the map has free before any ended there.
+  enum Flag : std::uint8_t { kSeen = 4, kWasHit = 8, kPassedOne = 64, kPassedBits = 192 };
   static constexpr int kShownShift = 4;
   static constexpr std::uint8_t kShownBits = 3 << kShownShift;
   Cell shown(std::size_t i) const { return static_cast<Cell>(cells_[i] >> kShownShift & 3); }
@@ -173,6 +221,7 @@ class MapChangeLayer {
   void end(double x, double y);
 
   int width_, height_;
+  std::int16_t place_x_ = 0, place_y_ = 0;        // the robot's place in the scan being added
   GridFrame frame_;                               // to walk in cells
   std::vector<std::uint8_t> cells_;               // MapCell | Flag | shown Cell
   int tiles_x_;                                   // tiles per row
