@@ -34,6 +34,20 @@ double PathScript::duration() const {
   return total;
 }
 
+namespace {
+
+// `person x1 y1 x2 y2 v [pause]`, a line of `words` words.
+Person parsePerson(const LineParser<PathScriptError>& p, std::size_t words) {
+  const auto a = p.numbers(words == 7 ? 6 : 5, "person x1 y1 x2 y2 speed [pause]");
+  if (a[4] < 0.0) p.fail("person speed must not be negative");
+  if (a.back() < 0.0) p.fail("person pause must not be negative");
+  Person person{a[0], a[1], a[2], a[3], a[4]};
+  if (a.size() == 6) person.pause = a[5];
+  return person;
+}
+
+}  // namespace
+
 PathScript parsePathScript(std::istream& in, const std::string& file) {
   PathScript script;
   script.file = file;
@@ -103,11 +117,7 @@ PathScript parsePathScript(std::istream& in, const std::string& file) {
     } else if (cmd == "floor") {
       script.motions.push_back({false, 0.0, 0.0, 0.0, {}, line, p.word("floor NAME")});
     } else if (cmd == "person") {
-      const auto a = p.numbers(words.size() == 7 ? 6 : 5, "person x1 y1 x2 y2 speed [pause]");
-      if (a[4] < 0.0) p.fail("person speed must not be negative");
-      if (a.back() < 0.0) p.fail("person pause must not be negative");
-      script.people.push_back({a[0], a[1], a[2], a[3], a[4]});
-      if (a.size() == 6) script.people.back().pause = a[5];
+      script.people.push_back(parsePerson(p, words.size()));
     } else {
       p.fail("unknown command '" + cmd +
              "' (expected start, speed, goto, turn, wait, velocity, teleport, floor or person)");

@@ -38,4 +38,11 @@ OccupancyGrid wallGrid(int column, const Pose2& origin) {
   return OccupancyGrid(10, 5, 0.1, origin, data);
 }
 
+OccupancyGrid changedRoomWorld() { return room(6.0, 4.0, 0.05, {kChangedRoomAdded}); }
+OccupancyGrid changedRoomMap() { return room(6.0, 4.0, 0.05, {kChangedRoomRemoved}); }
+
+std::vector<Pose2> changedRoomTour() {
+  return {{3.0, 2.0, 0.0}, {2.6, 1.2, 0.5}, {2.0, 1.0, 1.6}, {3.2, 2.8, -2.0}, {2.5, 2.2, 3.0}};
+}
+
 }  // namespace pf::test

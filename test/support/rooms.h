@@ -34,4 +34,14 @@ OccupancyGrid asymmetricRoom();
 /// grid's frame, whose ranges and distances are easy to work out by hand.
 OccupancyGrid wallGrid(int column, const Pose2& origin = {});
 
+/// The change layer's tests' room: 6 m x 4 m in 0.05 m cells, the world with
+/// a box the map lacks (kChangedRoomAdded), the map with a box the world no
+/// longer has (kChangedRoomRemoved).
+inline constexpr Box kChangedRoomAdded{4.0, 1.7, 4.6, 2.3};
+inline constexpr Box kChangedRoomRemoved{1.2, 2.6, 1.8, 3.2};
+OccupancyGrid changedRoomWorld();
+OccupancyGrid changedRoomMap();
+/// The robot's poses in it: round the room's middle, where it sees both boxes.
+std::vector<Pose2> changedRoomTour();
+
 }  // namespace pf::test

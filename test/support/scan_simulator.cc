@@ -49,4 +49,11 @@ LaserScan simulateScan(const OccupancyGrid& grid, const Pose2& base, const ScanS
   return ScanSimulator(grid, spec).scanFrom(base);
 }
 
+LaserScan scan360(const OccupancyGrid& grid, const Pose2& base) {
+  ScanSpec spec;
+  spec.beams = 360;
+  spec.angle_increment = 2.0 * M_PI / 360;
+  return simulateScan(grid, base, spec);
+}
+
 }  // namespace pf::test

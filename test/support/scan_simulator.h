@@ -60,4 +60,7 @@ LaserScan noReturnScan(const ScanSpec& spec = {});
 /// One scan of `grid` from `base` (a ScanSimulator used once).
 LaserScan simulateScan(const OccupancyGrid& grid, const Pose2& base, const ScanSpec& spec = {});
 
+/// A 360-beam scan of `grid` from `base`, a beam a degree, as a Neato's.
+LaserScan scan360(const OccupancyGrid& grid, const Pose2& base);
+
 }  // namespace pf::test

@@ -17,27 +17,16 @@ namespace pf {
 namespace {
 
 using test::Box;
+using test::changedRoomMap;
+using test::changedRoomTour;
+using test::changedRoomWorld;
+using test::kChangedRoomAdded;
+using test::kChangedRoomRemoved;
 using test::room;
-
-const Box kAdded{4.0, 1.7, 4.6, 2.3};    // in the world, not on the map
-const Box kRemoved{1.2, 2.6, 1.8, 3.2};  // on the map, not in the world
-
-OccupancyGrid world() { return room(6.0, 4.0, 0.05, {kAdded}); }
-OccupancyGrid mapOf() { return room(6.0, 4.0, 0.05, {kRemoved}); }
-
-LaserScan scan360(const OccupancyGrid& seen, const Pose2& p) {
-  test::ScanSpec spec;
-  spec.beams = 360;
-  spec.angle_increment = 2.0 * M_PI / 360;
-  return test::simulateScan(seen, p, spec);
-}
-
-std::vector<Pose2> tour() {
-  return {{3.0, 2.0, 0.0}, {2.6, 1.2, 0.5}, {2.0, 1.0, 1.6}, {3.2, 2.8, -2.0}, {2.5, 2.2, 3.0}};
-}
+using test::scan360;
 
 void tourOnce(MapChangeLayer* layer, const OccupancyGrid& seen) {
-  for (const Pose2& p : tour()) layer->add(scan360(seen, p), p);
+  for (const Pose2& p : changedRoomTour()) layer->add(scan360(seen, p), p);
 }
 
 void expectSameSummary(const MapChangeLayer& a, const MapChangeLayer& b) {
@@ -51,11 +40,11 @@ void expectSameSummary(const MapChangeLayer& a, const MapChangeLayer& b) {
 }
 
 TEST(MapChangeFile, RestoresTheLayerAndItsCounts) {
-  const OccupancyGrid map = mapOf();
+  const OccupancyGrid map = changedRoomMap();
   const DistanceField field(map, 2.0);
   MapChangeLayer learned(field);
-  tourOnce(&learned, world());
-  tourOnce(&learned, world());
+  tourOnce(&learned, changedRoomWorld());
+  tourOnce(&learned, changedRoomWorld());
   ASSERT_GT(learned.summary().added, 0u);
   ASSERT_GT(learned.summary().removed, 0u);
 
@@ -84,13 +73,13 @@ TEST(MapChangeFile, RestoresTheLayerAndItsCounts) {
 }
 
 TEST(MapChangeFile, ReportsTheEvidenceBehindEachChange) {
-  const OccupancyGrid map = mapOf();
+  const OccupancyGrid map = changedRoomMap();
   const DistanceField field(map, 2.0);
   MapChangeLayer layer(field);
-  tourOnce(&layer, world());
+  tourOnce(&layer, changedRoomWorld());
   const MapChangeLayer::Summary once = layer.summary();
   ASSERT_GT(once.added, 0u);
-  tourOnce(&layer, world());
+  tourOnce(&layer, changedRoomWorld());
   const MapChangeLayer::Summary twice = layer.summary();
   // Each change has at least kMinScans scans behind it, and a second tour of
   // the same world adds to them.
@@ -103,9 +92,9 @@ TEST(MapChangeFile, ReportsTheEvidenceBehindEachChange) {
 TEST(MapChangeFile, AWideMapSeenInPartIsSmall) {
   // 2000 x 2000 cells, a room of 6 x 4 m in its corner toured.
   const OccupancyGrid map =
-      room(100.0, 100.0, 0.05, {kRemoved, {6.0, 0.0, 6.1, 4.1}, {0.0, 4.0, 6.1, 4.1}});
+      room(100.0, 100.0, 0.05, {kChangedRoomRemoved, {6.0, 0.0, 6.1, 4.1}, {0.0, 4.0, 6.1, 4.1}});
   const OccupancyGrid seen =
-      room(100.0, 100.0, 0.05, {kAdded, {6.0, 0.0, 6.1, 4.1}, {0.0, 4.0, 6.1, 4.1}});
+      room(100.0, 100.0, 0.05, {kChangedRoomAdded, {6.0, 0.0, 6.1, 4.1}, {0.0, 4.0, 6.1, 4.1}});
   const DistanceField field(map, 2.0);
   MapChangeLayer layer(field);
   tourOnce(&layer, seen);
@@ -120,11 +109,11 @@ TEST(MapChangeFile, AWideMapSeenInPartIsSmall) {
 }
 
 TEST(MapChangeFile, RefusesAFileCutShortOrAltered) {
-  const OccupancyGrid map = mapOf();
+  const OccupancyGrid map = changedRoomMap();
   const DistanceField field(map, 2.0);
   MapChangeLayer learned(field);
-  tourOnce(&learned, world());
-  tourOnce(&learned, world());
+  tourOnce(&learned, changedRoomWorld());
+  tourOnce(&learned, changedRoomWorld());
   const std::string bytes = mapChangesFile(learned, "the room");
   for (std::size_t n = 0; n < bytes.size(); n += n < 200 ? 1 : 97) {
     EXPECT_NE("", readMapChangesFile(bytes.substr(0, n)).error) << n << " of " << bytes.size();
@@ -153,12 +142,12 @@ TEST(MapChangeFile, RefusesAFileCutShortOrAltered) {
 }
 
 TEST(MapChangeFile, RefusesAnotherMapsLayer) {
-  const OccupancyGrid map = mapOf();
+  const OccupancyGrid map = changedRoomMap();
   const DistanceField field(map, 2.0);
   MapChangeLayer learned(field);
-  tourOnce(&learned, world());
-  tourOnce(&learned, world());
-  const OccupancyGrid taller = room(6.0, 4.5, 0.05, {kRemoved});
+  tourOnce(&learned, changedRoomWorld());
+  tourOnce(&learned, changedRoomWorld());
+  const OccupancyGrid taller = room(6.0, 4.5, 0.05, {kChangedRoomRemoved});
   const DistanceField taller_field(taller, 2.0);
   MapChangeLayer other(taller_field);
   const std::string error = other.decode(learned.encode());
@@ -175,11 +164,11 @@ TEST(MapChangeFile, RefusesAnotherMapsLayer) {
 }
 
 TEST(MapChangeFile, ARestoredLayerIsWhatTheScansAreJudgedOn) {
-  const OccupancyGrid map = mapOf();
+  const OccupancyGrid map = changedRoomMap();
   const DistanceField field(map, 2.0);
   MapChangeLayer learned(field);
-  tourOnce(&learned, world());
-  tourOnce(&learned, world());
+  tourOnce(&learned, changedRoomWorld());
+  tourOnce(&learned, changedRoomWorld());
   BeamScreen screen;
   screen.setMap(BeamScreen::prepare(field));
   // A beam from the west wall along the removed box's row to the east wall.

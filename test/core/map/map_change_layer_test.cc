@@ -16,27 +16,14 @@ namespace pf {
 namespace {
 
 using test::Box;
+using test::changedRoomMap;
+using test::changedRoomTour;
+using test::changedRoomWorld;
+using test::kChangedRoomAdded;
+using test::kChangedRoomRemoved;
 using test::room;
+using test::scan360;
 using test::simulateScan;
-
-const Box kAdded{4.0, 1.7, 4.6, 2.3};    // in the world, not on the map
-const Box kRemoved{1.2, 2.6, 1.8, 3.2};  // on the map, not in the world
-
-OccupancyGrid world() { return room(6.0, 4.0, 0.05, {kAdded}); }
-OccupancyGrid mapOf() { return room(6.0, 4.0, 0.05, {kRemoved}); }
-
-// A 360-beam scan of `seen` from `p`, as a Neato's.
-LaserScan scan360(const OccupancyGrid& seen, const Pose2& p) {
-  test::ScanSpec spec;
-  spec.beams = 360;
-  spec.angle_increment = 2.0 * M_PI / 360;
-  return simulateScan(seen, p, spec);
-}
-
-// The robot's poses: round the room's middle, where it sees both boxes.
-std::vector<Pose2> tour() {
-  return {{3.0, 2.0, 0.0}, {2.6, 1.2, 0.5}, {2.0, 1.0, 1.6}, {3.2, 2.8, -2.0}, {2.5, 2.2, 3.0}};
-}
 
 // The cells of `box` and one cell round it in state `c`: a beam's end
 // point lies in the cell before a face as often as in the face's.
@@ -57,13 +44,13 @@ MapChangeLayer toured(const OccupancyGrid& map, const OccupancyGrid& seen, int t
   const DistanceField field(map, 2.0);
   MapChangeLayer layer(field);
   for (int k = 0; k < times; ++k) {
-    for (const Pose2& p : tour()) layer.add(scan360(seen, p), p);
+    for (const Pose2& p : changedRoomTour()) layer.add(scan360(seen, p), p);
   }
   return layer;
 }
 
 TEST(MapChangeLayer, AWorldAsMappedHasNoChange) {
-  const MapChangeLayer layer = toured(mapOf(), mapOf(), 3);
+  const MapChangeLayer layer = toured(changedRoomMap(), changedRoomMap(), 3);
   const MapChangeLayer::Summary s = layer.summary();
   EXPECT_GT(s.seen, 3000u);
   EXPECT_EQ(0u, s.added);
@@ -72,50 +59,51 @@ TEST(MapChangeLayer, AWorldAsMappedHasNoChange) {
 }
 
 TEST(MapChangeLayer, FindsWhatTheMapLacksAndWhatIsGone) {
-  const OccupancyGrid map = mapOf();
-  const MapChangeLayer layer = toured(map, world(), 3);
+  const OccupancyGrid map = changedRoomMap();
+  const MapChangeLayer layer = toured(map, changedRoomWorld(), 3);
   // The added box's faces towards the tour are hit: a 0.6 m face is 12 cells;
   // those hit from one pose of the tour only are not added (kMinBaseline).
-  EXPECT_GE(cellsIn(layer, map, kAdded, MapChangeLayer::Cell::kAdded), 16);
+  EXPECT_GE(cellsIn(layer, map, kChangedRoomAdded, MapChangeLayer::Cell::kAdded), 16);
   // The gone box is seen through: most of its 13 x 13 cells.
-  EXPECT_GE(cellsIn(layer, map, kRemoved, MapChangeLayer::Cell::kRemoved), 100);
+  EXPECT_GE(cellsIn(layer, map, kChangedRoomRemoved, MapChangeLayer::Cell::kRemoved), 100);
   // Nothing else: every changed cell is one of the boxes'.
   const MapChangeLayer::Summary s = layer.summary();
-  EXPECT_EQ(s.added,
-            static_cast<std::size_t>(cellsIn(layer, map, kAdded, MapChangeLayer::Cell::kAdded)));
-  EXPECT_EQ(s.removed, static_cast<std::size_t>(
-                           cellsIn(layer, map, kRemoved, MapChangeLayer::Cell::kRemoved)));
+  EXPECT_EQ(s.added, static_cast<std::size_t>(
+                         cellsIn(layer, map, kChangedRoomAdded, MapChangeLayer::Cell::kAdded)));
+  EXPECT_EQ(s.removed, static_cast<std::size_t>(cellsIn(layer, map, kChangedRoomRemoved,
+                                                        MapChangeLayer::Cell::kRemoved)));
 }
 
 TEST(MapChangeLayer, OneGlimpseIsNotAChange) {
   // One scan is fewer than kMinScans, however many of its beams hit a cell.
-  const OccupancyGrid map = mapOf();
+  const OccupancyGrid map = changedRoomMap();
   const DistanceField field(map, 2.0);
   MapChangeLayer layer(field);
-  const Pose2 p = tour().front();
-  layer.add(scan360(world(), p), p);
+  const Pose2 p = changedRoomTour().front();
+  layer.add(scan360(changedRoomWorld(), p), p);
   EXPECT_EQ(0u, layer.summary().added);
 }
 
 TEST(MapChangeLayer, SomeoneStandingByIsNotAWall) {
   // The box as a person standing by while the robot turns in place: hit by
   // every scan, all from one place, it is not added...
-  const OccupancyGrid map = mapOf();
+  const OccupancyGrid map = changedRoomMap();
   const DistanceField field(map, 2.0);
   MapChangeLayer layer(field);
-  const Pose2 p = tour().front();
+  const Pose2 p = changedRoomTour().front();
   for (int k = 0; k < 6; ++k) {
     const Pose2 turned{p.x, p.y, p.yaw + 0.6 * k};
-    layer.add(scan360(world(), turned), turned);
+    layer.add(scan360(changedRoomWorld(), turned), turned);
   }
   EXPECT_EQ(0u, layer.summary().added);
   // ...until it is seen from kMinBaseline away, as a cupboard is from the
   // robot driving past...
   const Pose2 q{p.x, p.y - MapChangeLayer::kMinBaseline - 0.05, p.yaw};
-  layer.add(scan360(world(), q), q);
+  layer.add(scan360(changedRoomWorld(), q), q);
   const std::size_t added = layer.summary().added;
-  EXPECT_GE(cellsIn(layer, map, kAdded, MapChangeLayer::Cell::kAdded), 5);
-  EXPECT_EQ(static_cast<std::size_t>(cellsIn(layer, map, kAdded, MapChangeLayer::Cell::kAdded)),
+  EXPECT_GE(cellsIn(layer, map, kChangedRoomAdded, MapChangeLayer::Cell::kAdded), 5);
+  EXPECT_EQ(static_cast<std::size_t>(
+                cellsIn(layer, map, kChangedRoomAdded, MapChangeLayer::Cell::kAdded)),
             added);
   // ...and once the place is seen empty (kClearScans scans in a row), from
   // wherever, it is gone from the layer, however many scans hit it before:
@@ -129,7 +117,7 @@ TEST(MapChangeLayer, SomeoneStandingByIsNotAWall) {
   layer.add(scan360(map, p), p);
   EXPECT_EQ(0u, layer.summary().added);
   // Seen again from two places, it is back.
-  layer.add(scan360(world(), p), p);
+  layer.add(scan360(changedRoomWorld(), p), p);
   EXPECT_GT(layer.summary().added, 0u);
 }
 
@@ -138,7 +126,7 @@ TEST(MapChangeLayer, WhatMovedInWhileTheRobotLookedIsNotAWall) {
   // anything stood there: what stops the beams there later came while the
   // robot looked, a person walking up, and is added only after
   // kMovedInScans scans hit it, however many places they came from.
-  const OccupancyGrid map = mapOf();
+  const OccupancyGrid map = changedRoomMap();
   const DistanceField field(map, 2.0);
   MapChangeLayer layer(field);
   const Pose2 near{3.2, 2.0, 0.0};  // 0.8 m from the box's west face
@@ -150,24 +138,25 @@ TEST(MapChangeLayer, WhatMovedInWhileTheRobotLookedIsNotAWall) {
                                      {3.2, 2.8, -2.0}, {2.5, 2.2, 3.0}, {3.0, 1.0, 0.3},
                                      {2.2, 2.9, -0.5}, {3.1, 3.1, -1.0}};
   for (std::size_t k = 0; k + 1 < static_cast<std::size_t>(MapChangeLayer::kMovedInScans); ++k) {
-    layer.add(scan360(world(), places[k]), places[k]);
+    layer.add(scan360(changedRoomWorld(), places[k]), places[k]);
   }
   // The west face, passed from near before, is not added yet...
-  const Box west{kAdded.x0 - 0.05, kAdded.y0 + 0.1, kAdded.x0 + 0.05, kAdded.y1 - 0.1};
+  const Box west{kChangedRoomAdded.x0 - 0.05, kChangedRoomAdded.y0 + 0.1,
+                 kChangedRoomAdded.x0 + 0.05, kChangedRoomAdded.y1 - 0.1};
   EXPECT_EQ(0, cellsIn(layer, map, west, MapChangeLayer::Cell::kAdded));
   // ...and is, a pallet put down for good, once kMovedInScans hit it.
   for (int round = 0; round < 3; ++round) {
-    for (const Pose2& p : places) layer.add(scan360(world(), p), p);
+    for (const Pose2& p : places) layer.add(scan360(changedRoomWorld(), p), p);
   }
   EXPECT_GT(cellsIn(layer, map, west, MapChangeLayer::Cell::kAdded), 5);
 }
 
 TEST(MapChangeLayer, ListsEachCellThatBecameOrStoppedBeingAChange) {
-  const OccupancyGrid map = mapOf();
+  const OccupancyGrid map = changedRoomMap();
   const DistanceField field(map, 2.0);
   MapChangeLayer layer(field);
   for (int k = 0; k < 3; ++k) {
-    for (const Pose2& p : tour()) layer.add(scan360(world(), p), p);
+    for (const Pose2& p : changedRoomTour()) layer.add(scan360(changedRoomWorld(), p), p);
   }
   std::vector<std::size_t> changed = layer.takeChangedCells();
   const MapChangeLayer::Summary s = layer.summary();
@@ -184,8 +173,8 @@ TEST(MapChangeLayer, ListsEachCellThatBecameOrStoppedBeingAChange) {
 }
 
 TEST(MapChangeLayer, WritesTheMasksConvention) {
-  const OccupancyGrid map = mapOf();
-  const MapChangeLayer layer = toured(map, world(), 3);
+  const OccupancyGrid map = changedRoomMap();
+  const MapChangeLayer layer = toured(map, changedRoomWorld(), 3);
   const std::vector<std::uint8_t> pixels = layer.pixels();
   const std::vector<std::int8_t> values = layer.occupancy();
   ASSERT_EQ(map.data().size(), pixels.size());
