@@ -63,23 +63,46 @@ __attribute__((target("avx2"))) inline void stencil4(__m128i lo, int size, __m12
 struct Grid {
   double c, s, inv_res, origin_x, origin_y, max_distance;
   int width, height;
+  const float* cells;       // DistanceField::surfaceCells, or nullptr: then
   const uint16_t* classes;  // DistanceField::classes
-  const float* surface;     // per class, its surface distance
+  const float* surface;     // and per class, its surface distance
 };
 
 // One row of four lanes' stencils: v[k] holds, in each lane, the surface
-// distance of the cell at column xs[k] of the row starting at row_start:
-// its class (a four-byte gather at two-byte steps, the upper half masked
-// off; classes() has an entry past the last cell), then the class's value.
+// distance of the cell at column xs[k] of the row starting at row_start.
+// With a float a cell: `contiguous` (every lane's four columns are xs[0] ..
+// xs[0] + 3, none clamped) fetches them with four loads and a transpose,
+// faster than four gathers. Without: the cell's class (a four-byte gather
+// at two-byte steps, the upper half masked off; classes() has an entry past
+// the last cell), then the class's value.
 __attribute__((target("avx2"))) inline void stencilRow4(const Grid& g, __m128i row_start,
-                                                        const __m128i xs[4], __m256d v[4]) {
-  const __m128i low = _mm_set1_epi32(0xFFFF);
-  for (int k = 0; k < 4; ++k) {
-    const __m128i cell = _mm_add_epi32(row_start, xs[k]);
-    const __m128i cls =
-        _mm_and_si128(_mm_i32gather_epi32(reinterpret_cast<const int*>(g.classes), cell, 2), low);
-    v[k] = _mm256_cvtps_pd(_mm_i32gather_ps(g.surface, cls, 4));
+                                                        const __m128i xs[4], bool contiguous,
+                                                        __m256d v[4]) {
+  if (!g.cells) {
+    const __m128i low = _mm_set1_epi32(0xFFFF);
+    for (int k = 0; k < 4; ++k) {
+      const __m128i cell = _mm_add_epi32(row_start, xs[k]);
+      const __m128i cls =
+          _mm_and_si128(_mm_i32gather_epi32(reinterpret_cast<const int*>(g.classes), cell, 2), low);
+      v[k] = _mm256_cvtps_pd(_mm_i32gather_ps(g.surface, cls, 4));
+    }
+    return;
   }
+  if (!contiguous) {
+    for (int k = 0; k < 4; ++k) {
+      v[k] = _mm256_cvtps_pd(_mm_i32gather_ps(g.cells, _mm_add_epi32(row_start, xs[k]), 4));
+    }
+    return;
+  }
+  alignas(16) std::int32_t first[4];
+  _mm_store_si128(reinterpret_cast<__m128i*>(first), _mm_add_epi32(row_start, xs[0]));
+  __m128 r0 = _mm_loadu_ps(g.cells + first[0]), r1 = _mm_loadu_ps(g.cells + first[1]);
+  __m128 r2 = _mm_loadu_ps(g.cells + first[2]), r3 = _mm_loadu_ps(g.cells + first[3]);
+  _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
+  v[0] = _mm256_cvtps_pd(r0);
+  v[1] = _mm256_cvtps_pd(r1);
+  v[2] = _mm256_cvtps_pd(r2);
+  v[3] = _mm256_cvtps_pd(r3);
 }
 
 // BicubicDistanceField::sample for the points [0, n) in blocks of four, one
@@ -96,6 +119,8 @@ __attribute__((target("avx2"))) std::size_t sampleBlocksAvx2(const Grid& g, cons
   const __m256d below = _mm256_set1_pd(-2.0);
   const __m256d right = _mm256_set1_pd(g.width + 1.0), top = _mm256_set1_pd(g.height + 1.0);
   const __m128i width = _mm_set1_epi32(g.width);
+  // Columns 1 .. width - 3: the stencil's four columns all on the map.
+  const __m128i last_start = _mm_set1_epi32(g.width - 2);
   std::size_t i = 0;
   for (; i + 4 <= n; i += 4) {
     const __m256d ox = _mm256_sub_pd(_mm256_loadu_pd(wx + i), _mm256_set1_pd(g.origin_x));
@@ -118,10 +143,13 @@ __attribute__((target("avx2"))) std::size_t sampleBlocksAvx2(const Grid& g, cons
     __m128i xs[4], ys[4];
     stencil4(ix, g.width, xs);
     stencil4(iy, g.height, ys);
+    const bool contiguous =
+        _mm_movemask_ps(_mm_castsi128_ps(_mm_and_si128(_mm_cmpgt_epi32(ix, _mm_setzero_si128()),
+                                                       _mm_cmplt_epi32(ix, last_start)))) == 0xF;
     __m256d value = _mm256_setzero_pd(), dgx = value, dgy = value;
     for (int j = 0; j < 4; ++j) {
       __m256d v[4];
-      stencilRow4(g, _mm_mullo_epi32(ys[j], width), xs, v);
+      stencilRow4(g, _mm_mullo_epi32(ys[j], width), xs, contiguous, v);
       __m256d row = _mm256_setzero_pd(), drow = row;
       for (int k = 0; k < 4; ++k) {
         row = _mm256_add_pd(row, _mm256_mul_pd(wxs[k], v[k]));
@@ -204,11 +232,17 @@ void BicubicDistanceField::sample(const double* wx, const double* wy, std::size_
 #if defined(__x86_64__)
   static const bool avx2 = __builtin_cpu_supports("avx2");
   if (avx2 && int_indices_) {
-    const Grid g{cos_yaw_,         sin_yaw_,
-                 inv_resolution_,  origin_x_,
-                 origin_y_,        field_.maxDistance(),
-                 width_,           height_,
-                 field_.classes(), field_.classSurfaceDistances().data()};
+    const Grid g{cos_yaw_,
+                 sin_yaw_,
+                 inv_resolution_,
+                 origin_x_,
+                 origin_y_,
+                 field_.maxDistance(),
+                 width_,
+                 height_,
+                 field_.surfaceCells(),
+                 field_.classes(),
+                 field_.classSurfaceDistances().data()};
     i = sampleBlocksAvx2(g, wx, wy, n, out);
   }
 #endif

@@ -120,6 +120,10 @@ DistanceField::DistanceField(OccupancyGrid grid, double max_distance, int thread
     distances_[c] = v > 0.0f ? v : 0.0f;
     surfaces_[c] = std::fabs(v);
   }
+  if (size() <= kMaxFloatCells) {
+    surface_cells_.resize(size());
+    for (std::size_t i = 0; i < size(); ++i) surface_cells_[i] = surfaces_[classes_[i]];
+  }
 }
 
 namespace {

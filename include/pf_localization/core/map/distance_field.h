@@ -68,6 +68,14 @@ class DistanceField {
   /// map out of date is not a wrong pose".
   float surfaceDistance(std::size_t i) const { return surfaces_[classes_[i]]; }
   std::size_t size() const { return classes_.size() - 1; }
+  /// Every cell's surface distance as a float, row-major, on a map of up to
+  /// kMaxFloatCells cells (nullptr on a larger one): the scan fit's
+  /// stencils read four neighbours in one load there, where classes take a
+  /// gather and a lookup each (the refinement's samples cost twice as much).
+  const float* surfaceCells() const {
+    return surface_cells_.empty() ? nullptr : surface_cells_.data();
+  }
+  static constexpr std::size_t kMaxFloatCells = std::size_t{16} << 20;
 
   /// Every cell's class, row-major, for loops over many cells: the cell's
   /// distance is classDistances()[class], its surface distance
@@ -99,6 +107,7 @@ class DistanceField {
   double max_distance_;
   std::vector<uint16_t> classes_;  // see classes()
   std::vector<float> distances_, surfaces_;
+  std::vector<float> surface_cells_;  // see surfaceCells()
 };
 
 }  // namespace pf
