@@ -104,7 +104,7 @@ LikelihoodFieldModel::LikelihoodFieldModel(OccupancyGrid grid,
     : params_((validate(params), params)),
       field_(std::make_shared<const DistanceField>(std::move(grid), params.max_distance,
                                                    params.threads)),
-      cell_tables_(layout == TableLayout::kBySize ? field_->size() <= kMaxCellTableCells
+      cell_tables_(layout == TableLayout::kBySize ? field_->size() <= DistanceField::kMaxFloatCells
                                                   : layout == TableLayout::kPerCell) {
   if (!params.beam_skip) return;
   const OccupancyGrid& map = field_->grid();

@@ -10,7 +10,7 @@
 //
 // log p depends only on the distance of the cell an end point falls in, so
 // it is precomputed once per map (and per range_max): a map of up to
-// kMaxCellTableCells cells gets a float a cell, with a one-cell border that
+// DistanceField::kMaxFloatCells cells gets a float a cell, with a one-cell border that
 // stands for "outside the map", and the per-beam work is: transform the end
 // point, clamp the cell index into the table, add. A larger map's cells'
 // distances take few values (the field keeps a class a cell:
@@ -82,9 +82,7 @@ void validate(const LikelihoodFieldModelParams& params);
 
 class LikelihoodFieldModel : public SensorModel {
  public:
-  /// The largest map whose tables hold a float a cell (64 MB a table).
-  static constexpr std::size_t kMaxCellTableCells = std::size_t{16} << 20;
-  /// How the tables are laid out: by the map's size (kMaxCellTableCells),
+  /// How the tables are laid out: by the map's size (DistanceField::kMaxFloatCells),
   /// or either way whatever the size (for tests: the scores are the same).
   enum class TableLayout { kBySize, kPerCell, kPerClass };
 
