@@ -1,6 +1,7 @@
 #include "pf_localization/core/map/distance_transform.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <limits>
 #include <stdexcept>
@@ -85,38 +86,58 @@ std::vector<float> squaredDistanceTransform(const std::vector<bool>& is_source, 
 
 void cappedRowPass(const uint16_t* g, int n, uint16_t cap, RowPassScratch* scratch, int32_t* d) {
   std::vector<int>& v = scratch->v;
-  std::vector<double>& z = scratch->z;
+  std::vector<int64_t>& z_num = scratch->z_num;
+  std::vector<int64_t>& z_den = scratch->z_den;
   v.resize(static_cast<std::size_t>(n));
-  z.resize(static_cast<std::size_t>(n) + 1);
-  const auto f = [g](int p) { return static_cast<double>(g[p]) * g[p]; };
+  z_num.resize(static_cast<std::size_t>(n));
+  z_den.resize(static_cast<std::size_t>(n));
+  // f(p) + p^2, the numerators' parts: below 2^17 + n^2.
+  const auto h = [g](int p) { return int64_t{g[p]} * g[p] + int64_t{p} * p; };
   // Felzenszwalb-Huttenlocher's envelope (transform1d above), over the
-  // sources that can reach below the cap only; z[0] is -inf, so once a
-  // source is in, k never drops below 0.
+  // sources that can reach below the cap only, in integers: the boundary
+  // between the parabolas at p < q is (h(q) - h(p)) / (2 (q - p)), and
+  // boundaries are compared by cross-multiplying (the products stay below
+  // 2^62 for rows of up to 2^20 cells), not divided. The first boundary is
+  // -inf: once a source is in, k never drops below 0.
   int k = -1;
   for (int q = 0; q < n; ++q) {
     if (g[q] >= cap) continue;
-    const double fq = f(q) + static_cast<double>(q) * q;
-    double s = -std::numeric_limits<double>::infinity();
+    const int64_t hq = h(q);
+    int64_t num = 0, den = 1;
     while (k >= 0) {
       const int p = v[k];
-      s = (fq - (f(p) + static_cast<double>(p) * p)) / (2.0 * (q - p));
-      if (s > z[k]) break;
+      num = hq - h(p);
+      den = 2 * int64_t{q - p};
+      if (k == 0 || num * z_den[k] > z_num[k] * den) break;
       --k;
     }
     ++k;
     v[k] = q;
-    z[k] = s;
+    z_num[k] = num;
+    z_den[k] = den;
   }
   if (k < 0) {
     std::fill(d, d + n, -1);
     return;
   }
-  z[k + 1] = std::numeric_limits<double>::infinity();
-  int j = 0;
-  for (int q = 0; q < n; ++q) {
-    while (z[j + 1] < q) ++j;
-    const int dq = std::abs(q - v[j]);
-    d[q] = dq < cap ? dq * dq + int32_t{g[v[j]]} * g[v[j]] : -1;
+  // Parabola j holds the cells up to floor(z[j + 1]); a double's quotient
+  // floors exactly, as a fraction of denominator below 2^21 is never within
+  // 2^-21 of an integer it is not. Within a parabola's cells, those fewer
+  // than cap columns from its source get its distance, the others -1.
+  int q = 0;
+  for (int j = 0; j <= k && q < n; ++j) {
+    int last = n - 1;
+    if (j < k) {
+      const double z = static_cast<double>(z_num[j + 1]) / static_cast<double>(z_den[j + 1]);
+      last = static_cast<int>(std::clamp<double>(std::floor(z), -1.0, n - 1.0));
+    }
+    if (last < q) continue;
+    const int p = v[j];
+    const int32_t gp2 = int32_t{g[p]} * g[p];
+    const int lo = std::clamp(p - cap + 1, q, last + 1), hi = std::min(last, p + cap - 1);
+    for (; q < lo; ++q) d[q] = -1;
+    for (; q <= hi; ++q) d[q] = (q - p) * (q - p) + gp2;
+    for (; q <= last; ++q) d[q] = -1;
   }
 }
 

@@ -105,10 +105,18 @@ class NearObstacle {
     }
   }
   const OccupancyGrid& grid() const { return grid_; }
-  bool near(const CellIndex& cell) const {
-    if (!grid_.contains(cell)) return false;
-    const auto i = static_cast<std::size_t>(grid_.linearIndex(cell));
-    return (bits_[i / 64] >> (i % 64)) & 1;
+  /// The bits of cells (x0 + k, y), k in [0, n), as bit k of one word
+  /// (0 off the map); n at most 64.
+  uint64_t row(int x0, int y, int n) const {
+    const int lo = std::max(x0, 0), hi = std::min(x0 + n, grid_.width());
+    if (y < 0 || y >= grid_.height() || lo >= hi) return 0;
+    const std::size_t i = static_cast<std::size_t>(y) * grid_.width() + lo;
+    const std::size_t word = i / 64, shift = i % 64;
+    uint64_t v = bits_[word] >> shift;
+    if (shift != 0 && word + 1 < bits_.size()) v |= bits_[word + 1] << (64 - shift);
+    const int k = hi - lo;
+    if (k < 64) v &= (uint64_t{1} << k) - 1;
+    return v << (lo - x0);
   }
 
  private:
@@ -118,33 +126,43 @@ class NearObstacle {
 
 // The best of `candidate` moved by multiples of `step` cells within
 // +-reach cells, scored by the share of `samples` (grid-frame points) each
-// move puts within one cell of an obstacle. Each sample is tried at every
-// move in turn, so that the moves' cells, close together, share cache lines.
-// The first best move in row order wins.
+// move puts within one cell of an obstacle. A move by whole cells moves a
+// sample's cell by as many (samples are cell centres, and candidates whole
+// cells or half turns about cell corners: a sample is half a cell from any
+// boundary), so each sample reads the row of bits under each move's row at
+// once. The first best move in row order wins.
 Candidate bestOffset(const NearObstacle& near, const std::vector<Eigen::Vector2d>& samples,
                      const Pose2& candidate, int reach, int step) {
   const double res = near.grid().resolution();
-  std::vector<Pose2> moves;
-  for (int dy = -reach; dy <= reach; dy += step) {
-    for (int dx = -reach; dx <= reach; dx += step) {
-      moves.push_back({candidate.x + dx * res, candidate.y + dy * res, candidate.yaw});
-    }
-  }
+  const int side = 2 * (reach / step) + 1, span = 2 * reach + 1;
+  std::vector<std::size_t> hits(static_cast<std::size_t>(side) * side, 0);
   const double c = std::cos(candidate.yaw), s = std::sin(candidate.yaw);
-  std::vector<std::size_t> hits(moves.size(), 0);
   for (const Eigen::Vector2d& u : samples) {
-    const double rx = c * u.x() - s * u.y(), ry = s * u.x() + c * u.y();
-    for (std::size_t k = 0; k < moves.size(); ++k) {
-      const double x = rx + moves[k].x, y = ry + moves[k].y;
-      hits[k] +=
-          near.near({static_cast<int>(std::floor(x / res)), static_cast<int>(std::floor(y / res))});
+    const double x = c * u.x() - s * u.y() + candidate.x, y = s * u.x() + c * u.y() + candidate.y;
+    const int cx = static_cast<int>(std::floor(x / res)),
+              cy = static_cast<int>(std::floor(y / res));
+    for (int r = 0; r < side; ++r) {
+      const int dy = r * step - reach;
+      std::size_t* row_hits = &hits[static_cast<std::size_t>(r) * side];
+      if (span <= 64) {
+        const uint64_t bits = near.row(cx - reach, cy + dy, span);
+        if (bits == 0) continue;
+        for (int k = 0; k < side; ++k) row_hits[k] += (bits >> (k * step)) & 1;
+      } else {
+        for (int k = 0; k < side; ++k) {
+          row_hits[k] += near.row(cx + k * step - reach, cy + dy, 1);
+        }
+      }
     }
   }
   Candidate best{candidate, -1.0};
-  for (std::size_t k = 0; k < moves.size(); ++k) {
+  for (std::size_t k = 0; k < hits.size(); ++k) {
     const double score =
         samples.empty() ? 0.0 : static_cast<double>(hits[k]) / static_cast<double>(samples.size());
-    if (score > best.score) best = {moves[k], score};
+    const int dx = static_cast<int>(k % side) * step - reach;
+    const int dy = static_cast<int>(k / side) * step - reach;
+    if (score > best.score)
+      best = {{candidate.x + dx * res, candidate.y + dy * res, candidate.yaw}, score};
   }
   return best;
 }

@@ -59,10 +59,12 @@ void cappedColumnDistances(const IsSource& is_source, int width, int height, uin
 }
 
 /// The scratch of cappedRowPass, kept between rows: the lower envelope's
-/// parabolas (their columns) and the boundaries between them.
+/// parabolas (their columns) and the boundaries between them, each the
+/// fraction z_num / z_den (z_den > 0).
 struct RowPassScratch {
   std::vector<int> v;
-  std::vector<double> z;
+  std::vector<int64_t> z_num;
+  std::vector<int64_t> z_den;
 };
 
 /// The row pass over one row of column distances g[0, n) from
