@@ -108,6 +108,11 @@ DistanceField::DistanceField(OccupancyGrid grid, double max_distance, int thread
                                 std::to_string(static_cast<int>(kMaxCapCells)) + " cells of " +
                                 std::to_string(grid_.resolution()) + " m");
   }
+  if (grid_.width() > kMaxRowPassCells) {
+    throw std::invalid_argument("likelihood field: the map is " + std::to_string(grid_.width()) +
+                                " cells wide, more than the " + std::to_string(kMaxRowPassCells) +
+                                " its distance transform takes");
+  }
   const ValueClasses values(static_cast<float>(grid_.resolution()),
                             static_cast<float>(max_distance));
   classes_.assign(grid_.data().size() + 1, values.outside_cap_class);

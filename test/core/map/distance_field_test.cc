@@ -10,6 +10,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "pf_localization/core/map/distance_transform.h"
+
 namespace pf {
 namespace {
 
@@ -205,6 +207,16 @@ TEST(DistanceField, InvalidMaxDistanceThrows) {
   // 0.5 m cells: 1 024 m is 2 048 cells, the most the field lists.
   EXPECT_NO_THROW(DistanceField(grid, 1024.0));
   EXPECT_THROW(DistanceField(grid, 1024.5), std::invalid_argument);
+}
+
+TEST(DistanceField, RowsLongerThanTheTransformTakesAreRefused) {
+  const auto row = [](int width) {
+    std::vector<int8_t> data(static_cast<std::size_t>(width), 0);
+    data[0] = 100;
+    return OccupancyGrid(width, 1, 0.05, {}, data);
+  };
+  EXPECT_NO_THROW(DistanceField(row(kMaxRowPassCells), 0.2));
+  EXPECT_THROW(DistanceField(row(kMaxRowPassCells + 1), 0.2), std::invalid_argument);
 }
 
 TEST(DistanceField, FewClassesHoldEveryValueExactly) {

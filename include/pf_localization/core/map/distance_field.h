@@ -44,7 +44,8 @@ class DistanceField {
   static constexpr double kMaxCapCells = 2048.0;
 
   /// Throws std::invalid_argument when max_distance is not positive and
-  /// finite, or more than kMaxCapCells cells. Keeps `grid` (moved in: a
+  /// finite, or more than kMaxCapCells cells, or when the map is more than
+  /// kMaxRowPassCells (distance_transform.h) wide. Keeps `grid` (moved in: a
   /// large map is not held twice). Its passes run on up to `threads`
   /// threads (WorkerPool); the result is the same on any number.
   DistanceField(OccupancyGrid grid, double max_distance, int threads = 1);

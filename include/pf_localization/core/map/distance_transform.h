@@ -67,11 +67,16 @@ struct RowPassScratch {
   std::vector<int64_t> z_den;
 };
 
+/// The longest row cappedRowPass takes: its integer arithmetic stays below
+/// 2^62 up to it.
+constexpr int kMaxRowPassCells = 1 << 20;
+
 /// The row pass over one row of column distances g[0, n) from
 /// cappedColumnDistances with the same `cap`: d[x] = min over x' of
 /// (x - x')^2 + g[x']^2 over the sources with g[x'] < cap, where that is
 /// below cap^2; -1 where there is no such source, and maybe where it is
-/// cap^2 or more (a source cap or more columns away).
+/// cap^2 or more (a source cap or more columns away). n at most
+/// kMaxRowPassCells.
 void cappedRowPass(const uint16_t* g, int n, uint16_t cap, RowPassScratch* scratch, int32_t* d);
 
 }  // namespace pf
