@@ -28,8 +28,8 @@ OccupancyGrid::OccupancyGrid(int width, int height, double resolution, const Pos
                                 " cell values for a " + std::to_string(width) + " x " +
                                 std::to_string(height) + " grid");
   }
-  free_cells_ = FreeCells(data_.size(),
-                          [this](std::size_t i) { return classify(data_[i]) == CellState::kFree; });
+  static_assert(kFreeMax >= 0, "classify: free is [0, kFreeMax]");
+  free_cells_ = FreeCells::ofValues(data_.data(), data_.size(), kFreeMax);
 }
 
 CellState OccupancyGrid::state(const CellIndex& c) const {

@@ -42,5 +42,21 @@ TEST(FreeCells, AFewBitsACell) {
   EXPECT_LE(all.bytes(), cells / 64 * 12 + 12);
 }
 
+TEST(FreeCells, OfValuesIsTheSetOfItsPredicate) {
+  // Every value a cell can hold, in runs that end anywhere in a word.
+  std::mt19937 rng(7);
+  for (std::size_t cells : {0, 1, 7, 8, 63, 64, 65, 200, 1000}) {
+    std::vector<int8_t> values(cells);
+    for (int8_t& v : values) v = static_cast<int8_t>(rng() % 256);
+    for (int8_t free_max : {0, 19, 64, 126}) {
+      const FreeCells fast = FreeCells::ofValues(values.data(), cells, free_max);
+      const FreeCells slow(cells,
+                           [&](std::size_t i) { return values[i] >= 0 && values[i] <= free_max; });
+      ASSERT_EQ(slow.size(), fast.size()) << cells << " cells, free_max " << int{free_max};
+      for (std::size_t k = 0; k < slow.size(); ++k) ASSERT_EQ(slow[k], fast[k]);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace pf
