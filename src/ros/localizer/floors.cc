@@ -17,7 +17,7 @@ constexpr double kSearchPeriod = 0.2;  // s of wall time between two looks at th
 std::optional<pf::FloorsFile> Floors::read(const std::string& path) {
   try {
     pf::FloorsFile file = pf::loadFloorsFile(path);
-    ROS_INFO("pf_node: floors_file %s: %zu floors (%s), starting on '%s'", path.c_str(),
+    ROS_INFO("pf_node: floors_file %s: %zu floors (%s), initial floor '%s'", path.c_str(),
              file.floors.size(), file.names().c_str(), file.floors[file.initial].name.c_str());
     return file;
   } catch (const pf::FloorsFileError& e) {
@@ -45,7 +45,15 @@ Floors::~Floors() {
 }
 
 bool Floors::start() {
-  const Outcome outcome = change(file_.floors[file_.initial].name, std::nullopt);
+  // A pose saved on a floor is used there (decideSavedPose: and only there).
+  const std::string saved = scheduler_->withFilter([&] { return live_->savedPoseFloor(); });
+  std::size_t index = file_.initial;
+  if (const std::optional<std::size_t> found = file_.find(saved); found && !saved.empty()) {
+    index = *found;
+    ROS_INFO("pf_node: starting on floor '%s', where the earlier run saved its pose",
+             saved.c_str());
+  }
+  const Outcome outcome = change(file_.floors[index].name, std::nullopt);
   if (!outcome.ok) ROS_ERROR("pf_node: %s", outcome.message.c_str());
   return outcome.ok;
 }

@@ -73,7 +73,7 @@ bool LiveLocalizer::changeFloor(std::optional<BuiltMap> built, const std::string
   // A first map without a pose starts as any first map does: from the
   // configured initial pose (or a saved one, checked), or globally.
   const bool starts = !have_map_ && !pose;
-  if (built && !install(std::move(*built), stamp, replaced, starts)) return false;
+  if (built && !install(std::move(*built), stamp, floor, replaced, starts)) return false;
   output_.setFloor(floor);
   if (starts) return true;
   if (!pose) return startGlobalLocalization();
@@ -83,7 +83,7 @@ bool LiveLocalizer::changeFloor(std::optional<BuiltMap> built, const std::string
   return false;
 }
 
-bool LiveLocalizer::install(BuiltMap built, const ros::Time& stamp,
+bool LiveLocalizer::install(BuiltMap built, const ros::Time& stamp, const std::string& floor,
                             std::optional<pf::PreparedMap>* replaced, bool announce) {
   const bool first = !have_map_;
   const nav_msgs::MapMetaData info = built.ready.info;
@@ -96,8 +96,8 @@ bool LiveLocalizer::install(BuiltMap built, const ros::Time& stamp,
   have_map_ = true;
   placement_.reset();
   if (config_.save_pose_rate > 0.0 || (first && saved_pose_)) {
-    saver_.setMap(signature);
-    if (first && saved_pose_) checkSavedPose(signature);
+    saver_.setMap(signature, floor);
+    if (first && saved_pose_) checkSavedPose(signature, floor);
   }
   if (changes_saver_.enabled()) mapChangesOnNewMap(signature, first, stamp);
   ROS_INFO("pf_node: map %u x %u cells at %.3f m; %zu particles", info.width, info.height,
@@ -109,11 +109,11 @@ bool LiveLocalizer::install(BuiltMap built, const ros::Time& stamp,
 }
 
 // On the first map, when the configured initial pose was saved by an
-// earlier run: it stays only on the map it was saved on, in free space;
-// otherwise global localization, now and on a restart.
-void LiveLocalizer::checkSavedPose(const std::string& map_signature) {
+// earlier run: it stays only on the map (and floor) it was saved on, in free
+// space; otherwise global localization, now and on a restart.
+void LiveLocalizer::checkSavedPose(const std::string& map_signature, const std::string& floor) {
   const SavedPoseDecision d = decideSavedPose(*saved_pose_, *config_.initial_pose, map_signature,
-                                              *localizer_.filter().map());
+                                              *localizer_.filter().map(), floor);
   saved_pose_.reset();
   if (d.resume) {
     ROS_INFO("pf_node: %s", d.message.c_str());

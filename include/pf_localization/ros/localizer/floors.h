@@ -76,8 +76,11 @@ class Floors {
   Floors& operator=(const Floors&) = delete;
 
   /// Installs the initial floor's map, as the first map: the filter starts
-  /// from the configured initial pose, or globally. False when its map cannot
-  /// be loaded (logged; change_floor may still bring another floor's).
+  /// from the configured initial pose, or globally. A pose an earlier run
+  /// saved on a floor (saved_pose.h) starts on that floor instead, when the
+  /// file has it (otherwise the initial floor, where the pose is not used:
+  /// one warning). False when its map cannot be loaded (logged; change_floor
+  /// may still bring another floor's).
   bool start();
 
   /// Moves to floor `name`: at `pose` (any frame tf knows), or with global

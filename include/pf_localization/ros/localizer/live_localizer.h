@@ -86,6 +86,10 @@ class LiveLocalizer {
   /// Whether a map was installed. Changed only by installMap(), which pf_node
   /// calls from its main spinner; read there without the mutex.
   bool haveMap() const { return have_map_; }
+  /// The floor the configured initial pose was saved on by an earlier run
+  /// (saved_pose.h), until the first map checks it: empty when it is not a
+  /// saved one or names no floor. Floors starts on it when it has it.
+  std::string savedPoseFloor() const { return saved_pose_ ? saved_pose_->floor : ""; }
 
   /// For a search of every floor (floors.h), with the filter's lock held:
   /// the filter's live parameters, every update's odometry and scans
@@ -145,11 +149,12 @@ class LiveLocalizer {
  private:
   void logInitialPose() const;
   // installMap's part with the filter's lock held: `built`, from a map
-  // stamped `stamp`, replaces the filter's map (which goes to `replaced`, if
-  // any); `announce`: map -> odom and the estimate go out now.
-  bool install(BuiltMap built, const ros::Time& stamp,
+  // stamped `stamp` (floor `floor`'s with a building's floors, else empty),
+  // replaces the filter's map (which goes to `replaced`, if any);
+  // `announce`: map -> odom and the estimate go out now.
+  bool install(BuiltMap built, const ros::Time& stamp, const std::string& floor = "",
                std::optional<pf::PreparedMap>* replaced = nullptr, bool announce = true);
-  void checkSavedPose(const std::string& map_signature);
+  void checkSavedPose(const std::string& map_signature, const std::string& floor);
   // A new map of signature `signature` for the layer's saver; on the first
   // (`first`), the layer saved on it restored and published.
   void mapChangesOnNewMap(const std::string& signature, bool first, const ros::Time& stamp);
