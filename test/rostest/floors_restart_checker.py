@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """rostest checker: pf_node with a building's floors (floors_file) restarts on the floor it saved its
-pose on, at that pose.
+pose on, at that pose, and with each floor's change layer.
 
 Starts the pf_node binary itself (as map_changes_restart_checker.py does), named `node`, with
 config/pf.yaml's defaults, floors_file `floors`, save_pose_rate 2 Hz and map_changes_file in a fresh
@@ -15,9 +15,17 @@ temporary folder, under this test's master with /use_sim_time set:
      must be within `max_first_error` m of the ground truth (interpolated at its stamp: the robot
      moved on between the two runs' scans), and every one from `settle` s after the restart within
      `max_error` m.
+Each floor's change layer (pf_map_changes) goes to its own file beside map_changes_file: run 2
+publishes the upper floor's before any scan, and, on change_floor to the ground floor after the bag,
+the ground floor's (left at run 1's ride), each with at least `min_share` of the cells run 1's last
+one of that floor had seen.
+  3. pf_node on a floors file whose upper floor has another map (`other_map`): on change_floor there
+     it says once, however many rides, that the upper floor's layer was learned on another map.
+  4. pf_node on `floors` with a saved pose on a floor it does not have: it starts on the initial
+     floor, and says why once.
 The nodes' logs are read from their output.
 
-Private params: bag, floors, node (pf_floors), first_from [s of the bag] (30), restart_at (44),
+Private params: bag, floors, other_map, node (pf_floors), min_share (0.9), first_from [s of the bag] (30), restart_at (44),
 second_seconds (16), rate (2), max_first_error [m] (0.3), settle [s] (1), max_error [m] (0.05),
 wait [s of wall time for each step] (30).
 """
@@ -41,6 +49,7 @@ import rostest
 import yaml
 from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped
 from pf_localization.srv import ChangeFloor
+from nav_msgs.msg import OccupancyGrid
 from std_msgs.msg import String
 
 PKG = 'pf_localization'
@@ -83,10 +92,23 @@ class Watch:
         rospy.Subscriber('/pf_pose', PoseWithCovarianceStamped, self._on_pose, queue_size=100)
         rospy.Subscriber('/ground_truth', PoseStamped, self._on_truth, queue_size=10)
         rospy.Subscriber('/floor', String, self._on_bag_floor, queue_size=10)
+        self.layers = []       # pf_map_changes' messages since the last clear()
+        rospy.Subscriber('/pf_map_changes', OccupancyGrid, self._on_layer, queue_size=10)
 
     def clear(self):
         with self.lock:
-            self.floors, self.poses, self.bag_floor = [], [], []
+            self.floors, self.poses, self.bag_floor, self.layers = [], [], [], []
+
+    def _on_layer(self, msg):
+        with self.lock:
+            self.layers.append(msg)
+
+    def layer(self):
+        """The cells the latest pf_map_changes has seen, and how many came."""
+        with self.lock:
+            if not self.layers:
+                return None, 0
+            return {i for i, v in enumerate(self.layers[-1].data) if v != -1}, len(self.layers)
 
     def _on_floor(self, msg):
         with self.lock:
@@ -114,6 +136,8 @@ class FloorsRestartTest(unittest.TestCase):
             cls.defaults = yaml.safe_load(f)
         cls.bag = rospy.get_param('~bag')
         cls.floors = rospy.get_param('~floors')
+        cls.other_map = rospy.get_param('~other_map')
+        cls.min_share = float(rospy.get_param('~min_share', 0.9))
         cls.node = rospy.get_param('~node', 'pf_floors')
         cls.first_from = float(rospy.get_param('~first_from', 30.0))
         cls.restart_at = float(rospy.get_param('~restart_at', 44.0))
@@ -126,6 +150,9 @@ class FloorsRestartTest(unittest.TestCase):
         cls.start, cls.truth_t, cls.truth = truth_of(cls.bag)
         cls.dir = tempfile.mkdtemp(prefix='floors_restart_')
         cls.file = os.path.join(cls.dir, 'layer', cls.node + '.map_changes')
+        cls.floor_file = {f: os.path.join(cls.dir, 'layer', '%s.%s.map_changes' % (cls.node, f))
+                          for f in ('ground', 'upper')}
+        cls.seen = {}  # floor -> the cells run 1's last pf_map_changes on it had seen
         cls.watch = Watch()
         cls.procs = []
         cls.report = []
@@ -196,10 +223,30 @@ class FloorsRestartTest(unittest.TestCase):
         self.assertEqual(0, proc.returncode, '%s exited %d:\n%s'
                          % (run, proc.returncode, self.output(run)))
 
+    def change_floor(self, run, floor):
+        """change_floor to `floor` without a pose."""
+        res = rospy.ServiceProxy('/change_floor', ChangeFloor)(floor, PoseWithCovarianceStamped())
+        self.assertTrue(res.success, '%s: change_floor %s: %s' % (run, floor, res.message))
+
+    def wait_for_layer(self, run, after):
+        """The cells pf_map_changes has seen once more than `after` messages came."""
+        self.wait_for('published pf_map_changes', lambda: self.watch.layer()[1] > after, run)
+        return self.watch.layer()
+
+    def check_restored(self, run, floor, seen):
+        self.wait_for_line(run, "floor '%s': restored the map changes learned on this map from %s"
+                           % (floor, self.floor_file[floor]))
+        kept = len(self.seen[floor] & seen) / float(len(self.seen[floor]))
+        self.report.append('%s: floor %s\'s layer restored: %d cells seen, %.3f of run 1\'s %d'
+                           % (run, floor, len(seen), kept, len(self.seen[floor])))
+        self.assertGreaterEqual(kept, self.min_share, '; '.join(self.report))
+
     def ride(self, run):
         """change_floor at each of the bag's rides seen since the last clear(), with the true pose."""
         with self.watch.lock:
             rides, self.watch.bag_floor = self.watch.bag_floor, []
+        if rides:
+            self.seen['ground'] = self.watch.layer()[0]
         for floor, truth in rides:
             self.assertIsNotNone(truth, 'no ground truth before the ride to ' + floor)
             pose = PoseWithCovarianceStamped()
@@ -240,7 +287,12 @@ class FloorsRestartTest(unittest.TestCase):
             riding.set()
             thread.join()
         self.wait_for_floor('run1', 'upper')
+        self.seen['upper'] = self.watch.layer()[0]
         self.interrupt('run1', proc)
+        for floor in ('ground', 'upper'):
+            self.assertTrue(self.seen[floor], 'run 1 saw no cell on floor ' + floor)
+            self.assertTrue(os.path.exists(self.floor_file[floor]), self.floor_file[floor])
+        self.assertFalse(os.path.exists(self.file), 'a floor\'s layer in the single map\'s file')
         saved = rospy.get_param('/%s/saved_pose_map' % self.node)
         self.report.append('run 1 saved: ...' + saved[saved.index('; pose'):])
         self.assertTrue(saved.endswith('; floor upper'), saved)
@@ -251,6 +303,11 @@ class FloorsRestartTest(unittest.TestCase):
         self.wait_for_floor('run2', 'upper')
         self.wait_for_line('run2', "starting on floor 'upper', where the earlier run saved its pose")
         self.wait_for_line('run2', "resuming from the pose saved by an earlier run at")
+        seen, _ = self.wait_for_layer('run2', 0)
+        with self.watch.lock:  # the pose at start-up is stamped 0
+            updates = [p for p in self.watch.poses if p[0] > 0]
+        self.assertFalse(updates, 'run 2: an update before the bag played')
+        self.check_restored('run2', 'upper', seen)
         self.play('play2', self.restart_at, self.second_seconds)
         with self.watch.lock:
             poses, floors = list(self.watch.poses), list(self.watch.floors)
@@ -271,12 +328,68 @@ class FloorsRestartTest(unittest.TestCase):
                               worst[1], worst[0]))
         self.assertLessEqual(first[1], self.max_first_error, '; '.join(self.report))
         self.assertLessEqual(worst[1], self.max_error, '; '.join(self.report))
+        # The ground floor's layer, left at run 1's ride, comes back with its map.
+        count = self.watch.layer()[1]
+        self.change_floor('run2', 'ground')
+        seen, _ = self.wait_for_layer('run2', count)
+        self.check_restored('run2', 'ground', seen)
         return proc
+
+    def third_run(self):
+        """The upper floor's map changed: its layer is refused, said once."""
+        with open(self.floors) as f:
+            floors = yaml.safe_load(f)
+        folder = os.path.dirname(self.floors)
+        for floor in floors['floors']:
+            floor['map'] = os.path.join(folder, floor['map'])
+            if floor['name'] == 'upper':
+                floor['map'] = self.other_map
+        changed = os.path.join(self.dir, 'changed_floors.yaml')
+        with open(changed, 'w') as f:
+            yaml.safe_dump(floors, f)
+        rospy.set_param('/%s/floors_file' % self.node, changed)
+        rospy.delete_param('/%s/saved_pose_map' % self.node)  # the pose as given: ground floor
+        self.watch.clear()
+        proc = self.start_pf_node('run3')
+        self.wait_for_floor('run3', 'ground')
+        rospy.wait_for_service('/change_floor', timeout=self.wait)
+        for floor in ('upper', 'ground', 'upper'):
+            self.change_floor('run3', floor)
+        self.wait_for_floor('run3', 'upper')
+        refused = "floor 'upper': the map changes in %s were learned on another map" \
+            % self.floor_file['upper']
+        lines = [l for l in self.output('run3').splitlines() if refused in l]
+        self.assertEqual(1, len(lines), 'run 3 said %d times "%s":\n%s'
+                         % (len(lines), refused, self.output('run3')))
+        self.assertIn('WARN', lines[0])
+        self.report.append('run 3: ' + lines[0][lines[0].index('pf_node:'):][:150] + '...')
+        self.interrupt('run3', proc)
+        rospy.set_param('/%s/floors_file' % self.node, self.floors)
+
+    def fourth_run(self):
+        """A pose saved on a floor the floors file does not have: the initial floor, said once."""
+        pose = [rospy.get_param('/%s/%s' % (self.node, k))
+                for k in ('initial_pose_x', 'initial_pose_y', 'initial_pose_a')]
+        rospy.set_param('/%s/saved_pose_map' % self.node,
+                        'some map; pose %r %r %r; floor attic' % tuple(pose))
+        self.watch.clear()
+        proc = self.start_pf_node('run4')
+        self.wait_for_floor('run4', 'ground')
+        why = "it was saved on floor 'attic', which the floors file does not have. " \
+              "Starting on floor 'ground' with global localization"
+        self.wait_for_line('run4', why)
+        lines = [l for l in self.output('run4').splitlines() if 'attic' in l]
+        self.assertEqual(1, len(lines), 'run 4:\n' + self.output('run4'))
+        self.assertIn('WARN', lines[0])
+        self.report.append('run 4: ' + lines[0][lines[0].index('pf_node:'):])
+        self.interrupt('run4', proc)
 
     def test_restart(self):
         self.first_run()
         second = self.second_run()
         self.interrupt('run2', second)
+        self.third_run()
+        self.fourth_run()
         print('floors_restart_checker:\n  ' + '\n  '.join(self.report))
         sys.stdout.flush()
 

@@ -113,6 +113,7 @@ std::optional<LiveLocalizer::BuiltMap> Floors::mapOf(std::size_t index, std::str
     kept.map.reset();
     built.ready.info = kept.info;
     built.signature = kept.signature;
+    built.kept = true;
     return built;
   }
   nav_msgs::OccupancyGrid map;

@@ -88,6 +88,10 @@ bool LiveLocalizer::install(BuiltMap built, const ros::Time& stamp, const std::s
   const bool first = !have_map_;
   const nav_msgs::MapMetaData info = built.ready.info;
   const std::string& signature = built.signature;
+  // The floor left: its layer's last copy, for its own file.
+  if (!floor.empty() && !first) {
+    changes_saver_.offer(localizer_.mapChanges(), ros::WallTime::now(), true);
+  }
   const std::string error = localizer_.setMap(std::move(built.ready), replaced);
   if (!error.empty()) {
     ROS_ERROR("pf_node: %s", error.c_str());
@@ -99,7 +103,10 @@ bool LiveLocalizer::install(BuiltMap built, const ros::Time& stamp, const std::s
     saver_.setMap(signature, floor);
     if (first && saved_pose_) checkSavedPose(signature, floor);
   }
-  if (changes_saver_.enabled()) mapChangesOnNewMap(signature, first, stamp);
+  // A floor's layer is restored with its map's first build, a single map's on the first map.
+  if (changes_saver_.enabled()) {
+    mapChangesOnNewMap(signature, floor, floor.empty() ? first : !built.kept, stamp);
+  }
   ROS_INFO("pf_node: map %u x %u cells at %.3f m; %zu particles", info.width, info.height,
            info.resolution, localizer_.filter().particles().size());
   if (!announce) return true;
@@ -127,19 +134,22 @@ void LiveLocalizer::checkSavedPose(const std::string& map_signature, const std::
   if (!error.empty()) ROS_WARN("pf_node: %s", error.c_str());
 }
 
-void LiveLocalizer::mapChangesOnNewMap(const std::string& signature, bool first,
-                                       const ros::Time& stamp) {
-  changes_saver_.setMap(signature);
-  if (!first) return;
-  const MapChangesRestore r =
-      restoreMapChanges(changes_saver_.path(), signature, &localizer_.filter());
+void LiveLocalizer::mapChangesOnNewMap(const std::string& signature, const std::string& floor,
+                                       bool restore, const ros::Time& stamp) {
+  const std::string path =
+      floor.empty() ? changes_saver_.path() : floorMapChangesPath(changes_saver_.path(), floor);
+  // A kept floor's layer is as its file holds it, or as a pending copy will.
+  changes_saver_.setMap(signature, restore ? 0 : localizer_.mapChanges()->scans(), path);
+  if (!restore) return;
+  const MapChangesRestore r = restoreMapChanges(path, signature, &localizer_.filter());
+  const std::string on = floor.empty() ? "" : "floor '" + floor + "': ";
   if (r.level == MapChangesRestore::Level::kWarn) {
-    ROS_WARN("pf_node: %s", r.message.c_str());
+    ROS_WARN("pf_node: %s%s", on.c_str(), r.message.c_str());
   } else {
-    ROS_INFO("pf_node: %s", r.message.c_str());
+    ROS_INFO("pf_node: %s%s", on.c_str(), r.message.c_str());
   }
   if (!r.restored) return;
-  changes_saver_.setMap(signature, localizer_.mapChanges()->scans());  // the file holds it
+  changes_saver_.setMap(signature, localizer_.mapChanges()->scans(), path);  // the file holds it
   output_.publishMapChangesNow(localizer_, stamp);
 }
 

@@ -5,8 +5,9 @@
 // max_update_time's particle cap, time jumping back (TimeJumpHandler: tf
 // and the filter start over), the scans tf dropped and the check of a pose
 // saved by an earlier run on the first map (saved_pose.h), and the layer of
-// the map's changes saved with the pose, restored on the first map when it
-// was learned on it, and cleared on request (map_changes_saver.h).
+// the map's changes saved with the pose, restored on the first map (with a
+// building's floors: on each floor's first) when it was learned on it, and
+// cleared on request (map_changes_saver.h).
 //
 // Threads (docs/ros-interface.md, "Threads, latency and overload"): every
 // method but saver(), haveMap(), installMap() and buildMap() must be called
@@ -69,6 +70,7 @@ class LiveLocalizer {
   struct BuiltMap {
     ScanLocalizer::ReadyMap ready;
     std::string signature;
+    bool kept = false;  // a floor's map kept from an earlier visit, its change layer with it
   };
   BuiltMap buildMap(const nav_msgs::OccupancyGrid& map, UpdateScheduler& scheduler) const;
   /// A building's floor (floors.h), with the filter's lock held and in one
@@ -78,8 +80,10 @@ class LiveLocalizer {
   /// with what its change layer learned; then the filter starts at `pose`
   /// (moved on by the odometry since its stamp) or, without one, globally
   /// (a first map without a pose: as installMap's first map). `floor` names
-  /// the floor on pf_status. False when refused (logged): a refused pose
-  /// leaves global localization on the new floor.
+  /// the floor on pf_status. The change layer of the floor left is copied
+  /// for its file, and a floor's map built afresh (not `kept`) gets the
+  /// layer its file holds (map_changes_saver.h). False when refused
+  /// (logged): a refused pose leaves global localization on the new floor.
   bool changeFloor(std::optional<BuiltMap> built, const std::string& floor,
                    const std::optional<geometry_msgs::PoseWithCovarianceStamped>& pose,
                    std::optional<pf::PreparedMap>* replaced);
@@ -155,9 +159,10 @@ class LiveLocalizer {
   bool install(BuiltMap built, const ros::Time& stamp, const std::string& floor = "",
                std::optional<pf::PreparedMap>* replaced = nullptr, bool announce = true);
   void checkSavedPose(const std::string& map_signature, const std::string& floor);
-  // A new map of signature `signature` for the layer's saver; on the first
-  // (`first`), the layer saved on it restored and published.
-  void mapChangesOnNewMap(const std::string& signature, bool first, const ros::Time& stamp);
+  // A new map of signature `signature` (floor `floor`'s, or none) for the
+  // layer's saver; when `restore`, the layer saved on it restored and published.
+  void mapChangesOnNewMap(const std::string& signature, const std::string& floor, bool restore,
+                          const ros::Time& stamp);
   // The layer's copy written now, if any (a warning if it cannot be).
   void writeMapChanges();
   void restartAfterJump(double back_s);
