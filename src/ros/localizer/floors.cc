@@ -37,9 +37,22 @@ Floors::Floors(pf::FloorsFile file, LiveLocalizer* live, UpdateScheduler* schedu
       service_(nh.advertiseService("change_floor", &Floors::onChangeFloor, this)),
       search_timer_(nh.createWallTimer(
           ros::WallDuration(kSearchPeriod), [this](const ros::WallTimerEvent&) { checkSearch(); },
-          false, false)) {}
+          false, false)) {
+  live_->useFloors([this] { return search(); });
+}
+
+std::unique_ptr<Floors> Floors::create(std::optional<pf::FloorsFile> file, LiveLocalizer* live,
+                                       UpdateScheduler* scheduler, ToGlobal to_global,
+                                       ros::NodeHandle& nh) {
+  if (!file) return nullptr;
+  auto floors =
+      std::make_unique<Floors>(std::move(*file), live, scheduler, std::move(to_global), nh);
+  floors->start();
+  return floors;
+}
 
 Floors::~Floors() {
+  live_->useFloors({});
   search_timer_.stop();
   if (search_) scheduler_->withFilter([&] { stopSearch(); });
 }

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "pf_localization/ros/input/conversions.h"
+#include "pf_localization/ros/input/pose_transform.h"
 #include "pf_localization/ros/input/scan_drop_message.h"
 
 namespace pf_ros {
@@ -18,6 +19,7 @@ LiveLocalizer::LiveLocalizer(const LocalizerConfig& config, std::optional<SavedP
                              tf2_ros::Buffer* tf, MapToOdomRepublisher* republisher,
                              LimitedWarn* warn, ros::NodeHandle& nh, PoseSaver::Write write_pose)
     : config_(config),
+      tf_(tf),
       republisher_(republisher),
       warn_(warn),
       localizer_(config, tf),
@@ -52,6 +54,39 @@ void LiveLocalizer::logInitialPose() const {
 bool LiveLocalizer::installMap(const nav_msgs::OccupancyGrid& map, UpdateScheduler& scheduler) {
   BuiltMap built = buildMap(map, scheduler);
   return scheduler.withFilter([&] { return install(std::move(built), map.header.stamp); });
+}
+
+void LiveLocalizer::mapFromTopic(const nav_msgs::OccupancyGrid& map, const std::string& topic,
+                                 UpdateScheduler& scheduler) {
+  if (floor_search_ || (config_.first_map_only && have_map_)) {
+    if (warn_->due("first_map_only")) {
+      ROS_INFO("pf_node: %s: ignoring a new map on %s",
+               floor_search_ ? "floors_file" : "first_map_only", topic.c_str());
+    }
+    return;
+  }
+  installMap(map, scheduler);
+}
+
+bool LiveLocalizer::applyInitialPose(const geometry_msgs::PoseWithCovarianceStamped& pose,
+                                     UpdateScheduler& scheduler) {
+  const auto global = initialPoseInFrame(*tf_, pose, config_.global_frame, warn_);
+  return global && scheduler.withFilter([&] { return setInitialPose(*global); });
+}
+
+bool LiveLocalizer::setMap(nav_msgs::SetMap::Request& request, UpdateScheduler& scheduler) {
+  if (request.initial_pose.header.stamp.isZero())
+    request.initial_pose.header.stamp = ros::Time::now();
+  if (floor_search_) {
+    ROS_WARN("pf_node: set_map refused: the maps are floors_file's (change_floor)");
+    return false;
+  }
+  return installMap(request.map, scheduler) && applyInitialPose(request.initial_pose, scheduler);
+}
+
+bool LiveLocalizer::globalLocalization(UpdateScheduler& scheduler) {
+  if (floor_search_) floor_search_();
+  return scheduler.withFilter([&] { return startGlobalLocalization(); });
 }
 
 LiveLocalizer::BuiltMap LiveLocalizer::buildMap(const nav_msgs::OccupancyGrid& map,

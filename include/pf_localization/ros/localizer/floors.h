@@ -66,8 +66,14 @@ class Floors {
   /// fatal: pf_node does not start with a floors file it cannot read).
   static std::optional<pf::FloorsFile> read(const std::string& path);
 
+  /// pf_node's floors: none without a floors file, else made and start()ed.
+  static std::unique_ptr<Floors> create(std::optional<pf::FloorsFile> file, LiveLocalizer* live,
+                                        UpdateScheduler* scheduler, ToGlobal to_global,
+                                        ros::NodeHandle& nh);
+
   /// `live` and `scheduler` must outlive it. Advertises pf_floor and
-  /// change_floor on `nh`; installs nothing yet (start()).
+  /// change_floor on `nh`, and has `live` leave the maps to it
+  /// (LiveLocalizer::useFloors) while it lives; installs nothing yet (start()).
   Floors(pf::FloorsFile file, LiveLocalizer* live, UpdateScheduler* scheduler, ToGlobal to_global,
          ros::NodeHandle& nh);
   /// Ends a search still running: the filter's updates stop feeding it.

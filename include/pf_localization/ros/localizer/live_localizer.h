@@ -10,24 +10,28 @@
 // cleared on request (map_changes_saver.h).
 //
 // Threads (docs/ros-interface.md, "Threads, latency and overload"): every
-// method but saver(), haveMap(), installMap() and buildMap() must be called
-// with the filter's lock held (UpdateScheduler); an update holds it whole (on
-// the filter thread, or on roscpp's poll thread when it is short), the main
-// spinner's callbacks that touch the filter wait for it; installMap() and
-// buildMap() take it themselves, only to read the recipe and, for
-// installMap(), around the swap of a map built without it, and
-// saveAtShutdown() around the copy of the layer. What runs at a steady rate never
+// method but saver(), haveMap(), installMap(), buildMap(), saveAtShutdown()
+// and the main spinner's map sources, initial poses and global_localization
+// (useFloors() to globalLocalization()) must be called with the filter's lock
+// held (UpdateScheduler); an update holds it whole (on the filter thread, or
+// on roscpp's poll thread when it is short), the main spinner's callbacks
+// that touch the filter wait for it; those methods take it themselves when
+// they touch the filter (installMap() and buildMap() only to read the recipe
+// and, for installMap(), around the swap of a map built without it, and
+// saveAtShutdown() around the copy of the layer). What runs at a steady rate never
 // does: the republisher and the saver get their data under small locks of their own.
 #pragma once
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <nav_msgs/OccupancyGrid.h>
+#include <nav_msgs/SetMap.h>
 #include <ros/ros.h>
 #include <std_msgs/Header.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/message_filter.h>
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -90,6 +94,28 @@ class LiveLocalizer {
   /// Whether a map was installed. Changed only by installMap(), which pf_node
   /// calls from its main spinner; read there without the mutex.
   bool haveMap() const { return have_map_; }
+
+  /// pf_node's map sources, initial poses and global_localization, on its
+  /// main spinner without the filter's lock, as installMap(). With a
+  /// building's floors (floors.h, which calls useFloors() while it lives:
+  /// `search` starts its search of every floor) the maps are the floors':
+  /// the map topic is ignored and set_map refused. A map on the topic is
+  /// ignored too after the first with first_map_only (both said at most
+  /// every 5 s).
+  void useFloors(std::function<bool()> search) { floor_search_ = std::move(search); }
+  void mapFromTopic(const nav_msgs::OccupancyGrid& map, const std::string& topic,
+                    UpdateScheduler& scheduler);
+  /// An initial pose (initialpose, set_map's) in any frame tf knows, moved
+  /// into the global frame first (initialPoseInFrame). False when refused (warned).
+  bool applyInitialPose(const geometry_msgs::PoseWithCovarianceStamped& pose,
+                        UpdateScheduler& scheduler);
+  /// amcl's set_map: a new map and the pose on it in one call (a robot moved
+  /// to another floor), the pose the robot's when asked (a zero stamp: now;
+  /// the odometry moves it on while the map builds). The map is installed
+  /// even with first_map_only, which guards the map topic only.
+  bool setMap(nav_msgs::SetMap::Request& request, UpdateScheduler& scheduler);
+  /// With floors, on every floor, and meanwhile on the current one.
+  bool globalLocalization(UpdateScheduler& scheduler);
   /// The floor the configured initial pose was saved on by an earlier run
   /// (saved_pose.h), until the first map checks it: empty when it is not a
   /// saved one or names no floor. Floors starts on it when it has it.
@@ -170,6 +196,7 @@ class LiveLocalizer {
   void filterChanged(const ros::Time& scan_stamp);
 
   const LocalizerConfig config_;  // as read at start-up: the live values are localizer_'s
+  tf2_ros::Buffer* tf_;
   MapToOdomRepublisher* republisher_;
   LimitedWarn* warn_;
   ScanLocalizer localizer_;
@@ -185,6 +212,7 @@ class LiveLocalizer {
   bool saved_pose_ignored_ = false;         // it was, and global localization started
   bool pose_before_map_ = false;            // an initial pose replaced it before any map
   std::optional<pf::Pose2> last_odom_;      // odom -> base at the latest scan used
+  std::function<bool()> floor_search_;      // while a building's floors own the maps
 };
 
 }  // namespace pf_ros
