@@ -174,7 +174,8 @@ void LiveLocalizer::mapChangesOnNewMap(const std::string& signature, const std::
   const std::string path =
       floor.empty() ? changes_saver_.path() : floorMapChangesPath(changes_saver_.path(), floor);
   // A kept floor's layer is as its file holds it, or as a pending copy will.
-  changes_saver_.setMap(signature, restore ? 0 : localizer_.mapChanges()->scans(), path);
+  const pf::MapChangeLayer* layer = localizer_.mapChanges();
+  changes_saver_.setMap(signature, restore || !layer ? 0 : layer->scans(), path);
   if (!restore) return;
   const MapChangesRestore r = restoreMapChanges(path, signature, &localizer_.filter());
   const std::string on = floor.empty() ? "" : "floor '" + floor + "': ";
