@@ -238,7 +238,8 @@ class FloorsRestartTest(unittest.TestCase):
                            % (floor, self.floor_file[floor]))
         kept = len(self.seen[floor] & seen) / float(len(self.seen[floor]))
         self.report.append('%s: floor %s\'s layer restored: %d cells seen, %.3f of run 1\'s %d'
-                           % (run, floor, len(seen), kept, len(self.seen[floor])))
+                           % (run.replace('run', 'run '), floor, len(seen), kept,
+                              len(self.seen[floor])))
         self.assertGreaterEqual(kept, self.min_share, '; '.join(self.report))
 
     def ride(self, run):
