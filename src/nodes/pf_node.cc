@@ -69,9 +69,11 @@ class PfNode {
         [this] { return live_->nextUpdateOnPollThread(); }, &warn_);
     odometry_ = std::make_unique<OdometryInput>(nh, config.odom_frame, config.base_frame,
                                                 &tf_->buffer(), &warn_);
-    map_sub_ = nh.subscribe("map", 1, &PfNode::onMap, this);
+    map_sub_ = nh.subscribe<nav_msgs::OccupancyGrid>("map", 1, [this](const auto& msg) {
+      live_->mapFromTopic(*msg, map_sub_.getTopic(), *scheduler_);
+    });
     initial_pose_sub_ = nh.subscribe<geometry_msgs::PoseWithCovarianceStamped>(
-        "initialpose", 2, [this](const auto& msg) { applyInitialPose(*msg); });
+        "initialpose", 2, [this](const auto& msg) { live_->applyInitialPose(*msg, *scheduler_); });
     services_ = {nh.advertiseService("global_localization", &PfNode::onGlobalLocalization, this),
                  nh.advertiseService("request_nomotion_update", &PfNode::onNoMotionUpdate, this),
                  nh.advertiseService("set_map", &PfNode::onSetMap, this),
@@ -99,15 +101,12 @@ class PfNode {
             scheduler_->withFilter([&] { live_->scanDropped(header, reason); });
           });
         });
-    if (floors) {
-      floors_ = std::make_unique<Floors>(
-          std::move(*floors), live_.get(), scheduler_.get(),
-          [this](const auto& pose) {
-            return initialPoseInFrame(tf_->buffer(), pose, config_.global_frame, &warn_);
-          },
-          nh);
-      floors_->start();
-    }
+    floors_ = Floors::create(
+        std::move(floors), live_.get(), scheduler_.get(),
+        [this](const auto& pose) {
+          return initialPoseInFrame(tf_->buffer(), pose, config_.global_frame, &warn_);
+        },
+        nh);
     scans_->subscribe(nh);  // last: their callbacks may run at once, on the poll thread
   }
 
@@ -139,39 +138,13 @@ class PfNode {
   }
 
  private:
-  void onMap(const nav_msgs::OccupancyGridConstPtr& msg) {
-    if (floors_ || (config_.first_map_only && live_->haveMap())) {
-      if (warn_.due("first_map_only")) {
-        ROS_INFO("pf_node: %s: ignoring a new map on %s",
-                 floors_ ? "floors_file" : "first_map_only", map_sub_.getTopic().c_str());
-      }
-      return;
-    }
-    live_->installMap(*msg, *scheduler_);
-  }
-
-  // An initial pose in another frame (say odom, or base_link) is moved into
-  // the global frame through tf first.
-  bool applyInitialPose(const geometry_msgs::PoseWithCovarianceStamped& pose) {
-    const auto global = initialPoseInFrame(tf_->buffer(), pose, config_.global_frame, &warn_);
-    return global && scheduler_->withFilter([&] { return live_->setInitialPose(*global); });
-  }
-
-  // amcl's set_map: a new map and the pose on it in one call (a robot moved to another floor), the
-  // pose the robot's when asked (the odometry moves it on while the map builds). The map is
-  // installed even when first_map_only is set, which guards against map topic updates only.
   bool onSetMap(nav_msgs::SetMap::Request& req, nav_msgs::SetMap::Response& res) {
-    if (req.initial_pose.header.stamp.isZero()) req.initial_pose.header.stamp = ros::Time::now();
-    if (floors_) ROS_WARN("pf_node: set_map refused: the maps are floors_file's (change_floor)");
-    res.success =
-        !floors_ && live_->installMap(req.map, *scheduler_) && applyInitialPose(req.initial_pose);
+    res.success = live_->setMap(req, *scheduler_);
     return true;
   }
 
-  // With a building's floors, on every floor (floors.h), and meanwhile on the current one.
   bool onGlobalLocalization(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {
-    if (floors_) floors_->search();
-    return scheduler_->withFilter([&] { return live_->startGlobalLocalization(); });
+    return live_->globalLocalization(*scheduler_);
   }
 
   bool onClearMapChanges(std_srvs::Empty::Request&, std_srvs::Empty::Response&) {

@@ -17,7 +17,7 @@ constexpr double kSearchPeriod = 0.2;  // s of wall time between two looks at th
 std::optional<pf::FloorsFile> Floors::read(const std::string& path) {
   try {
     pf::FloorsFile file = pf::loadFloorsFile(path);
-    ROS_INFO("pf_node: floors_file %s: %zu floors (%s), starting on '%s'", path.c_str(),
+    ROS_INFO("pf_node: floors_file %s: %zu floors (%s), initial floor '%s'", path.c_str(),
              file.floors.size(), file.names().c_str(), file.floors[file.initial].name.c_str());
     return file;
   } catch (const pf::FloorsFileError& e) {
@@ -37,15 +37,36 @@ Floors::Floors(pf::FloorsFile file, LiveLocalizer* live, UpdateScheduler* schedu
       service_(nh.advertiseService("change_floor", &Floors::onChangeFloor, this)),
       search_timer_(nh.createWallTimer(
           ros::WallDuration(kSearchPeriod), [this](const ros::WallTimerEvent&) { checkSearch(); },
-          false, false)) {}
+          false, false)) {
+  live_->useFloors([this] { return search(); });
+}
+
+std::unique_ptr<Floors> Floors::create(std::optional<pf::FloorsFile> file, LiveLocalizer* live,
+                                       UpdateScheduler* scheduler, ToGlobal to_global,
+                                       ros::NodeHandle& nh) {
+  if (!file) return nullptr;
+  auto floors =
+      std::make_unique<Floors>(std::move(*file), live, scheduler, std::move(to_global), nh);
+  floors->start();
+  return floors;
+}
 
 Floors::~Floors() {
+  live_->useFloors({});
   search_timer_.stop();
   if (search_) scheduler_->withFilter([&] { stopSearch(); });
 }
 
 bool Floors::start() {
-  const Outcome outcome = change(file_.floors[file_.initial].name, std::nullopt);
+  // A pose saved on a floor is used there (decideSavedPose: and only there).
+  const std::string saved = scheduler_->withFilter([&] { return live_->savedPoseFloor(); });
+  std::size_t index = file_.initial;
+  if (const std::optional<std::size_t> found = file_.find(saved); found && !saved.empty()) {
+    index = *found;
+    ROS_INFO("pf_node: starting on floor '%s', where the earlier run saved its pose",
+             saved.c_str());
+  }
+  const Outcome outcome = change(file_.floors[index].name, std::nullopt);
   if (!outcome.ok) ROS_ERROR("pf_node: %s", outcome.message.c_str());
   return outcome.ok;
 }
@@ -105,6 +126,7 @@ std::optional<LiveLocalizer::BuiltMap> Floors::mapOf(std::size_t index, std::str
     kept.map.reset();
     built.ready.info = kept.info;
     built.signature = kept.signature;
+    built.kept = true;
     return built;
   }
   nav_msgs::OccupancyGrid map;

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "pf_localization/ros/input/conversions.h"
+#include "pf_localization/ros/input/pose_transform.h"
 #include "pf_localization/ros/input/scan_drop_message.h"
 
 namespace pf_ros {
@@ -18,6 +19,7 @@ LiveLocalizer::LiveLocalizer(const LocalizerConfig& config, std::optional<SavedP
                              tf2_ros::Buffer* tf, MapToOdomRepublisher* republisher,
                              LimitedWarn* warn, ros::NodeHandle& nh, PoseSaver::Write write_pose)
     : config_(config),
+      tf_(tf),
       republisher_(republisher),
       warn_(warn),
       localizer_(config, tf),
@@ -54,6 +56,39 @@ bool LiveLocalizer::installMap(const nav_msgs::OccupancyGrid& map, UpdateSchedul
   return scheduler.withFilter([&] { return install(std::move(built), map.header.stamp); });
 }
 
+void LiveLocalizer::mapFromTopic(const nav_msgs::OccupancyGrid& map, const std::string& topic,
+                                 UpdateScheduler& scheduler) {
+  if (floor_search_ || (config_.first_map_only && have_map_)) {
+    if (warn_->due("first_map_only")) {
+      ROS_INFO("pf_node: %s: ignoring a new map on %s",
+               floor_search_ ? "floors_file" : "first_map_only", topic.c_str());
+    }
+    return;
+  }
+  installMap(map, scheduler);
+}
+
+bool LiveLocalizer::applyInitialPose(const geometry_msgs::PoseWithCovarianceStamped& pose,
+                                     UpdateScheduler& scheduler) {
+  const auto global = initialPoseInFrame(*tf_, pose, config_.global_frame, warn_);
+  return global && scheduler.withFilter([&] { return setInitialPose(*global); });
+}
+
+bool LiveLocalizer::setMap(nav_msgs::SetMap::Request& request, UpdateScheduler& scheduler) {
+  if (request.initial_pose.header.stamp.isZero())
+    request.initial_pose.header.stamp = ros::Time::now();
+  if (floor_search_) {
+    ROS_WARN("pf_node: set_map refused: the maps are floors_file's (change_floor)");
+    return false;
+  }
+  return installMap(request.map, scheduler) && applyInitialPose(request.initial_pose, scheduler);
+}
+
+bool LiveLocalizer::globalLocalization(UpdateScheduler& scheduler) {
+  if (floor_search_) floor_search_();
+  return scheduler.withFilter([&] { return startGlobalLocalization(); });
+}
+
 LiveLocalizer::BuiltMap LiveLocalizer::buildMap(const nav_msgs::OccupancyGrid& map,
                                                 UpdateScheduler& scheduler) const {
   const auto recipe = scheduler.withFilter([&] { return localizer_.mapRecipe(); });
@@ -73,7 +108,7 @@ bool LiveLocalizer::changeFloor(std::optional<BuiltMap> built, const std::string
   // A first map without a pose starts as any first map does: from the
   // configured initial pose (or a saved one, checked), or globally.
   const bool starts = !have_map_ && !pose;
-  if (built && !install(std::move(*built), stamp, replaced, starts)) return false;
+  if (built && !install(std::move(*built), stamp, floor, replaced, starts)) return false;
   output_.setFloor(floor);
   if (starts) return true;
   if (!pose) return startGlobalLocalization();
@@ -83,11 +118,15 @@ bool LiveLocalizer::changeFloor(std::optional<BuiltMap> built, const std::string
   return false;
 }
 
-bool LiveLocalizer::install(BuiltMap built, const ros::Time& stamp,
+bool LiveLocalizer::install(BuiltMap built, const ros::Time& stamp, const std::string& floor,
                             std::optional<pf::PreparedMap>* replaced, bool announce) {
   const bool first = !have_map_;
   const nav_msgs::MapMetaData info = built.ready.info;
   const std::string& signature = built.signature;
+  // The floor left: its layer's last copy, for its own file.
+  if (!floor.empty() && !first) {
+    changes_saver_.offer(localizer_.mapChanges(), ros::WallTime::now(), true);
+  }
   const std::string error = localizer_.setMap(std::move(built.ready), replaced);
   if (!error.empty()) {
     ROS_ERROR("pf_node: %s", error.c_str());
@@ -96,10 +135,13 @@ bool LiveLocalizer::install(BuiltMap built, const ros::Time& stamp,
   have_map_ = true;
   placement_.reset();
   if (config_.save_pose_rate > 0.0 || (first && saved_pose_)) {
-    saver_.setMap(signature);
-    if (first && saved_pose_) checkSavedPose(signature);
+    saver_.setMap(signature, floor);
+    if (first && saved_pose_) checkSavedPose(signature, floor);
   }
-  if (changes_saver_.enabled()) mapChangesOnNewMap(signature, first, stamp);
+  // A floor's layer is restored with its map's first build, a single map's on the first map.
+  if (changes_saver_.enabled()) {
+    mapChangesOnNewMap(signature, floor, floor.empty() ? first : !built.kept, stamp);
+  }
   ROS_INFO("pf_node: map %u x %u cells at %.3f m; %zu particles", info.width, info.height,
            info.resolution, localizer_.filter().particles().size());
   if (!announce) return true;
@@ -109,11 +151,11 @@ bool LiveLocalizer::install(BuiltMap built, const ros::Time& stamp,
 }
 
 // On the first map, when the configured initial pose was saved by an
-// earlier run: it stays only on the map it was saved on, in free space;
-// otherwise global localization, now and on a restart.
-void LiveLocalizer::checkSavedPose(const std::string& map_signature) {
+// earlier run: it stays only on the map (and floor) it was saved on, in free
+// space; otherwise global localization, now and on a restart.
+void LiveLocalizer::checkSavedPose(const std::string& map_signature, const std::string& floor) {
   const SavedPoseDecision d = decideSavedPose(*saved_pose_, *config_.initial_pose, map_signature,
-                                              *localizer_.filter().map());
+                                              *localizer_.filter().map(), floor);
   saved_pose_.reset();
   if (d.resume) {
     ROS_INFO("pf_node: %s", d.message.c_str());
@@ -127,19 +169,23 @@ void LiveLocalizer::checkSavedPose(const std::string& map_signature) {
   if (!error.empty()) ROS_WARN("pf_node: %s", error.c_str());
 }
 
-void LiveLocalizer::mapChangesOnNewMap(const std::string& signature, bool first,
-                                       const ros::Time& stamp) {
-  changes_saver_.setMap(signature);
-  if (!first) return;
-  const MapChangesRestore r =
-      restoreMapChanges(changes_saver_.path(), signature, &localizer_.filter());
+void LiveLocalizer::mapChangesOnNewMap(const std::string& signature, const std::string& floor,
+                                       bool restore, const ros::Time& stamp) {
+  const std::string path =
+      floor.empty() ? changes_saver_.path() : floorMapChangesPath(changes_saver_.path(), floor);
+  // A kept floor's layer is as its file holds it, or as a pending copy will.
+  const pf::MapChangeLayer* layer = localizer_.mapChanges();
+  changes_saver_.setMap(signature, restore || !layer ? 0 : layer->scans(), path);
+  if (!restore) return;
+  const MapChangesRestore r = restoreMapChanges(path, signature, &localizer_.filter());
+  const std::string on = floor.empty() ? "" : "floor '" + floor + "': ";
   if (r.level == MapChangesRestore::Level::kWarn) {
-    ROS_WARN("pf_node: %s", r.message.c_str());
+    ROS_WARN("pf_node: %s%s", on.c_str(), r.message.c_str());
   } else {
-    ROS_INFO("pf_node: %s", r.message.c_str());
+    ROS_INFO("pf_node: %s%s", on.c_str(), r.message.c_str());
   }
   if (!r.restored) return;
-  changes_saver_.setMap(signature, localizer_.mapChanges()->scans());  // the file holds it
+  changes_saver_.setMap(signature, localizer_.mapChanges()->scans(), path);  // the file holds it
   output_.publishMapChangesNow(localizer_, stamp);
 }
 

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -43,6 +44,23 @@ std::string defaultMapChangesPath(const std::string& node_name) {
                           : home && *home       ? std::string(home) + "/.ros"
                                                 : ".";
   return dir + "/" + name + ".map_changes";
+}
+
+std::string floorMapChangesPath(const std::string& path, const std::string& floor) {
+  std::string name;
+  for (const char c : floor) {
+    if (std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_') {
+      name += c;
+    } else {
+      char hex[4];
+      std::snprintf(hex, sizeof hex, "%%%02X", static_cast<unsigned char>(c));
+      name += hex;
+    }
+  }
+  const std::filesystem::path file(path);
+  const std::string ext = file.filename().extension().string();
+  if (ext.empty() || ext == file.filename().string()) return path + "." + name;
+  return path.substr(0, path.size() - ext.size()) + "." + name + ext;
 }
 
 std::string writeFileAtomically(const std::string& path, const std::string& bytes) {
@@ -110,8 +128,10 @@ MapChangesRestore restoreMapChanges(const std::string& path, const std::string& 
 MapChangesSaver::MapChangesSaver(std::string path, double rate)
     : path_(std::move(path)), rate_(rate) {}
 
-void MapChangesSaver::setMap(const std::string& signature, std::size_t saved_scans) {
+void MapChangesSaver::setMap(const std::string& signature, std::size_t saved_scans,
+                             const std::string& path) {
   signature_ = signature;
+  current_path_ = path.empty() ? path_ : path;
   copied_scans_ = saved_scans;
   dirty_ = false;
 }
@@ -129,22 +149,24 @@ void MapChangesSaver::offer(const pf::MapChangeLayer* layer, const ros::WallTime
   dirty_ = false;
   last_copy_ = now;
   std::lock_guard<std::mutex> lock(mutex_);
-  pending_ = std::move(bytes);
+  pending_[current_path_.empty() ? path_ : current_path_] = std::move(bytes);
 }
 
 std::string MapChangesSaver::writePending() {
-  std::optional<std::string> bytes;
+  std::map<std::string, std::string> files;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    bytes.swap(pending_);
+    files.swap(pending_);
   }
-  if (!bytes) return "";
-  const std::string error = writeFileAtomically(path_, *bytes);
-  if (!error.empty()) {
+  std::string errors;
+  for (auto& [path, bytes] : files) {
+    const std::string error = writeFileAtomically(path, bytes);
+    if (error.empty()) continue;
+    errors += (errors.empty() ? "" : "; ") + error;
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!pending_) pending_ = std::move(bytes);  // unless a newer copy came
+    pending_.emplace(path, std::move(bytes));  // unless a newer copy came
   }
-  return error;
+  return errors;
 }
 
 }  // namespace pf_ros

@@ -22,9 +22,10 @@ std::optional<PoseToSave> poseToSave(const ScanLocalizer& localizer,
 
 PoseSaver::PoseSaver(double rate, Write write) : rate_(rate), write_(std::move(write)) {}
 
-void PoseSaver::setMap(const std::string& map_signature) {
+void PoseSaver::setMap(const std::string& map_signature, const std::string& floor) {
   std::lock_guard<std::mutex> lock(mutex_);
   map_signature_ = map_signature;
+  floor_ = floor;
   pose_.reset();
 }
 
@@ -36,7 +37,7 @@ void PoseSaver::set(const std::optional<PoseToSave>& pose) {
 std::optional<PoseSaver::Record> PoseSaver::latest() const {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!pose_) return std::nullopt;
-  return Record{*pose_, map_signature_};
+  return Record{*pose_, map_signature_, floor_};
 }
 
 void PoseSaver::saveWhenDue(const ros::Time& now) {
@@ -61,7 +62,7 @@ void writeSavedPose(const PoseSaver::Record& record, const ros::NodeHandle& pnh)
   pnh.setParam("initial_cov_xx", s.cov_xx);
   pnh.setParam("initial_cov_yy", s.cov_yy);
   pnh.setParam("initial_cov_aa", s.cov_aa);
-  pnh.setParam(kSavedPoseMapParam, savedPoseMapValue(record.map_signature, s.pose));
+  pnh.setParam(kSavedPoseMapParam, savedPoseMapValue(record.map_signature, s.pose, record.floor));
 }
 
 }  // namespace pf_ros

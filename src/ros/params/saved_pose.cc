@@ -12,8 +12,10 @@
 namespace pf_ros {
 namespace {
 
-// Separates the map's signature from the pose in ~saved_pose_map.
+// Separate the map's signature from the pose, and the pose from the floor,
+// in ~saved_pose_map.
 constexpr const char* kPoseTag = "; pose ";
+constexpr const char* kFloorTag = "; floor ";
 
 // m or rad: a pose read back from the parameter server (XML-RPC's decimal
 // doubles) is the saved one within rounding; one typed in is not this close.
@@ -54,21 +56,29 @@ std::string mapSignature(const nav_msgs::OccupancyGrid& map) {
   return text;
 }
 
-std::string savedPoseMapValue(const std::string& map_signature, const pf::Pose2& pose) {
+std::string savedPoseMapValue(const std::string& map_signature, const pf::Pose2& pose,
+                              const std::string& floor) {
   char text[128];
   std::snprintf(text, sizeof text, "%.17g %.17g %.17g", pose.x, pose.y, pose.yaw);
-  return map_signature + kPoseTag + text;
+  return map_signature + kPoseTag + text + (floor.empty() ? "" : kFloorTag + floor);
 }
 
 SavedPoseMap parseSavedPoseMap(const std::string& value) {
   SavedPoseMap saved;
-  const std::size_t tag = value.rfind(kPoseTag);
+  // The signature never holds the tags; a floor's name may.
+  const std::size_t tag = value.find(kPoseTag);
   if (tag == std::string::npos) {
     saved.map_signature = value;
     return saved;
   }
   saved.map_signature = value.substr(0, tag);
-  std::istringstream in(value.substr(tag + std::string(kPoseTag).size()));
+  std::string pose_text = value.substr(tag + std::string(kPoseTag).size());
+  const std::size_t floor_tag = pose_text.find(kFloorTag);
+  if (floor_tag != std::string::npos) {
+    saved.floor = pose_text.substr(floor_tag + std::string(kFloorTag).size());
+    pose_text.erase(floor_tag);
+  }
+  std::istringstream in(pose_text);
   pf::Pose2 pose;
   if (in >> pose.x >> pose.y >> pose.yaw && pose.isFinite()) saved.pose = pose;
   return saved;
@@ -84,19 +94,24 @@ bool isSavedPose(const std::optional<SavedPoseMap>& saved,
 }
 
 SavedPoseDecision decideSavedPose(const SavedPoseMap& saved, const pf::Pose2& pose,
-                                  const std::string& map_signature, const pf::OccupancyGrid& grid) {
+                                  const std::string& map_signature, const pf::OccupancyGrid& grid,
+                                  const std::string& floor) {
   SavedPoseDecision d;
   const std::string ignoring = "ignoring the initial pose " + describe(pose) +
                                " saved by an earlier run (~" + kSavedPoseMapParam + "): ";
-  if (saved.map_signature != map_signature) {
+  if (!floor.empty() && !saved.floor.empty() && saved.floor != floor) {
+    d.message = ignoring + "it was saved on floor '" + saved.floor +
+                "', which the floors file does not have. Starting on floor '" + floor +
+                "' with global localization";
+  } else if (saved.map_signature != map_signature) {
     d.message = ignoring + "it was saved on another map (" + saved.map_signature +
                 "; this one: " + map_signature + "). Starting global localization";
   } else if (!grid.isFreeAt(pose.x, pose.y)) {
     d.message = ignoring + whyNotFree(grid, pose) + ". Starting global localization";
   } else {
     d.resume = true;
-    d.message =
-        "resuming from the pose saved by an earlier run at " + describe(pose) + " on this map";
+    d.message = "resuming from the pose saved by an earlier run at " + describe(pose) +
+                (floor.empty() ? " on this map" : " on floor '" + floor + "'");
   }
   return d;
 }

@@ -180,6 +180,38 @@ TEST_F(MapChangesSaverTest, CopiesOnlyWhatChangedAtMostOnceAPeriod) {
   EXPECT_FALSE(std::filesystem::exists(path_ + ".off"));
 }
 
+// A building's floors: each floor's layer in its own file, a floor's last
+// copy written even when the next floor's comes before the write.
+TEST_F(MapChangesSaverTest, EachFloorsLayerGoesToItsOwnFile) {
+  const std::string ground = floorMapChangesPath(path_, "ground");
+  const std::string upper = floorMapChangesPath(path_, "upper");
+  EXPECT_EQ((dir_ / "sub" / "pf_node.ground.map_changes").string(), ground);
+  const pf::MapChangeLayer layer = learned(field_);
+  pf::MapChangeLayer other(field_);
+  other.add(pf::test::simulateScan(worldGrid(), pf::Pose2{2.0, 1.5, 0.0}, pf::test::ScanSpec{}),
+            pf::Pose2{2.0, 1.5, 0.0});
+  MapChangesSaver saver(path_, 0.5);
+  saver.setMap(signature_, 0, ground);
+  saver.offer(&layer, ros::WallTime(100.0), true);  // the ride's last copy of the floor left
+  saver.setMap("upper's map", 0, upper);
+  saver.offer(&other, ros::WallTime(100.1), true);
+  ASSERT_EQ("", saver.writePending());
+  EXPECT_FALSE(std::filesystem::exists(path_));  // the single map's file is not a floor's
+  EXPECT_EQ(pf::mapChangesFile(layer, signature_), readAll(ground));
+  EXPECT_EQ(pf::mapChangesFile(other, "upper's map"), readAll(upper));
+  ScanLocalizer localizer(config_, &tf_);
+  ASSERT_EQ("", localizer.setMap(map_));
+  EXPECT_TRUE(restoreMapChanges(ground, signature_, &localizer.filter()).restored);
+  EXPECT_EQ(layer.occupancy(), localizer.mapChangesMsg(ros::Time(1.0))->data);
+  EXPECT_FALSE(restoreMapChanges(upper, signature_, &localizer.filter()).restored);
+
+  // Any name makes a file name of its own, in the same folder.
+  EXPECT_EQ("/r/pf_node.level%202%2F3.map_changes",
+            floorMapChangesPath("/r/pf_node.map_changes", "level 2/3"));
+  EXPECT_EQ("/r/layer.upper", floorMapChangesPath("/r/layer", "upper"));
+  EXPECT_EQ("/r.d/.layer.upper", floorMapChangesPath("/r.d/.layer", "upper"));
+}
+
 TEST_F(MapChangesSaverTest, WritesAFileWholeOrSaysWhy) {
   ASSERT_EQ("", writeFileAtomically(path_, "one"));
   ASSERT_EQ("", writeFileAtomically(path_, "two"));

@@ -47,6 +47,27 @@ TEST(SavedPoseMap, ReadsBackWhatWasSaved) {
   EXPECT_FALSE(bare.pose);
 }
 
+TEST(SavedPoseMap, ReadsBackTheFloor) {
+  const pf::Pose2 pose{12.25, 7.5, -1.25};
+  const std::string value = savedPoseMapValue(mapSignature(room()), pose, "upper");
+  EXPECT_NE(std::string::npos, value.find("; floor upper")) << value;
+  const SavedPoseMap saved = parseSavedPoseMap(value);
+  EXPECT_EQ(mapSignature(room()), saved.map_signature);
+  EXPECT_EQ("upper", saved.floor);
+  ASSERT_TRUE(saved.pose);
+  EXPECT_DOUBLE_EQ(pose.x, saved.pose->x);
+  EXPECT_DOUBLE_EQ(pose.yaw, saved.pose->yaw);
+  // A floor's name is the rest of the value, whatever it holds.
+  EXPECT_EQ("2; pose 1 2 3",
+            parseSavedPoseMap(savedPoseMapValue("m", pose, "2; pose 1 2 3")).floor);
+  EXPECT_TRUE(isSavedPose(saved, pose));
+  // Without floors, or saved by a version that had none: no floor, as before.
+  const std::string plain = savedPoseMapValue(mapSignature(room()), pose);
+  EXPECT_EQ(std::string::npos, plain.find("floor")) << plain;
+  EXPECT_EQ("", parseSavedPoseMap(plain).floor);
+  EXPECT_TRUE(parseSavedPoseMap(plain).pose);
+}
+
 TEST(IsSavedPose, OnlyThePoseTheEarlierRunSaved) {
   const pf::Pose2 saved_pose{1.5, 1.0, 0.3};
   const SavedPoseMap saved = parseSavedPoseMap(savedPoseMapValue("m", saved_pose));
@@ -81,6 +102,28 @@ TEST(DecideSavedPose, AnotherMapStartsGlobalLocalization) {
   EXPECT_FALSE(d.resume);
   EXPECT_NE(std::string::npos, d.message.find("saved on another map")) << d.message;
   EXPECT_NE(std::string::npos, d.message.find("global localization")) << d.message;
+}
+
+TEST(DecideSavedPose, OnlyOnTheFloorItWasSavedOn) {
+  const pf::Pose2 pose{1.5, 1.0, 0.3};
+  const SavedPoseMap saved =
+      parseSavedPoseMap(savedPoseMapValue(mapSignature(room()), pose, "upper"));
+  const pf::OccupancyGrid grid = toCore(room());
+  const SavedPoseDecision there = decideSavedPose(saved, pose, mapSignature(room()), grid, "upper");
+  EXPECT_TRUE(there.resume) << there.message;
+  EXPECT_NE(std::string::npos, there.message.find("on floor 'upper'")) << there.message;
+  // Another floor, even of the same map: the floors file has no floor 'upper'.
+  const SavedPoseDecision other =
+      decideSavedPose(saved, pose, mapSignature(room()), grid, "ground");
+  EXPECT_FALSE(other.resume);
+  EXPECT_NE(std::string::npos, other.message.find("saved on floor 'upper'")) << other.message;
+  EXPECT_NE(std::string::npos, other.message.find("Starting on floor 'ground' with global"))
+      << other.message;
+  // Without floors the floor is not looked at.
+  EXPECT_TRUE(decideSavedPose(saved, pose, mapSignature(room()), grid).resume);
+  // A pose saved without a floor is used on any floor of its map.
+  const SavedPoseMap plain = parseSavedPoseMap(savedPoseMapValue(mapSignature(room()), pose));
+  EXPECT_TRUE(decideSavedPose(plain, pose, mapSignature(room()), grid, "ground").resume);
 }
 
 TEST(DecideSavedPose, APoseOutsideTheFreeSpaceStartsGlobalLocalization) {

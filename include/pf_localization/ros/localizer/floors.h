@@ -66,8 +66,14 @@ class Floors {
   /// fatal: pf_node does not start with a floors file it cannot read).
   static std::optional<pf::FloorsFile> read(const std::string& path);
 
+  /// pf_node's floors: none without a floors file, else made and start()ed.
+  static std::unique_ptr<Floors> create(std::optional<pf::FloorsFile> file, LiveLocalizer* live,
+                                        UpdateScheduler* scheduler, ToGlobal to_global,
+                                        ros::NodeHandle& nh);
+
   /// `live` and `scheduler` must outlive it. Advertises pf_floor and
-  /// change_floor on `nh`; installs nothing yet (start()).
+  /// change_floor on `nh`, and has `live` leave the maps to it
+  /// (LiveLocalizer::useFloors) while it lives; installs nothing yet (start()).
   Floors(pf::FloorsFile file, LiveLocalizer* live, UpdateScheduler* scheduler, ToGlobal to_global,
          ros::NodeHandle& nh);
   /// Ends a search still running: the filter's updates stop feeding it.
@@ -76,8 +82,11 @@ class Floors {
   Floors& operator=(const Floors&) = delete;
 
   /// Installs the initial floor's map, as the first map: the filter starts
-  /// from the configured initial pose, or globally. False when its map cannot
-  /// be loaded (logged; change_floor may still bring another floor's).
+  /// from the configured initial pose, or globally. A pose an earlier run
+  /// saved on a floor (saved_pose.h) starts on that floor instead, when the
+  /// file has it (otherwise the initial floor, where the pose is not used:
+  /// one warning). False when its map cannot be loaded (logged; change_floor
+  /// may still bring another floor's).
   bool start();
 
   /// Moves to floor `name`: at `pose` (any frame tf knows), or with global

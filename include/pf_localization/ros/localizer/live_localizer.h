@@ -5,28 +5,33 @@
 // max_update_time's particle cap, time jumping back (TimeJumpHandler: tf
 // and the filter start over), the scans tf dropped and the check of a pose
 // saved by an earlier run on the first map (saved_pose.h), and the layer of
-// the map's changes saved with the pose, restored on the first map when it
-// was learned on it, and cleared on request (map_changes_saver.h).
+// the map's changes saved with the pose, restored on the first map (with a
+// building's floors: on each floor's first) when it was learned on it, and
+// cleared on request (map_changes_saver.h).
 //
 // Threads (docs/ros-interface.md, "Threads, latency and overload"): every
-// method but saver(), haveMap(), installMap() and buildMap() must be called
-// with the filter's lock held (UpdateScheduler); an update holds it whole (on
-// the filter thread, or on roscpp's poll thread when it is short), the main
-// spinner's callbacks that touch the filter wait for it; installMap() and
-// buildMap() take it themselves, only to read the recipe and, for
-// installMap(), around the swap of a map built without it, and
-// saveAtShutdown() around the copy of the layer. What runs at a steady rate never
+// method but saver(), haveMap(), installMap(), buildMap(), saveAtShutdown()
+// and the main spinner's map sources, initial poses and global_localization
+// (useFloors() to globalLocalization()) must be called with the filter's lock
+// held (UpdateScheduler); an update holds it whole (on the filter thread, or
+// on roscpp's poll thread when it is short), the main spinner's callbacks
+// that touch the filter wait for it; those methods take it themselves when
+// they touch the filter (installMap() and buildMap() only to read the recipe
+// and, for installMap(), around the swap of a map built without it, and
+// saveAtShutdown() around the copy of the layer). What runs at a steady rate never
 // does: the republisher and the saver get their data under small locks of their own.
 #pragma once
 
 #include <geometry_msgs/PoseWithCovarianceStamped.h>
 #include <nav_msgs/OccupancyGrid.h>
+#include <nav_msgs/SetMap.h>
 #include <ros/ros.h>
 #include <std_msgs/Header.h>
 #include <tf2_ros/buffer.h>
 #include <tf2_ros/message_filter.h>
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 
@@ -69,6 +74,7 @@ class LiveLocalizer {
   struct BuiltMap {
     ScanLocalizer::ReadyMap ready;
     std::string signature;
+    bool kept = false;  // a floor's map kept from an earlier visit, its change layer with it
   };
   BuiltMap buildMap(const nav_msgs::OccupancyGrid& map, UpdateScheduler& scheduler) const;
   /// A building's floor (floors.h), with the filter's lock held and in one
@@ -78,14 +84,42 @@ class LiveLocalizer {
   /// with what its change layer learned; then the filter starts at `pose`
   /// (moved on by the odometry since its stamp) or, without one, globally
   /// (a first map without a pose: as installMap's first map). `floor` names
-  /// the floor on pf_status. False when refused (logged): a refused pose
-  /// leaves global localization on the new floor.
+  /// the floor on pf_status. The change layer of the floor left is copied
+  /// for its file, and a floor's map built afresh (not `kept`) gets the
+  /// layer its file holds (map_changes_saver.h). False when refused
+  /// (logged): a refused pose leaves global localization on the new floor.
   bool changeFloor(std::optional<BuiltMap> built, const std::string& floor,
                    const std::optional<geometry_msgs::PoseWithCovarianceStamped>& pose,
                    std::optional<pf::PreparedMap>* replaced);
   /// Whether a map was installed. Changed only by installMap(), which pf_node
   /// calls from its main spinner; read there without the mutex.
   bool haveMap() const { return have_map_; }
+
+  /// pf_node's map sources, initial poses and global_localization, on its
+  /// main spinner without the filter's lock, as installMap(). With a
+  /// building's floors (floors.h, which calls useFloors() while it lives:
+  /// `search` starts its search of every floor) the maps are the floors':
+  /// the map topic is ignored and set_map refused. A map on the topic is
+  /// ignored too after the first with first_map_only (both said at most
+  /// every 5 s).
+  void useFloors(std::function<bool()> search) { floor_search_ = std::move(search); }
+  void mapFromTopic(const nav_msgs::OccupancyGrid& map, const std::string& topic,
+                    UpdateScheduler& scheduler);
+  /// An initial pose (initialpose, set_map's) in any frame tf knows, moved
+  /// into the global frame first (initialPoseInFrame). False when refused (warned).
+  bool applyInitialPose(const geometry_msgs::PoseWithCovarianceStamped& pose,
+                        UpdateScheduler& scheduler);
+  /// amcl's set_map: a new map and the pose on it in one call (a robot moved
+  /// to another floor), the pose the robot's when asked (a zero stamp: now;
+  /// the odometry moves it on while the map builds). The map is installed
+  /// even with first_map_only, which guards the map topic only.
+  bool setMap(nav_msgs::SetMap::Request& request, UpdateScheduler& scheduler);
+  /// With floors, on every floor, and meanwhile on the current one.
+  bool globalLocalization(UpdateScheduler& scheduler);
+  /// The floor the configured initial pose was saved on by an earlier run
+  /// (saved_pose.h), until the first map checks it: empty when it is not a
+  /// saved one or names no floor. Floors starts on it when it has it.
+  std::string savedPoseFloor() const { return saved_pose_ ? saved_pose_->floor : ""; }
 
   /// For a search of every floor (floors.h), with the filter's lock held:
   /// the filter's live parameters, every update's odometry and scans
@@ -145,14 +179,16 @@ class LiveLocalizer {
  private:
   void logInitialPose() const;
   // installMap's part with the filter's lock held: `built`, from a map
-  // stamped `stamp`, replaces the filter's map (which goes to `replaced`, if
-  // any); `announce`: map -> odom and the estimate go out now.
-  bool install(BuiltMap built, const ros::Time& stamp,
+  // stamped `stamp` (floor `floor`'s with a building's floors, else empty),
+  // replaces the filter's map (which goes to `replaced`, if any);
+  // `announce`: map -> odom and the estimate go out now.
+  bool install(BuiltMap built, const ros::Time& stamp, const std::string& floor = "",
                std::optional<pf::PreparedMap>* replaced = nullptr, bool announce = true);
-  void checkSavedPose(const std::string& map_signature);
-  // A new map of signature `signature` for the layer's saver; on the first
-  // (`first`), the layer saved on it restored and published.
-  void mapChangesOnNewMap(const std::string& signature, bool first, const ros::Time& stamp);
+  void checkSavedPose(const std::string& map_signature, const std::string& floor);
+  // A new map of signature `signature` (floor `floor`'s, or none) for the
+  // layer's saver; when `restore`, the layer saved on it restored and published.
+  void mapChangesOnNewMap(const std::string& signature, const std::string& floor, bool restore,
+                          const ros::Time& stamp);
   // The layer's copy written now, if any (a warning if it cannot be).
   void writeMapChanges();
   void restartAfterJump(double back_s);
@@ -160,6 +196,7 @@ class LiveLocalizer {
   void filterChanged(const ros::Time& scan_stamp);
 
   const LocalizerConfig config_;  // as read at start-up: the live values are localizer_'s
+  tf2_ros::Buffer* tf_;
   MapToOdomRepublisher* republisher_;
   LimitedWarn* warn_;
   ScanLocalizer localizer_;
@@ -175,6 +212,7 @@ class LiveLocalizer {
   bool saved_pose_ignored_ = false;         // it was, and global localization started
   bool pose_before_map_ = false;            // an initial pose replaced it before any map
   std::optional<pf::Pose2> last_odom_;      // odom -> base at the latest scan used
+  std::function<bool()> floor_search_;      // while a building's floors own the maps
 };
 
 }  // namespace pf_ros

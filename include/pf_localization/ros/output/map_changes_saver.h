@@ -8,6 +8,13 @@
 // written whole to a temporary beside it, then renamed over it, so that a
 // crash mid-write leaves the last one.
 //
+// With a building's floors (floors.h) each floor has a file of its own
+// beside that one (floorMapChangesPath): the layer of the floor in use is
+// saved as above, that of a floor left once more as the ride leaves it (it
+// does not change while its map is kept), and each floor's is restored when
+// its map is built (at start, or on the first ride there), on the same
+// signature only.
+//
 // Threads, as PoseSaver's: the filter's side copies the layer into the
 // file's bytes (offer(), with the filter's lock held, at most once a period
 // and only when the layer changed since), and the main spinner writes the
@@ -19,6 +26,7 @@
 
 #include <ros/time.h>
 
+#include <map>
 #include <mutex>
 #include <optional>
 #include <string>
@@ -32,6 +40,11 @@ namespace pf_ros {
 /// its leading '/' and with the others as '_' ("/robot1/pf_node":
 /// robot1_pf_node.map_changes).
 std::string defaultMapChangesPath(const std::string& node_name);
+
+/// Floor `floor`'s file beside `path`: the floor's name, its bytes other
+/// than letters, digits, '-' and '_' as %XX, before the extension
+/// ("/r/pf_node.map_changes", "upper": /r/pf_node.upper.map_changes).
+std::string floorMapChangesPath(const std::string& path, const std::string& floor);
 
 /// What became of the file on the first map, for the log.
 struct MapChangesRestore {
@@ -58,21 +71,24 @@ class MapChangesSaver {
   MapChangesSaver(std::string path, double rate);
 
   bool enabled() const { return rate_ > 0.0; }
+  /// The file given (a floor's: floorMapChangesPath()).
   const std::string& path() const { return path_; }
 
   /// Filter side. A new map, of signature `signature`: its layer is
-  /// written from its first change on (the file keeps what it holds until
-  /// then); `saved_scans`: the scans of the layer the file already holds
-  /// (restored from it), not copied again.
-  void setMap(const std::string& signature, std::size_t saved_scans = 0);
+  /// written, to `path` (empty: path()), from its first change on (the file
+  /// keeps what it holds until then); `saved_scans`: the scans of the layer
+  /// the file already holds (restored from it), not copied again. A copy of
+  /// the map before not written yet still goes to its own file.
+  void setMap(const std::string& signature, std::size_t saved_scans = 0,
+              const std::string& path = "");
   /// The layer changed otherwise than by learning (cleared, restored).
   void changed() { dirty_ = true; }
   /// After the filter changed: `layer` copied when it changed since the last
   /// copy and a period has passed since (`now`), or at once when `now_anyway`.
   void offer(const pf::MapChangeLayer* layer, const ros::WallTime& now, bool now_anyway = false);
 
-  /// Main spinner: the latest copy written, when it was not yet. Empty, or
-  /// why it could not be (the copy is kept for the next try).
+  /// Main spinner: the latest copy of each file written, when it was not
+  /// yet. Empty, or why one could not be (its copy is kept for the next try).
   std::string writePending();
 
  private:
@@ -80,12 +96,13 @@ class MapChangesSaver {
   const double rate_;
   // The filter's side (its lock).
   std::string signature_;
+  std::string current_path_;      // the file of the map in use
   std::size_t copied_scans_ = 0;  // the layer's scans at the last copy
   bool dirty_ = false;
   ros::WallTime last_copy_;
   // Shared with the main spinner.
   std::mutex mutex_;
-  std::optional<std::string> pending_;  // bytes not written yet
+  std::map<std::string, std::string> pending_;  // bytes not written yet, by file
 };
 
 }  // namespace pf_ros

@@ -41,6 +41,7 @@ class PoseSaver {
   struct Record {
     PoseToSave pose;
     std::string map_signature;
+    std::string floor;  // with a building's floors (floors.h); empty otherwise
   };
   /// How a record is saved (writeSavedPose() on the node's ~, in pf_node).
   using Write = std::function<void(const Record&)>;
@@ -51,8 +52,9 @@ class PoseSaver {
   /// Whether anything is ever saved (rate > 0).
   bool enabled() const { return rate_ > 0.0; }
 
-  /// A new map: nothing to save until the pose on it is set().
-  void setMap(const std::string& map_signature);
+  /// A new map, on floor `floor` with a building's floors: nothing to save
+  /// until the pose on it is set().
+  void setMap(const std::string& map_signature, const std::string& floor = "");
   /// The pose to save from now on (nothing: none).
   void set(const std::optional<PoseToSave>& pose);
   /// What to save: nothing before a map and a pose on it.
@@ -73,6 +75,7 @@ class PoseSaver {
   RepublishSchedule schedule_;  // the main spinner's
   mutable std::mutex mutex_;    // guards what follows
   std::string map_signature_;
+  std::string floor_;
   std::optional<PoseToSave> pose_;
 };
 

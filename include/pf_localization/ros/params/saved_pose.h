@@ -3,11 +3,13 @@
 // to ~initial_cov_*, where readConfig finds them, so that a node restarted
 // under the same master (respawn, a crash, a relaunch) resumes where the
 // robot is. With it goes ~saved_pose_map: the signature of the map the pose
-// was on (size, resolution, origin, a hash of the cells) and the pose
-// itself. At start-up a configured initial pose that ~saved_pose_map
-// records is a saved one, and it is only used on a first map with the same
-// signature that has the pose in a free cell; otherwise global localization
-// (a roscore that had run another bag may hold a pose on another map).
+// was on (size, resolution, origin, a hash of the cells), the pose itself
+// and, with a building's floors (floors.h), the floor's name. At start-up a
+// configured initial pose that ~saved_pose_map records is a saved one, and
+// it is only used on a first map with the same signature that has the pose
+// in a free cell (with floors: on the floor it names, where pf_node then
+// starts); otherwise global localization (a roscore that had run another
+// bag may hold a pose on another map).
 // PoseSaver (pose_saver.h) saves it; this is what it saves, and what a later
 // run makes of it.
 #pragma once
@@ -29,14 +31,18 @@ namespace pf_ros {
 /// <64-bit FNV-1a hash of the cells, hex>". Equal for the same map sent again.
 std::string mapSignature(const nav_msgs::OccupancyGrid& map);
 
-/// ~saved_pose_map's value: "<map signature>; pose <x> <y> <yaw>".
-std::string savedPoseMapValue(const std::string& map_signature, const pf::Pose2& pose);
+/// ~saved_pose_map's value: "<map signature>; pose <x> <y> <yaw>", and
+/// "; floor <name>" after it when `floor` is not empty.
+std::string savedPoseMapValue(const std::string& map_signature, const pf::Pose2& pose,
+                              const std::string& floor = "");
 
-/// ~saved_pose_map read back: the map's signature, and the pose when the
-/// value records one.
+/// ~saved_pose_map read back: the map's signature, the pose when the value
+/// records one, and the floor (empty when it records none: a value saved
+/// without floors, or by an earlier version).
 struct SavedPoseMap {
   std::string map_signature;
   std::optional<pf::Pose2> pose;
+  std::string floor;
 };
 SavedPoseMap parseSavedPoseMap(const std::string& value);
 
@@ -51,9 +57,12 @@ struct SavedPoseDecision {
   bool resume = false;  // false: ignore it, start global localization
   std::string message;  // for the log: INFO when resuming, WARN otherwise
 };
-/// `map_signature`, `grid`: the first map. Resumes when the pose was saved on
-/// a map of that signature and lies in one of its free cells.
+/// `map_signature`, `grid`: the first map; `floor`: its floor's name (empty
+/// without floors: the saved floor is not looked at). Resumes when the pose
+/// was saved on a map of that signature (and on that floor, when both name
+/// one) and lies in one of its free cells.
 SavedPoseDecision decideSavedPose(const SavedPoseMap& saved, const pf::Pose2& pose,
-                                  const std::string& map_signature, const pf::OccupancyGrid& grid);
+                                  const std::string& map_signature, const pf::OccupancyGrid& grid,
+                                  const std::string& floor = "");
 
 }  // namespace pf_ros
