@@ -341,7 +341,10 @@ MapChangeLayer::Cell MapChangeLayer::classify(std::size_t i) const {
   const Counts& c = countsAt(i);
   const int hits = c.hits, passes = c.passes;
   const int stopped = hits + c.free, reached = passes + c.ends;
-  if (hits >= kMinScans && hits >= kChangedShare * stopped && c.apart && c.clear < kClearScans &&
+  // Hits from one place only (the robot turning there, or back there) are
+  // what a person standing by gives too: fewer clear scans take them out.
+  const int clear_scans = c.apart ? kClearScans : kOnePlaceClearScans;
+  if (hits >= kMinScans && hits >= kChangedShare * stopped && c.clear < clear_scans &&
       (!c.moved_in || hits >= kMovedInScans)) {
     return Cell::kAdded;
   }

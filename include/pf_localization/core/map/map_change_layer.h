@@ -14,16 +14,18 @@
 // maps of Meyer-Delius et al. (IROS 2010) do, instead of merged into it.
 // People are not walls: a person who stands a while is hit by the beams of
 // several scans as much as a cupboard is, so a cell is added only on what a
-// person does not give. Its hits came from robot places at least
-// kMinBaseline apart (a surface seen from several places, not from one
-// place while something stood there); the scans since its last hit did not
-// see through it (kClearScans: a static surface stops the beams that
-// reach it; where a person stood, the beams run through once they have
-// left: the latest evidence wins, as in occupancy mapping with clamping,
-// Hornung et al., "OctoMap", Autonomous Robots 2013); and, when the robot
-// saw its place empty from nearby before the first hit (kMovedInPasses:
-// something moved in while it looked, the free-space violation of moving
-// object detection), many scans hit it (kMovedInScans). What moves is the
+// person does not give. The scans since its last hit did not see through
+// it (a static surface stops the beams that reach it; where a person
+// stood, the beams run through once they have left: the latest evidence
+// wins, as in occupancy mapping with clamping, Hornung et al., "OctoMap",
+// Autonomous Robots 2013): kClearScans in a row take out a cell hit from
+// robot places at least kMinBaseline apart, kOnePlaceClearScans one hit
+// from one place only (the robot turning where it stood, or back where it
+// was: a cupboard seen from one spot, or someone standing by); and, when
+// the robot saw its place empty from nearby before the first hit
+// (kMovedInPasses: something moved in while it looked, the free-space
+// violation of moving object detection), many scans hit it
+// (kMovedInScans). What moves is the
 // transient screening's (transient_beams.h) and the judging's, which masks
 // beams that end short of the map. See docs/design.md, "A map out of date
 // is not a wrong pose", and its "People are not walls".
@@ -66,10 +68,10 @@ class MapChangeLayer {
   /// Share of those that must say it changed: stopped there (added) or went
   /// through (removed).
   static constexpr double kChangedShare = 0.5;
-  /// m: an added cell's hits came from robot places at least this far apart
-  /// (the first hit's place and a later one): two scans added while the
-  /// robot drove (kMinStep), not the scans added while it turned in place
-  /// beside someone standing there.
+  /// m: a cell's hits came from robot places at least this far apart (the
+  /// first hit's place and a later one): two scans added while the robot
+  /// drove (kMinStep), not the scans added while it turned in place, where
+  /// a cupboard and someone standing by look the same.
   static constexpr double kMinBaseline = 0.4;
   /// Scans in a row whose beams went through a cell, none ending there,
   /// since its last hit that take it out of the added cells (until it is hit
@@ -77,6 +79,12 @@ class MapChangeLayer {
   /// left. Fewer are not enough: a beam grazing a surface's face passes the
   /// cells just before it (a pallet along an aisle, seen down the aisle).
   static constexpr int kClearScans = 3;
+  /// The same for a cell hit from one place only (not kMinBaseline apart):
+  /// two scans through it since its last hit; it is kept until then, a
+  /// surface seen from one spot only (a planter, a cabinet seen across a
+  /// room from where the robot turned). One is not enough either: a beam
+  /// grazing its edge, seen again when the robot came back.
+  static constexpr int kOnePlaceClearScans = 2;
   /// Beams through a free cell before its first hit that make what it hit
   /// something that moved in while the robot looked (a person walking up):
   /// such a cell is added only after kMovedInScans hits, a pallet put down
