@@ -22,7 +22,8 @@ constexpr double kMinWait = 1e-6;
 // more: most of them), and the half period left covers the latency of a
 // loaded computer. Under simulated time every delay of the wall clock is
 // multiplied by the bag's rate and the clock moves in steps, so the timed
-// copy comes after one period, as the whole margin is needed there.
+// copy comes within one period, at the last /clock before it is due (see the
+// header), as the whole margin is needed there.
 constexpr double kWallClockPeriods = 1.5;
 
 }  // namespace
@@ -78,7 +79,7 @@ bool MapToOdomRepublisher::set(const std::optional<geometry_msgs::TransformStamp
   std::lock_guard<std::mutex> lock(mutex_);
   transform_ = map_to_odom;
   if (!scan_stamp.isZero()) scan_stamp_ = std::max(scan_stamp_, scan_stamp);
-  const ros::Time now = ros::Time::now();
+  const ros::Time now = clockNow();
   ros::Time stamp = std::max(now, scan_stamp_) + ros::Duration(options_.transform_tolerance);
   // A correction must reach tf now even when the clock has not moved since
   // the last timed publication.
@@ -115,9 +116,17 @@ std::size_t MapToOdomRepublisher::published() const {
   return published_;
 }
 
+ros::Time MapToOdomRepublisher::lastStamp() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return last_stamp_;
+}
+
 void MapToOdomRepublisher::onClock(const ros::Time& now) {
+  const ros::Time before = ros::Time().fromNSec(clock_ns_.exchange(now.toNSec()));
+  // The clock's latest step: the next /clock will likely be as far on.
+  const ros::Duration step = before.isZero() || before >= now ? ros::Duration() : now - before;
   std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
-  if (lock.owns_lock() && !stop_) tick(now, &lock);
+  if (lock.owns_lock() && !stop_) tick(now, step, &lock);
 }
 
 void MapToOdomRepublisher::onTimer() {
@@ -126,10 +135,15 @@ void MapToOdomRepublisher::onTimer() {
   if (::read(timer_fd_, &expirations, sizeof expirations) < 0) return;
   std::unique_lock<std::mutex> lock(mutex_);
   if (stop_) return;
-  tick(ros::Time::now(), &lock);
+  tick(ros::Time::now(), ros::Duration(), &lock);
   if (stop_) return;
   // Until the next is due; set() moves that later.
   armLocked(std::max((schedule_.next() - ros::Time::now()).toSec(), kMinWait));
+}
+
+ros::Time MapToOdomRepublisher::clockNow() const {
+  const std::int64_t ns = clock_ns_;
+  return ns == 0 ? ros::Time::now() : ros::Time().fromNSec(ns);
 }
 
 ros::Duration MapToOdomRepublisher::delayLocked() const {
@@ -145,10 +159,11 @@ void MapToOdomRepublisher::armLocked(double seconds) {
   ::timerfd_settime(timer_fd_, 0, &spec, nullptr);
 }
 
-void MapToOdomRepublisher::tick(const ros::Time& now, std::unique_lock<std::mutex>* lock) {
+void MapToOdomRepublisher::tick(const ros::Time& now, const ros::Duration& step,
+                                std::unique_lock<std::mutex>* lock) {
   const ros::Duration period = delayLocked();
   // Zero: simulated time has not started.
-  if (now.isZero() || !schedule_.due(now, period)) return;
+  if (now.isZero() || !schedule_.due(now, period, step.isZero() ? ros::Time() : now + step)) return;
   // The tick counts as a publication even when it has nothing new to send
   // (no map -> odom yet, or no later stamp): otherwise it would stay due.
   schedule_.published(now, period);

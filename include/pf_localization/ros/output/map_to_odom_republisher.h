@@ -1,7 +1,7 @@
 // map -> odom on /tf: published after every filter update, and again
 // whenever 1.5 periods (1 / tf_publish_rate s) pass without one on the wall
-// clock, one period under simulated time, so that tf users never wait more
-// than two periods (see kWallClockPeriods in the .cc). Neither a filter update
+// clock, at most one period under simulated time, so that tf users never
+// wait more than two periods (see kWallClockPeriods in the .cc). Neither a filter update
 // nor anything else on the node's spinner delays it: it only ever touches the
 // latest transform handed to it, under its own mutex, never the filter.
 //
@@ -14,9 +14,15 @@
 //   enough it never fires;
 // - under simulated time, /clock itself: no sleep can be timed on a clock
 //   that only /clock moves, so start() subscribes to it on the handle it is
-//   given (pf_node's poll thread), and the /clock message at which a
-//   publication is due publishes it, on the thread that brought it. No
-//   thread polls the clock (docs/performance.md, "The fixed cost").
+//   given (pf_node's poll thread), and the last /clock message before a
+//   publication is due publishes it, on the thread that brought it: the
+//   last one whose next, one step of the clock later (rosbag play's: 10 ms
+//   of wall time times the rate), would come after the due time. The first
+//   one after it would leave a gap of a period plus a step, over two
+//   periods whenever a step of a bag played at 4x is 5 ms late. No
+//   thread polls the clock (docs/performance.md, "The fixed cost"). The
+//   stamps are the latest /clock's (plus transform_tolerance), not roscpp's
+//   clock, which its own thread sets a step later.
 #pragma once
 
 #include <geometry_msgs/TransformStamped.h>
@@ -24,6 +30,8 @@
 #include <rosgraph_msgs/Clock.h>
 #include <tf2_ros/transform_broadcaster.h>
 
+#include <atomic>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <mutex>
@@ -75,6 +83,8 @@ class MapToOdomRepublisher {
 
   /// Number of map -> odom messages published since start.
   std::size_t published() const;
+  /// The stamp of the latest one (zero: none since start or reset()).
+  ros::Time lastStamp() const;
 
   /// Simulated time moved to `now` (/clock): the timed publication when one
   /// is due. Never waits: while set() publishes (which puts the next timed
@@ -91,9 +101,16 @@ class MapToOdomRepublisher {
   // How long after the latest publication the next timed one is due: 1.5
   // periods on the wall clock, one under simulated time (see the .cc).
   ros::Duration delayLocked() const;
-  // The timed publication at `now`, when due; `lock` holds mutex_ (and is
-  // released around the hook).
-  void tick(const ros::Time& now, std::unique_lock<std::mutex>* lock);
+  // The timed publication at `now`, when due (RepublishSchedule::due, the
+  // next chance taken to be `step` later: the clock's latest step; zero on
+  // the wall clock's timer); `lock` holds mutex_ (and is released around the
+  // hook).
+  void tick(const ros::Time& now, const ros::Duration& step, std::unique_lock<std::mutex>* lock);
+  // The node's time: under simulated time the latest /clock seen here, which
+  // roscpp's own clock (set on another thread, after this one's) trails by
+  // a step or more; ros::Time::now() before the first /clock and on the wall
+  // clock.
+  ros::Time clockNow() const;
   // Publishes the stored transform stamped `stamp`; mutex_ held.
   bool publishLocked(ros::Time stamp);
 
@@ -108,6 +125,7 @@ class MapToOdomRepublisher {
   RepublishSchedule schedule_;
   std::size_t published_ = 0;
   ros::Subscriber clock_sub_;
+  std::atomic<std::int64_t> clock_ns_{0};  // the latest /clock (ns); 0: none yet
   // Whether the poll thread may still call onTimer(): the poll set may call
   // a callback of a timer just taken out of it, so it checks this first,
   // under the guard's lock, which the destructor takes to clear it.
