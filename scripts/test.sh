@@ -225,7 +225,7 @@ rostests_by_length() {
 # nodes): run one at a time after the others, when only the low-priority lane
 # shares the machine, since five neighbours on two cores are not the load they
 # were written for.
-timed_rostests="max_update_time overload cpu_hog odom_topic map_swap floors"
+timed_rostests="max_update_time overload overload_4x cpu_hog odom_topic map_swap floors"
 
 full_tier() {
   local file args

@@ -2,8 +2,14 @@
 """rostest checker for pf_node under overload.
 
 Watches, while the bag plays (from the first to the last /ground_truth):
-  - map -> odom on /tf: the largest gap between two consecutive stamps
-    (sim time), which must stay below max_tf_gap [s]. A gap the clock
+  - map -> odom on /tf, as a recorder of /tf sees it (every message, in the
+    order it arrives): the gaps between consecutive stamps (sim time), raw,
+    which must stay below max_raw_tf_gap [s] wherever pf_node could have
+    published: a longer one only where /clock itself moved from one stamp's
+    time to the next's in a single step (no /clock value between them, the
+    stamps taken back by transform_tolerance; stamps come from /clock, so
+    no publisher could do better); and with the clock's jumps taken out,
+    below max_tf_gap [s]. A gap the clock
     itself made is not pf_node's: a timer under simulated time can only fire
     when /clock moves, which rosbag play does in steps of rate / 100 s (40 ms
     at 4x), and by a second at once when it is starved of CPU and catches up.
@@ -11,9 +17,11 @@ Watches, while the bag plays (from the first to the last /ground_truth):
     taken back by transform_tolerance [s], default 0.1, pf_node's) are
     subtracted from it: the sum of those longer than one tf period
     (tf_period [s], default 0.05; the clock's jumps), or the largest step
-    if that is more (the clock's resolution). The raw gaps are printed too;
-    a republishing timer stuck behind the filter shows up whole, since the
-    clock moves in small steps meanwhile;
+    if that is more (the clock's resolution). A republishing timer stuck
+    behind the filter shows up whole in both, since the clock moves in small
+    steps meanwhile. The clock's own steps are printed (a raw gap can be no
+    smaller than the step it spans), and stamps that arrive out of order
+    (not later than the one before) are counted and fail max_raw_tf_gap;
   - pf_node's pf_status (latency_*, update_time_*, dropped_scans,
     particle_cap): the last report must satisfy the bounds below;
   - pf_node's resident memory (/proc/PID/status VmRSS): from rss_after [s of
@@ -41,7 +49,8 @@ and that pf_node is alive at the end. Every figure is printed (rostest --text,
 or the XML result's <system-out>) whether the test passes or not.
 
 Params (all optional; unset: only reported):
-  max_tf_gap [s], tf_gap_p99 [s] (99 % of the gaps at most this),
+  max_raw_tf_gap [s], max_tf_gap [s], tf_gap_p99 [s] (99 % of the gaps
+  without the clock's jumps at most this),
   max_latency_p95_ms, latency_p95_over_update_ms (latency p95
   must stay below update_time p95 + this), max_update_time_p50_ms,
   max_update_time_p95_ms, max_particle_cap (particle_cap must be reported
@@ -53,6 +62,7 @@ Params (all optional; unset: only reported):
   global_at [s], global_floor.
 """
 
+import bisect
 import math
 import sys
 import threading
@@ -211,6 +221,8 @@ class OverloadChecker:
     def evaluate(self, pid):
         failures, info = [], []
         # tf gaps
+        arrived = [t[0] for t in self.tf_stamps]
+        out_of_order = sum(1 for a, b in zip(arrived, arrived[1:]) if b <= a)
         stamps = sorted(self.tf_stamps)
         clock = sorted(self.clock)
         steps = [(a, b - a) for a, b in zip(clock, clock[1:])]  # (from, step)
@@ -240,6 +252,35 @@ class OverloadChecker:
                     (len(stamps), max_gap, raw_max, len(clock), max((s for _, s in steps), default=0.0)))
         info.append('largest gaps (gap, raw stamp gap, clock step inside, at t) s: ' +
                     ', '.join('(%.3f %.3f %.3f %.1f)' % g for g in gaps[:5]))
+        by_raw = sorted(gaps, key=lambda g: g[1], reverse=True)
+        bound = opt('max_raw_tf_gap')
+        # The raw gaps over the bound that span no /clock value: the clock's single step.
+        over, of_clock = [], 0
+        for g in by_raw:
+            if bound is None or g[1] <= float(bound):
+                break
+            lo, hi = g[3] + self.first_gt - tol, g[3] + self.first_gt + g[1] - tol
+            k = bisect.bisect_right(clock, lo + 1e-3)
+            if k < len(clock) and clock[k] < hi - 1e-3:
+                over.append(g)
+            else:
+                of_clock += 1
+        info.append('largest raw stamp gaps (raw, clock step inside, at t) s: ' +
+                    ', '.join('(%.3f %.3f %.1f)' % (g[1], g[2], g[3]) for g in by_raw[:5]) +
+                    '; %d raw gaps over 0.1 s, %d stamps out of order; /clock steps over '
+                    '0.1 s: %d (information: a raw gap spans at least one step)' %
+                    (sum(1 for g in gaps if g[1] > 0.1), out_of_order,
+                     sum(1 for _, st in steps if st > 0.1)))
+        if bound is not None:
+            info.append('raw gaps over max_raw_tf_gap %s s: %d where /clock moved in one step '
+                        '(rosbag play behind), %d where pf_node skipped a /clock' %
+                        (bound, of_clock, len(over)))
+        if over:
+            failures.append('map->odom raw stamp gap %.3f s at t=%.1f s > max_raw_tf_gap %.3f s '
+                            'over /clock values pf_node did not publish at (%d such gaps)' %
+                            (over[0][1], over[0][3], float(bound), len(over)))
+        if bound is not None and out_of_order:
+            failures.append('%d map->odom stamps arrived out of order' % out_of_order)
         bound = opt('max_tf_gap')
         if bound is not None and not max_gap <= float(bound):
             failures.append('map->odom gap %.3f s > max_tf_gap %.3f s' % (max_gap, float(bound)))

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdint>
+#include <thread>
 #include <utility>
 
 namespace pf_ros {
@@ -22,7 +23,8 @@ constexpr double kMinWait = 1e-6;
 // more: most of them), and the half period left covers the latency of a
 // loaded computer. Under simulated time every delay of the wall clock is
 // multiplied by the bag's rate and the clock moves in steps, so the timed
-// copy comes after one period, as the whole margin is needed there.
+// copy comes within one period, at the last /clock before it is due (see the
+// header), as the whole margin is needed there.
 constexpr double kWallClockPeriods = 1.5;
 
 }  // namespace
@@ -33,19 +35,20 @@ MapToOdomRepublisher::MapToOdomRepublisher(const MapToOdomRepublisherOptions& op
 
 void MapToOdomRepublisher::start(ros::NodeHandle clock_nh) {
   if (poll_guard_ || clock_sub_) return;
-  if (ros::Time::isSimTime()) {
+  wall_clock_ = !ros::Time::isSimTime();
+  if (!wall_clock_) {
     clock_sub_ = clock_nh.subscribe<rosgraph_msgs::Clock>(
         "/clock", 1, [this](const rosgraph_msgs::ClockConstPtr& msg) { onClock(msg->clock); });
-    return;
   }
-  timer_fd_ = ::timerfd_create(CLOCK_MONOTONIC, TFD_CLOEXEC | TFD_NONBLOCK);
-  if (timer_fd_ < 0) {
+  const int fd = ::timerfd_create(CLOCK_MONOTONIC, TFD_CLOEXEC | TFD_NONBLOCK);
+  if (fd < 0) {
     ROS_ERROR("pf_node: no timer for republishing map -> odom (timerfd_create: errno %d)", errno);
     return;
   }
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    armLocked(kMinWait);  // the first publication is due at once
+    timer_fd_ = fd;
+    if (wall_clock_) armLocked(kMinWait);  // the first publication is due at once
   }
   auto guard = std::make_shared<PollGuard>();
   poll_guard_ = guard;
@@ -75,10 +78,25 @@ MapToOdomRepublisher::~MapToOdomRepublisher() {
 
 bool MapToOdomRepublisher::set(const std::optional<geometry_msgs::TransformStamped>& map_to_odom,
                                const ros::Time& scan_stamp) {
-  std::lock_guard<std::mutex> lock(mutex_);
-  transform_ = map_to_odom;
-  if (!scan_stamp.isZero()) scan_stamp_ = std::max(scan_stamp_, scan_stamp);
-  const ros::Time now = ros::Time::now();
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    transform_ = map_to_odom;
+    if (!scan_stamp.isZero()) scan_stamp_ = std::max(scan_stamp_, scan_stamp);
+    if (timer_fd_ < 0 || std::this_thread::get_id() == poll_thread_.load()) {
+      return publishUpdateLocked();
+    }
+    update_pending_ = true;
+    if (!options_.enabled || !transform_) return false;
+  }
+  // Outside the lock: the poll thread publishes it (onTimer()); a timer it
+  // re-armed meanwhile for later has already published it.
+  armLocked(kMinWait);
+  return true;
+}
+
+bool MapToOdomRepublisher::publishUpdateLocked() {
+  update_pending_ = false;
+  const ros::Time now = clockNow();
   ros::Time stamp = std::max(now, scan_stamp_) + ros::Duration(options_.transform_tolerance);
   // A correction must reach tf now even when the clock has not moved since
   // the last timed publication.
@@ -86,7 +104,7 @@ bool MapToOdomRepublisher::set(const std::optional<geometry_msgs::TransformStamp
   if (!publishLocked(stamp)) return false;
   if (!now.isZero()) {
     schedule_.published(now, delayLocked());
-    armLocked(delayLocked().toSec());  // puts the timed publication off
+    if (wall_clock_) armLocked(delayLocked().toSec());  // puts the timed publication off
   }
   return true;
 }
@@ -102,7 +120,7 @@ void MapToOdomRepublisher::reset() {
 void MapToOdomRepublisher::setRate(double hz) {
   std::lock_guard<std::mutex> lock(mutex_);
   options_.rate = hz;
-  armLocked(kMinWait);  // the next timed publication goes by the new rate
+  if (wall_clock_) armLocked(kMinWait);  // the next timed publication goes by the new rate
 }
 
 void MapToOdomRepublisher::setTransformTolerance(double seconds) {
@@ -115,25 +133,44 @@ std::size_t MapToOdomRepublisher::published() const {
   return published_;
 }
 
+ros::Time MapToOdomRepublisher::lastStamp() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return last_stamp_;
+}
+
 void MapToOdomRepublisher::onClock(const ros::Time& now) {
+  poll_thread_ = std::this_thread::get_id();
+  const ros::Time before = ros::Time().fromNSec(clock_ns_.exchange(now.toNSec()));
+  // The clock's latest step: the next /clock will likely be as far on.
+  const ros::Duration step = before.isZero() || before >= now ? ros::Duration() : now - before;
   std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
-  if (lock.owns_lock() && !stop_) tick(now, &lock);
+  if (!lock.owns_lock() || stop_) return;
+  if (update_pending_) publishUpdateLocked();
+  tick(now, step, &lock);
 }
 
 void MapToOdomRepublisher::onTimer() {
+  poll_thread_ = std::this_thread::get_id();
   std::uint64_t expirations = 0;
   // Nothing to read: set() re-armed it since it fired, so it is not due.
   if (::read(timer_fd_, &expirations, sizeof expirations) < 0) return;
   std::unique_lock<std::mutex> lock(mutex_);
   if (stop_) return;
-  tick(ros::Time::now(), &lock);
+  if (update_pending_) publishUpdateLocked();
+  if (!wall_clock_) return;  // /clock times the copies
+  tick(ros::Time::now(), ros::Duration(), &lock);
   if (stop_) return;
   // Until the next is due; set() moves that later.
   armLocked(std::max((schedule_.next() - ros::Time::now()).toSec(), kMinWait));
 }
 
+ros::Time MapToOdomRepublisher::clockNow() const {
+  const std::int64_t ns = clock_ns_;
+  return ns == 0 ? ros::Time::now() : ros::Time().fromNSec(ns);
+}
+
 ros::Duration MapToOdomRepublisher::delayLocked() const {
-  return ros::Duration((timer_fd_ >= 0 ? kWallClockPeriods : 1.0) / options_.rate);
+  return ros::Duration((wall_clock_ ? kWallClockPeriods : 1.0) / options_.rate);
 }
 
 void MapToOdomRepublisher::armLocked(double seconds) {
@@ -145,10 +182,11 @@ void MapToOdomRepublisher::armLocked(double seconds) {
   ::timerfd_settime(timer_fd_, 0, &spec, nullptr);
 }
 
-void MapToOdomRepublisher::tick(const ros::Time& now, std::unique_lock<std::mutex>* lock) {
+void MapToOdomRepublisher::tick(const ros::Time& now, const ros::Duration& step,
+                                std::unique_lock<std::mutex>* lock) {
   const ros::Duration period = delayLocked();
   // Zero: simulated time has not started.
-  if (now.isZero() || !schedule_.due(now, period)) return;
+  if (now.isZero() || !schedule_.due(now, period, step.isZero() ? ros::Time() : now + step)) return;
   // The tick counts as a publication even when it has nothing new to send
   // (no map -> odom yet, or no later stamp): otherwise it would stay due.
   schedule_.published(now, period);

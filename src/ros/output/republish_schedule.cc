@@ -2,9 +2,10 @@
 
 namespace pf_ros {
 
-bool RepublishSchedule::due(const ros::Time& now, const ros::Duration& period) {
+bool RepublishSchedule::due(const ros::Time& now, const ros::Duration& period,
+                            const ros::Time& next_chance) {
   if (next_.isZero() || now + period < next_) next_ = now;
-  return now >= next_;
+  return now >= next_ || next_chance > next_;
 }
 
 }  // namespace pf_ros

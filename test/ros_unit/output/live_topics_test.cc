@@ -48,15 +48,40 @@ TEST(MapToOdomRepublisher, UnderSimulatedTimeEachClockStepAtWhichAPeriodIsDuePub
   EXPECT_EQ(r.published(), after_update);
   clockAt(&r, 1070);
   EXPECT_EQ(r.published(), after_update + 1);
-  // A bag that starts over: time jumps back, the republisher forgets and the
-  // filter sets its first map -> odom again; the new timeline's first due
-  // /clock publishes.
-  ros::Time::setNow(at(0));
+  // A bag that starts over: /clock jumps back, the republisher forgets and
+  // the filter sets its first map -> odom again; the new timeline's first
+  // due /clock publishes.
+  clockAt(&r, 0);
   r.reset();
   ASSERT_TRUE(r.set(mapToOdom(), at(0)));
   const std::size_t restarted = r.published();
   clockAt(&r, 50);
   EXPECT_EQ(r.published(), restarted + 1);
+}
+
+TEST(MapToOdomRepublisher, UnderSimulatedTimeTheLastClockBeforeAPeriodPublishes) {
+  ros::Time::setNow(at(0));
+  MapToOdomRepublisher r(MapToOdomRepublisherOptions{20.0, 0.1, true});
+  clockAt(&r, 0);
+  ASSERT_TRUE(r.set(mapToOdom(), at(0)));
+  // /clock every 40 ms (a bag at 4x): each one publishes, since the next
+  // comes after the due time (50 ms after the latest publication). The first
+  // /clock after it would have published every 80 ms, and after a late step
+  // of 70 ms, 110 ms after the latest.
+  for (int ms = 40; ms <= 400; ms += 40) {
+    clockAt(&r, ms);
+    EXPECT_EQ(r.published(), 1u + static_cast<std::size_t>(ms / 40)) << "at " << ms << " ms";
+    EXPECT_EQ(r.lastStamp(), at(ms) + ros::Duration(0.1));
+  }
+  // A step of 10 ms after one of 40: the next /clock, 10 ms on, is still
+  // before the due time (450 ms): no publication.
+  const std::size_t before = r.published();
+  r.onClock(at(410));  // roscpp's own clock still at 400 ms: it trails
+  EXPECT_EQ(r.published(), before);
+  // An update's map -> odom is stamped from the latest /clock (410 ms), not
+  // from roscpp's trailing clock.
+  ASSERT_TRUE(r.set(mapToOdom(), at(405)));
+  EXPECT_EQ(r.lastStamp(), at(410) + ros::Duration(0.1));
 }
 
 TEST(LatchedTopic, KeepsTheLatestMessageForTheFirstSubscriber) {

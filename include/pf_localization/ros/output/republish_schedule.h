@@ -13,9 +13,13 @@ namespace pf_ros {
 /// get one at least once a period.
 class RepublishSchedule {
  public:
-  /// Whether a timed publication is due at `now`. The first call is, and so
-  /// is any call after time went back (a bag restarted).
-  bool due(const ros::Time& now, const ros::Duration& period);
+  /// Whether a timed publication is due at `now`: when a period has passed,
+  /// or when the next chance to publish, `next_chance` (zero: unknown), comes
+  /// after the due time, so that it goes at the last chance before the due
+  /// time rather than the first after it. The first call is due, and so is
+  /// any call after time went back (a bag restarted).
+  bool due(const ros::Time& now, const ros::Duration& period,
+           const ros::Time& next_chance = ros::Time());
   /// Something was published at `now`: the next is due one period later.
   void published(const ros::Time& now, const ros::Duration& period) { next_ = now + period; }
   /// Forget the past: due at once.
