@@ -10,6 +10,7 @@
 
 #include "pf_localization/core/sensor/scan_group.h"
 #include "pf_localization/core/sensor/sensor_update.h"
+#include "pf_localization/core/util/packed_flags.h"
 
 namespace pf {
 namespace {
@@ -92,16 +93,16 @@ class NearObstacle {
   explicit NearObstacle(const DistanceField& field) : grid_(field.grid()) {
     // Within 1.01 cells: a class below `within` (distance_field.h).
     const std::size_t within = field.classesWithin(1.01 * grid_.resolution());
-    // A word at a time, built in a register.
+    // A word at a time, four cells at a time in a register where the bound
+    // allows (packed_flags.h).
     bits_.assign((field.size() + 63) / 64, 0);
     const uint16_t* classes = field.classes();
-    for (std::size_t w = 0; w < bits_.size(); ++w) {
-      const std::size_t first = w * 64, end = std::min(first + 64, field.size());
-      uint64_t word = 0;
-      for (std::size_t i = first; i < end; ++i) {
-        word |= static_cast<uint64_t>(classes[i] < within) << (i - first);
-      }
-      bits_[w] = word;
+    const std::size_t packed = within <= 0x8000 ? field.size() / 64 : 0;
+    for (std::size_t w = 0; w < packed; ++w) {
+      bits_[w] = flagsBelow(classes + 64 * w, static_cast<unsigned>(within));
+    }
+    for (std::size_t i = packed * 64; i < field.size(); ++i) {
+      bits_[i / 64] |= static_cast<uint64_t>(classes[i] < within) << (i % 64);
     }
   }
   const OccupancyGrid& grid() const { return grid_; }
@@ -185,18 +186,17 @@ std::vector<std::uint32_t> obstacleCells(const OccupancyGrid& grid) {
   const auto occupied = [&cells](std::size_t i) {
     return OccupancyGrid::classify(cells[i]) == CellState::kOccupied;
   };
-  // Most cells are not obstacles: 32 at a time are looked at together first.
-  constexpr std::size_t kChunk = 32;
-  std::size_t i = 0;
-  for (; i + kChunk <= cells.size(); i += kChunk) {
-    bool any = false;
-    for (std::size_t k = 0; k < kChunk; ++k) any |= occupied(i + k);
-    if (!any) continue;
-    for (std::size_t k = i; k < i + kChunk; ++k) {
-      if (occupied(k)) obstacles.push_back(static_cast<std::uint32_t>(k));
+  // 64 cells at a time, as the bits of a word (packed_flags.h): most are not
+  // obstacles. Occupied is [kOccupiedMin, 127].
+  static_assert(OccupancyGrid::kOccupiedMin > 0, "occupied values are positive");
+  const std::size_t whole = cells.size() / 64;
+  for (std::size_t w = 0; w < whole; ++w) {
+    uint64_t bits = flagsInRange(cells.data() + 64 * w, OccupancyGrid::kOccupiedMin, 127);
+    for (; bits != 0; bits &= bits - 1) {
+      obstacles.push_back(static_cast<std::uint32_t>(64 * w + __builtin_ctzll(bits)));
     }
   }
-  for (; i < cells.size(); ++i) {
+  for (std::size_t i = whole * 64; i < cells.size(); ++i) {
     if (occupied(i)) obstacles.push_back(static_cast<std::uint32_t>(i));
   }
   return obstacles;
