@@ -170,11 +170,11 @@ void DistanceField::transformOutside(const ValueClasses& values, int threads) {
   const int w = grid_.width(), h = grid_.height();
   uint16_t* cells = classes_.data();
   const int8_t* map = grid_.data().data();
-  const auto occupied = [map](std::size_t i) { return DistanceField::occupied(map[i]); };
   // The column distances, then each row's classes in their place.
   inSlices(threads, static_cast<std::size_t>(w), [&](std::size_t begin, std::size_t end) {
-    cappedColumnDistances(occupied, w, h, values.outside_reach, static_cast<int>(begin),
-                          static_cast<int>(end), cells);
+    cappedColumnDistances(
+        map, [](int8_t v) { return DistanceField::occupied(v); }, w, h, values.outside_reach,
+        static_cast<int>(begin), static_cast<int>(end), cells);
   });
   inSlices(threads, static_cast<std::size_t>(h), [&](std::size_t begin, std::size_t end) {
     RowPassScratch scratch;

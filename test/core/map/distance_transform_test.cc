@@ -137,10 +137,12 @@ TEST(SquaredDistanceTransform, FarCornersOfALargerGridAreExact) {
 std::vector<int32_t> cappedTransform(const std::vector<bool>& grid, int width, int height,
                                      uint16_t cap) {
   std::vector<uint16_t> column(grid.size());
+  const std::vector<uint8_t> flags(grid.begin(), grid.end());
   // In two slices of columns, as two threads would.
-  const auto is_source = [&grid](std::size_t i) { return grid[i]; };
-  cappedColumnDistances(is_source, width, height, cap, 0, width / 3, column.data());
-  cappedColumnDistances(is_source, width, height, cap, width / 3, width, column.data());
+  const auto is_source = [](uint8_t flag) { return flag != 0; };
+  cappedColumnDistances(flags.data(), is_source, width, height, cap, 0, width / 3, column.data());
+  cappedColumnDistances(flags.data(), is_source, width, height, cap, width / 3, width,
+                        column.data());
   std::vector<int32_t> out(grid.size());
   RowPassScratch scratch;
   for (int y = 0; y < height; ++y) {

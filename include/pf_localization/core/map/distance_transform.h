@@ -30,31 +30,46 @@ namespace pf {
 std::vector<float> squaredDistanceTransform(const std::vector<bool>& is_source, int width,
                                             int height);
 
+/// One row of cappedColumnDistances' pass down (from the row above) or back
+/// up (kUp: from the row below, keeping the smaller). On pointers that do
+/// not alias and without a branch, so that the compiler vectorizes it.
+template <bool kUp, typename Value, typename IsSource>
+void cappedColumnStep(const Value* __restrict values, const IsSource& is_source,
+                      const uint16_t* __restrict from, uint16_t* __restrict out, std::size_t count,
+                      uint16_t cap) {
+  for (std::size_t k = 0; k < count; ++k) {
+    // Entries are at most cap, so min(g + 1, cap) is g + 1 below it.
+    const auto next = std::min(static_cast<uint16_t>(from[k] + 1), cap);
+    if constexpr (kUp) {
+      out[k] = std::min(out[k], next);
+    } else {
+      out[k] = is_source(values[k]) ? uint16_t{0} : next;
+    }
+  }
+}
+
 /// The column pass for distances below `cap` cells: out[y * width + x] is
 /// the distance in cells from (x, y) to the nearest source in column x, or
-/// `cap` when that is `cap` or more (or the column has none); is_source(i)
-/// says whether cell i (row-major) is a source. Columns [x_begin, x_end)
-/// only, so that threads can share a grid.
-template <typename IsSource>
-void cappedColumnDistances(const IsSource& is_source, int width, int height, uint16_t cap,
-                           int x_begin, int x_end, uint16_t* out) {
+/// `cap` when that is `cap` or more (or the column has none); cell i
+/// (row-major) is a source when is_source(values[i]). Columns [x_begin,
+/// x_end) only, so that threads can share a grid.
+template <typename Value, typename IsSource>
+void cappedColumnDistances(const Value* values, const IsSource& is_source, int width, int height,
+                           uint16_t cap, int x_begin, int x_end, uint16_t* out) {
   const std::size_t w = static_cast<std::size_t>(width);
   const std::size_t n = w * static_cast<std::size_t>(height);
   if (n == 0 || x_begin >= x_end) return;
-  const auto below = [cap](uint16_t g) { return static_cast<uint16_t>(g < cap ? g + 1 : cap); };
-  for (std::size_t x = x_begin; x < static_cast<std::size_t>(x_end); ++x) {
-    out[x] = is_source(x) ? 0 : cap;
-  }
+  const std::size_t first = static_cast<std::size_t>(x_begin);
+  const std::size_t count = static_cast<std::size_t>(x_end) - first;
+  for (std::size_t x = first; x < first + count; ++x) out[x] = is_source(values[x]) ? 0 : cap;
   for (std::size_t row = w; row < n; row += w) {
-    for (std::size_t i = row + x_begin; i < row + x_end; ++i) {
-      out[i] = is_source(i) ? 0 : below(out[i - w]);
-    }
+    cappedColumnStep<false>(values + row + first, is_source, out + row - w + first,
+                            out + row + first, count, cap);
   }
   for (std::size_t row = n - w; row >= w;) {
     row -= w;
-    for (std::size_t i = row + x_begin; i < row + x_end; ++i) {
-      out[i] = std::min(out[i], below(out[i + w]));
-    }
+    cappedColumnStep<true>(values + row + first, is_source, out + row + w + first,
+                           out + row + first, count, cap);
   }
 }
 
