@@ -32,10 +32,7 @@ wait [s of wall time for each step] (30).
 import bisect
 import math
 import os
-import re
 import shutil
-import signal
-import subprocess
 import sys
 import tempfile
 import threading
@@ -52,19 +49,11 @@ from pf_localization.srv import ChangeFloor
 from nav_msgs.msg import OccupancyGrid
 from std_msgs.msg import String
 
+from node_runs import NodeRuns, binary
+from pose_checker_poses import yaw_of
+
 PKG = 'pf_localization'
 NAME = 'floors_restart_checker'
-
-
-def binary(name):
-    found = roslib.packages.find_node(PKG, name)
-    if not found:
-        raise RuntimeError('%s not found with roslib.packages.find_node' % name)
-    return found[0]
-
-
-def yaw_of(q):
-    return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
 
 
 def truth_of(bag_path):
@@ -128,7 +117,7 @@ class Watch:
             self.bag_floor.append((msg.data, self.truth))
 
 
-class FloorsRestartTest(unittest.TestCase):
+class FloorsRestartTest(NodeRuns, unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.pf_node = binary('pf_node')
@@ -159,10 +148,7 @@ class FloorsRestartTest(unittest.TestCase):
 
     @classmethod
     def tearDownClass(cls):
-        for proc, _ in cls.procs:
-            if proc.poll() is None:
-                proc.kill()
-                proc.wait()
+        cls.kill_all()
         shutil.rmtree(cls.dir, ignore_errors=True)
 
     def truth_at(self, t):
@@ -174,18 +160,6 @@ class FloorsRestartTest(unittest.TestCase):
         a = (t - t0) / (t1 - t0) if t1 > t0 else 0.0
         (x0, y0, _), (x1, y1, yaw1) = self.truth[i - 1], self.truth[i]
         return x0 + a * (x1 - x0), y0 + a * (y1 - y0), yaw1
-
-    def start_proc(self, name, args):
-        log = open(os.path.join(self.dir, name + '.log'), 'w')
-        # rosconsole flushes each line only to a terminal unless told to.
-        env = dict(os.environ, ROSCONSOLE_STDOUT_LINE_BUFFERED='1')
-        proc = subprocess.Popen(args, stdout=log, stderr=subprocess.STDOUT, env=env)
-        self.procs.append((proc, log.name))
-        return proc
-
-    def output(self, name):
-        with open(os.path.join(self.dir, name + '.log')) as f:
-            return re.sub(r'\x1b\[[0-9;]*m', '', f.read())
 
     def start_pf_node(self, run):
         return self.start_proc(run, [self.pf_node, '__name:=' + self.node])
@@ -212,16 +186,6 @@ class FloorsRestartTest(unittest.TestCase):
             with self.watch.lock:
                 return bool(self.watch.floors) and self.watch.floors[-1] == floor
         self.wait_for('named floor %s on pf_floor' % floor, named, run)
-
-    def interrupt(self, run, proc):
-        proc.send_signal(signal.SIGINT)
-        try:
-            proc.wait(timeout=self.wait)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            self.fail('%s still running %.0f s after SIGINT' % (run, self.wait))
-        self.assertEqual(0, proc.returncode, '%s exited %d:\n%s'
-                         % (run, proc.returncode, self.output(run)))
 
     def change_floor(self, run, floor):
         """change_floor to `floor` without a pose."""

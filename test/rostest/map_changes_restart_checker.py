@@ -21,10 +21,7 @@ Private params: bag, map, other_map, initial_pose ("x y yaw"), play_seconds [s o
 rate (8), min_share (0.9), wait [s of wall time for each step] (25).
 """
 import os
-import re
 import shutil
-import signal
-import subprocess
 import sys
 import tempfile
 import threading
@@ -34,21 +31,15 @@ import unittest
 import roslib.packages
 import rospy
 import rostest
-import rosservice
 import yaml
 from diagnostic_msgs.msg import DiagnosticStatus
 from nav_msgs.msg import OccupancyGrid
 from std_srvs.srv import Empty
 
+from node_runs import NodeRuns, binary
+
 PKG = 'pf_localization'
 NAME = 'map_changes_restart_checker'
-
-
-def binary(name):
-    found = roslib.packages.find_node(PKG, name)
-    if not found:
-        raise RuntimeError('%s not found with roslib.packages.find_node' % name)
-    return found[0]
 
 
 def marked(msg):
@@ -82,7 +73,7 @@ class Layers:
             return self.latest.get(node), self.count.get(node, 0)
 
 
-class MapChangesRestartTest(unittest.TestCase):
+class MapChangesRestartTest(NodeRuns, unittest.TestCase):
     @classmethod
     def setUpClass(cls):
         cls.pf_node = binary('pf_node')
@@ -104,26 +95,11 @@ class MapChangesRestartTest(unittest.TestCase):
 
     @classmethod
     def tearDownClass(cls):
-        for proc, _ in cls.procs:
-            if proc.poll() is None:
-                proc.kill()
-                proc.wait()
+        cls.kill_all()
         shutil.rmtree(cls.dir, ignore_errors=True)
 
-    def start(self, name, args):
-        log = open(os.path.join(self.dir, name + '.log'), 'w')
-        # rosconsole flushes each line only to a terminal unless told to.
-        env = dict(os.environ, ROSCONSOLE_STDOUT_LINE_BUFFERED='1')
-        proc = subprocess.Popen(args, stdout=log, stderr=subprocess.STDOUT, env=env)
-        self.procs.append((proc, log.name))
-        return proc
-
-    def output(self, name):
-        with open(os.path.join(self.dir, name + '.log')) as f:
-            return re.sub(r'\x1b\[[0-9;]*m', '', f.read())
-
     def start_map(self, name, path):
-        return self.start(name, [self.map_publisher, path, '__name:=' + name, 'map:=/' + name])
+        return self.start_proc(name, [self.map_publisher, path, '__name:=' + name, 'map:=/' + name])
 
     def start_pf_node(self, name, map_topic, pose=None):
         for key, value in self.defaults.items():
@@ -133,7 +109,7 @@ class MapChangesRestartTest(unittest.TestCase):
         if pose:
             for key, value in zip(('initial_pose_x', 'initial_pose_y', 'initial_pose_a'), pose):
                 rospy.set_param('/%s/%s' % (name, key), value)
-        return self.start(name, [self.pf_node, '__name:=' + name, 'map:=/' + map_topic])
+        return self.start_proc(name, [self.pf_node, '__name:=' + name, 'map:=/' + map_topic])
 
     def wait_for_line(self, name, text):
         deadline = time.monotonic() + self.wait
@@ -154,23 +130,13 @@ class MapChangesRestartTest(unittest.TestCase):
         self.fail('no pf_map_changes from %s in %.0f s; its output:\n%s'
                   % (name, self.wait, self.output(name)))
 
-    def interrupt(self, name, proc):
-        proc.send_signal(signal.SIGINT)
-        try:
-            proc.wait(timeout=self.wait)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            self.fail('%s still running %.0f s after SIGINT' % (name, self.wait))
-        self.assertEqual(0, proc.returncode, '%s exited %d:\n%s'
-                         % (name, proc.returncode, self.output(name)))
-
     def test_restart(self):
         report = []
         self.start_map('map_a', self.map)
         # 1. learn from the bag, then stop.
         first = self.start_pf_node('pf_restart_1', 'map_a', self.pose)
         self.wait_for_line('pf_restart_1', 'no map changes saved in ' + self.file)
-        player = self.start('player', ['rosbag', 'play', '--clock', '-q', '-r', str(self.rate),
+        player = self.start_proc('player', ['rosbag', 'play', '--clock', '-q', '-r', str(self.rate),
                                        '-u', str(self.play_seconds), self.bag])
         player.wait(timeout=self.play_seconds / self.rate + self.wait)
         time.sleep(1.0)
