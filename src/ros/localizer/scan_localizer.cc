@@ -310,14 +310,19 @@ std::optional<geometry_msgs::PoseWithCovarianceStamped> ScanLocalizer::estimate(
 }
 
 std::optional<nav_msgs::OccupancyGrid> ScanLocalizer::mapChangesMsg(const ros::Time& stamp) const {
-  const pf::MapChangeLayer* changes = filter_.mapChanges();
-  if (!changes) return std::nullopt;
   nav_msgs::OccupancyGrid msg;
-  msg.header.stamp = stamp;
-  msg.header.frame_id = config_.global_frame;
-  msg.info = map_info_;
-  msg.data = changes->occupancy();
+  if (!mapChangesMsg(stamp, &msg)) return std::nullopt;
   return msg;
+}
+
+bool ScanLocalizer::mapChangesMsg(const ros::Time& stamp, nav_msgs::OccupancyGrid* msg) const {
+  const pf::MapChangeLayer* changes = filter_.mapChanges();
+  if (!changes) return false;
+  msg->header.stamp = stamp;
+  msg->header.frame_id = config_.global_frame;
+  msg->info = map_info_;
+  changes->occupancy(&msg->data);
+  return true;
 }
 
 geometry_msgs::PoseArray ScanLocalizer::particleCloud(const ros::Time& stamp) const {

@@ -100,7 +100,9 @@ void EstimatePublisher::publishMapChangesNow(const ScanLocalizer& localizer,
                                              const ros::Time& stamp) {
   const pf::MapChangeLayer* layer = localizer.mapChanges();
   if (layer == nullptr) return;
-  if (auto msg = localizer.mapChangesMsg(stamp)) changes_pub_.publish(std::move(*msg));
+  // A message of a cell per map cell: filled into the last one's storage.
+  nav_msgs::OccupancyGrid msg = changes_pub_.spare();
+  if (localizer.mapChangesMsg(stamp, &msg)) changes_pub_.publish(std::move(msg));
   last_changes_stamp_ = stamp;
   changes_scans_ = layer->scans();
 }

@@ -209,9 +209,20 @@ TEST(MapChangeLayer, WritesTheMasksConvention) {
     removed += pixels[i] == 205;
     EXPECT_EQ(pixels[i] == 128, values[i] == -1);
     EXPECT_EQ(pixels[i] == 0, values[i] == 100);
+    EXPECT_EQ(values[i],
+              MapChangeLayer::valueOf(layer.removed(i)  ? MapChangeLayer::Cell::kRemoved
+                                      : layer.added(i)  ? MapChangeLayer::Cell::kAdded
+                                      : values[i] == -1 ? MapChangeLayer::Cell::kUnseen
+                                                        : MapChangeLayer::Cell::kAsMapped));
   }
+  EXPECT_GT(added, 0u);
+  EXPECT_GT(removed, 0u);
   EXPECT_EQ(layer.summary().added, added);
   EXPECT_EQ(layer.summary().removed, removed);
+  // Into storage used before, longer and holding other values: the same.
+  std::vector<std::int8_t> reused(values.size() + 7, 42);
+  layer.occupancy(&reused);
+  EXPECT_EQ(values, reused);
   EXPECT_THROW(saveImage(map, std::vector<std::uint8_t>(3), "/tmp/x.yaml"), std::invalid_argument);
 }
 

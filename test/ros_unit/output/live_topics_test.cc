@@ -94,6 +94,13 @@ TEST(LatchedTopic, KeepsTheLatestMessageForTheFirstSubscriber) {
   topic.publish(latest);
   ASSERT_TRUE(topic.kept().has_value());  // nobody subscribes: kept, not sent
   EXPECT_EQ(topic.kept()->pose.pose.position.x, 2.0);
+  // The kept message is the storage for the next one, and is kept again
+  // once published.
+  geometry_msgs::PoseWithCovarianceStamped spare = topic.spare();
+  EXPECT_EQ(spare.pose.pose.position.x, 2.0);
+  EXPECT_FALSE(topic.kept().has_value());
+  topic.publish(spare);
+  ASSERT_TRUE(topic.kept().has_value());
 
   std::vector<double> received;
   ros::Subscriber sub = nh.subscribe<geometry_msgs::PoseWithCovarianceStamped>(

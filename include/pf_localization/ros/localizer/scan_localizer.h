@@ -152,6 +152,8 @@ class ScanLocalizer {
   /// That layer over the map as an OccupancyGrid (MapChangeLayer::occupancy()),
   /// stamped `stamp`; none before a map.
   std::optional<nav_msgs::OccupancyGrid> mapChangesMsg(const ros::Time& stamp) const;
+  /// The same into `msg`, whose storage is used again; false before a map.
+  bool mapChangesMsg(const ros::Time& stamp, nav_msgs::OccupancyGrid* msg) const;
   /// At most `max_poses` of them (0: all), a systematic resample by weight
   /// when there are more (toPoseArray in conversions.h).
   geometry_msgs::PoseArray particleCloud(const ros::Time& stamp, std::size_t max_poses) const;

@@ -36,11 +36,25 @@ class LatchedTopic {
   void publish(M msg) {
     std::lock_guard<std::mutex> lock(mutex_);
     if (pub_.getNumSubscribers() > 0) {
-      pub_.publish(msg);
+      pub_.publish(msg);  // serialized here: msg is free again
       kept_.reset();
+      spare_ = std::move(msg);
     } else {
       kept_ = std::move(msg);
     }
+  }
+
+  /// A message to fill and publish() next: the one kept or last published,
+  /// so that a large message's storage is used again rather than allocated
+  /// and faulted in for every message. Its contents are stale.
+  M spare() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (kept_) {
+      M m = std::move(*kept_);
+      kept_.reset();
+      return m;
+    }
+    return std::move(spare_);
   }
 
   /// The message kept for the first subscriber, if any (for tests).
@@ -59,6 +73,7 @@ class LatchedTopic {
 
   mutable std::mutex mutex_;
   std::optional<M> kept_;
+  M spare_;  // the last message published, for spare()
   ros::Publisher pub_;
 };
 
