@@ -195,7 +195,7 @@ std::vector<std::int8_t> MapChangeLayer::occupancy() const {
 void MapChangeLayer::occupancy(std::vector<std::int8_t>* out) const {
   static_assert(static_cast<int>(Cell::kUnseen) == 0 && static_cast<int>(Cell::kAsMapped) == 1 &&
                     static_cast<int>(Cell::kAdded) == 2 && static_cast<int>(Cell::kRemoved) == 3,
-                "the sum below is valueOf for this order");
+                "the masks below are valueOf for this order");
   const std::size_t n = cells_.size();  // a local: the bytes written could alias the vector
   out->resize(n);
   std::int8_t* o = out->data();
