@@ -1,9 +1,11 @@
 #!/usr/bin/python3
 """rosbag play, started once a latched topic has a message: for a rostest
-whose bag needs something another node of the launch publishes first (a
-laser's mounting on /tf_static). A fixed delay (play -d) is not enough on a
-loaded machine, where that node can take longer to start than the bag to
-move the robot away from its initial pose.
+whose bag needs something another node of the launch publishes first:
+pf_node's first pf_pose (sent once its map is set up and its cloud spread,
+before any scan), or a laser's mounting on /tf_static. A fixed delay (play
+-d) is not enough on a loaded machine, where starting the launch's nodes and
+building the map's fields can take longer than the bag needs to move the
+robot away from its initial pose, or into the checker's window.
 
     <node pkg="pf_localization" type="play_after.py" name="player"
           args="TOPIC -- PLAY_ARGUMENTS"/>
