@@ -8,10 +8,12 @@
 #include <malloc.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <thread>
 
 #include "pf_localization/core/estimate/cluster_estimate.h"
 #include "pf_localization/core/estimate/confidence.h"
@@ -140,13 +142,21 @@ void evictCaches(std::vector<std::uint8_t>* buffer) {
   benchmark::DoNotOptimize(sum);
 }
 
+// What happens between two timed updates of wholeUpdate.
+enum class Between {
+  kNothing,  // warm caches
+  kEvict,    // 64 MiB read
+  kSleep,    // the thread sleeps for a scan period
+};
+
 // The whole update at the size compared with amcl: 5000 fixed
 // particles, 60 beams, an update on every call. The scan is ray cast from
 // the cloud's centre, so the cloud tracks as it does on a recording (a scan
-// that fits nowhere would keep it spread or trigger recovery). With an
-// `evict` buffer, each update starts with cold caches (evictCaches, not
-// timed), as at a bag's pace. The map is `side` cells a side.
-void wholeUpdate(benchmark::State& state, int side, std::vector<std::uint8_t>* evict) {
+// that fits nowhere would keep it spread or trigger recovery). Between two
+// updates, untimed: nothing, or caches emptied by reading 64 MiB
+// (evictCaches), or a sleep of a scan period, as at a bag's pace. The map is
+// `side` cells a side.
+void wholeUpdate(benchmark::State& state, int side, Between between) {
   const std::size_t n = state.range(0);
   const pf::OccupancyGrid grid = pillarMap(side);
   pf::ParticleFilterParams params;
@@ -161,10 +171,14 @@ void wholeUpdate(benchmark::State& state, int side, std::vector<std::uint8_t>* e
   // cloud keeps moving and the scan keeps fitting.
   int k = 0;
   filter.update({0.0, 0.0, 0.0}, scan);
+  std::vector<std::uint8_t> evict;
+  if (between == Between::kEvict) evict.assign(std::size_t{64} << 20, 1);
   for (auto _ : state) {
-    if (evict) {
+    if (between != Between::kNothing) {
       state.PauseTiming();
-      evictCaches(evict);
+      if (between == Between::kEvict) evictCaches(&evict);
+      // The gap between AC109's scans replayed at 2x (scripts/live_cpu.sh).
+      if (between == Between::kSleep) std::this_thread::sleep_for(std::chrono::milliseconds(70));
       state.ResumeTiming();
     }
     const double x = 0.02 * ((++k) % 3 - 1);
@@ -175,18 +189,18 @@ void wholeUpdate(benchmark::State& state, int side, std::vector<std::uint8_t>* e
                          benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
-void BM_WholeUpdate(benchmark::State& state) { wholeUpdate(state, 400, nullptr); }
+void BM_WholeUpdate(benchmark::State& state) { wholeUpdate(state, 400, Between::kNothing); }
 BENCHMARK(BM_WholeUpdate)->Args({5000, 60})->Unit(benchmark::kMillisecond);
 
 // The same on a map of side x side cells (400: 20 x 20 m, a field of 0.6 MB;
 // 1088: AC109's grid, 4.7 MB), with warm caches (cold 0) and with cold ones
 // (cold 1: 64 MiB read before each update, twice the L3 of the 2-core
-// machines this project is measured on): what the gathers pay when the scans
-// come at a bag's pace and other processes run between them.
+// machines this project is measured on; cold 2: the thread sleeps 70 ms
+// before each update, as pf_node does between scans): what the update pays
+// when the scans come at a bag's pace and other processes run between them.
 void BM_WholeUpdateCache(benchmark::State& state) {
-  std::vector<std::uint8_t> evict;
-  if (state.range(3)) evict.assign(std::size_t{64} << 20, 1);
-  wholeUpdate(state, static_cast<int>(state.range(2)), state.range(3) ? &evict : nullptr);
+  static constexpr Between kBetween[] = {Between::kNothing, Between::kEvict, Between::kSleep};
+  wholeUpdate(state, static_cast<int>(state.range(2)), kBetween[state.range(3)]);
 }
 BENCHMARK(BM_WholeUpdateCache)
     ->ArgNames({"particles", "beams", "side", "cold"})
@@ -194,6 +208,12 @@ BENCHMARK(BM_WholeUpdateCache)
     ->Args({5000, 60, 400, 1})
     ->Args({5000, 60, 1088, 0})
     ->Args({5000, 60, 1088, 1})
+    ->Unit(benchmark::kMillisecond);
+// 200 updates: 14 s of sleep.
+BENCHMARK(BM_WholeUpdateCache)
+    ->ArgNames({"particles", "beams", "side", "cold"})
+    ->Args({5000, 60, 1088, 2})
+    ->Iterations(200)
     ->Unit(benchmark::kMillisecond);
 
 // The same whole update with the scans of one lidar or two (the target: at
