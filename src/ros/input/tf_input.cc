@@ -1,14 +1,53 @@
 #include "pf_localization/ros/input/tf_input.h"
 
 #include <ros/callback_queue.h>
+#include <ros/console.h>
+#include <ros/this_node.h>
+
+#include <optional>
+#include <string>
 
 namespace pf_ros {
 
 TfInput::TfInput(const ros::NodeHandle& nh)
     : buffer_(ros::Duration(30.0)), queue_(ros::getGlobalCallbackQueue()) {
-  listener_ = std::make_unique<tf2_ros::TransformListener>(buffer_, onPollThread(nh), false);
+  ros::NodeHandle here = onPollThread(nh);
+  tf_ = here.subscribe<tf2_msgs::TFMessage>(
+      "/tf", 100, [this](const ros::MessageEvent<tf2_msgs::TFMessage const>& event) {
+        onTransforms(event, false);
+      });
+  tf_static_ = here.subscribe<tf2_msgs::TFMessage>(
+      "/tf_static", 100, [this](const ros::MessageEvent<tf2_msgs::TFMessage const>& event) {
+        onTransforms(event, true);
+      });
 }
 
-TfInput::~TfInput() { listener_.reset(); }
+TfInput::~TfInput() {
+  tf_.shutdown();
+  tf_static_.shutdown();
+}
+
+void TfInput::onTransforms(const ros::MessageEvent<tf2_msgs::TFMessage const>& event,
+                           bool is_static) {
+  const ros::Time now = ros::Time::now();
+  if (now < last_message_) {
+    ROS_WARN("pf_node: time jumped back %.3f s: tf's buffer cleared",
+             (last_message_ - now).toSec());
+    buffer_.clear();
+  }
+  last_message_ = now;
+  const std::string& authority = event.getPublisherName();
+  std::optional<OwnMessageScope> own;
+  if (authority == ros::this_node::getName()) own.emplace();
+  for (const geometry_msgs::TransformStamped& transform : event.getConstMessage()->transforms) {
+    try {
+      buffer_.setTransform(transform, authority, is_static);
+    } catch (const tf2::TransformException& e) {
+      ROS_WARN_THROTTLE(5.0, "pf_node: a transform %s -> %s from %s was not stored: %s",
+                        transform.header.frame_id.c_str(), transform.child_frame_id.c_str(),
+                        authority.c_str(), e.what());
+    }
+  }
+}
 
 }  // namespace pf_ros

@@ -9,6 +9,8 @@ namespace {
 
 // How many InlineCallbackQueue callbacks this thread is inside.
 thread_local int t_running_inline = 0;
+// How many OwnMessageScopes this thread is inside.
+thread_local int t_own_messages = 0;
 
 struct RunningInline {
   RunningInline() { ++t_running_inline; }
@@ -28,6 +30,10 @@ class FunctionCallback : public ros::CallbackInterface {
 };
 
 }  // namespace
+
+OwnMessageScope::OwnMessageScope() { ++t_own_messages; }
+OwnMessageScope::~OwnMessageScope() { --t_own_messages; }
+bool OwnMessageScope::active() { return t_own_messages > 0; }
 
 void postCallback(ros::CallbackQueueInterface* queue, uint64_t owner_id, std::function<void()> fn) {
   queue->addCallback(boost::make_shared<FunctionCallback>(std::move(fn)), owner_id);

@@ -10,6 +10,8 @@
 #include <cerrno>
 #include <string>
 
+#include "pf_localization/ros/scheduling/inline_callback_queue.h"
+
 namespace pf_ros {
 namespace {
 
@@ -57,9 +59,10 @@ void UpdateScheduler::onScan(PendingScan scan) {
 // A hand-over to the filter thread costs two wake-ups and the caches the
 // messages warmed, so a short update runs where its scan arrived. It may run
 // inside roscpp's /tf callback, which is safe only while pf_node publishes
-// by value (docs/ros-interface.md, "Threads, latency and overload").
+// by value, and not inside the delivery of pf_node's own map -> odom
+// (docs/ros-interface.md, "Threads, latency and overload").
 bool UpdateScheduler::updateHere(const PendingScan& scan) {
-  if (t_updating) return false;
+  if (t_updating || OwnMessageScope::active()) return false;
   std::unique_lock<std::mutex> lock(filter_mutex_, std::try_to_lock);
   if (!lock.owns_lock() || !slot_.idle() || !is_short_()) return false;
   process(scan);

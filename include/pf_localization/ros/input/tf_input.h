@@ -1,16 +1,23 @@
-// pf_node's tf: a buffer of 30 s, filled by a listener whose callbacks run
-// on roscpp's poll thread as the messages arrive (InlineCallbackQueue: no
-// thread or spinner of the listener's own), so that a transform that
-// completes a waiting scan hands it on at once (docs/performance.md,
-// "Wake-ups: tf and scans on the poll thread"). The other subscriptions that
-// run on the poll thread (the scans, /clock) use the same queue.
+// pf_node's tf: a buffer of 30 s, filled from /tf and /tf_static by
+// callbacks that run on roscpp's poll thread as the messages arrive
+// (InlineCallbackQueue: no thread or spinner of their own), so that a
+// transform that completes a waiting scan hands it on at once
+// (docs/performance.md, "Wake-ups: tf and scans on the poll thread"). The
+// other subscriptions that run on the poll thread (the scans, /clock) use the
+// same queue.
+//
+// It does what tf2_ros::TransformListener does (each transform stored with
+// its publisher as the authority, the buffer cleared when time jumps back),
+// and one thing more: the node's own transforms are stored inside an
+// OwnMessageScope, so that a scan they complete is not updated, and its
+// map -> odom not published, by the thread that holds /tf's lock.
 #pragma once
 
+#include <ros/message_event.h>
 #include <ros/node_handle.h>
+#include <ros/subscriber.h>
+#include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/buffer.h>
-#include <tf2_ros/transform_listener.h>
-
-#include <memory>
 
 #include "pf_localization/ros/scheduling/inline_callback_queue.h"
 
@@ -34,9 +41,12 @@ class TfInput {
   ros::NodeHandle onPollThread(const ros::NodeHandle& nh) { return withQueue(nh, &queue_); }
 
  private:
+  void onTransforms(const ros::MessageEvent<tf2_msgs::TFMessage const>& event, bool is_static);
+
   tf2_ros::Buffer buffer_;
   InlineCallbackQueue queue_;
-  std::unique_ptr<tf2_ros::TransformListener> listener_;  // made in the constructor's body
+  ros::Subscriber tf_, tf_static_;
+  ros::Time last_message_;  // when the last message came, to see time jump back
 };
 
 }  // namespace pf_ros

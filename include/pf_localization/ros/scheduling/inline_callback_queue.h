@@ -10,8 +10,9 @@
 // one wake-up.
 //
 // Threads: a callback runs on roscpp's poll thread for a message from another
-// process, or on the publishing thread for one of this node's own messages
-// (roscpp delivers those intra-process). When another thread is already
+// process, and for one of this node's own messages published by value (from
+// roscpp's publish queue, holding the topic's lock: OwnMessageScope), or on
+// the publishing thread for one published by shared pointer. When another thread is already
 // inside the same subscription's callback (roscpp then answers TryAgain),
 // the callback goes to `fallback` (the main spinner's queue) instead of
 // waiting: order is kept, as roscpp's subscription queue hands out its
@@ -48,6 +49,24 @@ class InlineCallbackQueue : public ros::CallbackQueueInterface {
  private:
   ros::CallbackQueueInterface* fallback_;
   std::shared_mutex running_;  // held shared by every callback running here
+};
+
+/// Marks this thread, while it lives, as inside the delivery of one of this
+/// node's own messages. roscpp delivers a message published by value to the
+/// node's own subscriptions from its poll loop, holding the topic's lock for
+/// its subscribers; a callback that then published on that topic would wait
+/// for that lock, held by its own thread. TfInput opens one around this
+/// node's own transforms; UpdateScheduler runs no update inside one (its
+/// map -> odom goes on /tf).
+class OwnMessageScope {
+ public:
+  OwnMessageScope();
+  ~OwnMessageScope();
+  OwnMessageScope(const OwnMessageScope&) = delete;
+  OwnMessageScope& operator=(const OwnMessageScope&) = delete;
+
+  /// Whether this thread is inside one.
+  static bool active();
 };
 
 /// `nh` with its callbacks on `queue` (an InlineCallbackQueue, say).
