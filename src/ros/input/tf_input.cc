@@ -37,8 +37,10 @@ void TfInput::onTransforms(const ros::MessageEvent<tf2_msgs::TFMessage const>& e
   }
   last_message_ = now;
   const std::string& authority = event.getPublisherName();
+  // roscpp hands this node's own messages over without a connection header
+  // (their publisher reads "unknown_publisher"); another node's carry its name.
   std::optional<OwnMessageScope> own;
-  if (authority == ros::this_node::getName()) own.emplace();
+  if (!event.getConnectionHeaderPtr() || authority == ros::this_node::getName()) own.emplace();
   for (const geometry_msgs::TransformStamped& transform : event.getConstMessage()->transforms) {
     try {
       buffer_.setTransform(transform, authority, is_static);
