@@ -51,7 +51,7 @@ class PfNode {
   PfNode(const LocalizerConfig& config, std::optional<SavedPoseMap> saved,
          std::optional<pf::FloorsFile> floors, ros::NodeHandle nh, ros::NodeHandle pnh)
       : config_(config) {
-    tf_ = std::make_unique<TfInput>(nh);
+    tf_ = std::make_unique<TfInput>(nh, &warn_);
     republisher_ = std::make_unique<MapToOdomRepublisher>(
         MapToOdomRepublisherOptions{config.tf_publish_rate, config.transform_tolerance,
                                     config.tf_broadcast},

@@ -9,8 +9,8 @@
 
 namespace pf_ros {
 
-TfInput::TfInput(const ros::NodeHandle& nh)
-    : buffer_(ros::Duration(30.0)), queue_(ros::getGlobalCallbackQueue()) {
+TfInput::TfInput(const ros::NodeHandle& nh, LimitedWarn* warn)
+    : buffer_(ros::Duration(30.0)), queue_(ros::getGlobalCallbackQueue()), warn_(warn) {
   ros::NodeHandle here = onPollThread(nh);
   tf_ = here.subscribe<tf2_msgs::TFMessage>(
       "/tf", 100, [this](const ros::MessageEvent<tf2_msgs::TFMessage const>& event) {
@@ -45,9 +45,9 @@ void TfInput::onTransforms(const ros::MessageEvent<tf2_msgs::TFMessage const>& e
     try {
       buffer_.setTransform(transform, authority, is_static);
     } catch (const tf2::TransformException& e) {
-      ROS_WARN_THROTTLE(5.0, "pf_node: a transform %s -> %s from %s was not stored: %s",
-                        transform.header.frame_id.c_str(), transform.child_frame_id.c_str(),
-                        authority.c_str(), e.what());
+      warn_->warn("tf_not_stored", "a transform " + transform.header.frame_id + " -> " +
+                                       transform.child_frame_id + " from " + authority +
+                                       " was not stored: " + e.what());
     }
   }
 }

@@ -19,6 +19,7 @@
 #include <tf2_msgs/TFMessage.h>
 #include <tf2_ros/buffer.h>
 
+#include "pf_localization/ros/diagnostics/limited_warn.h"
 #include "pf_localization/ros/scheduling/inline_callback_queue.h"
 
 namespace pf_ros {
@@ -26,8 +27,9 @@ namespace pf_ros {
 class TfInput {
  public:
   /// Listens on `nh`; what cannot run at once goes to roscpp's global queue
-  /// (the main spinner's).
-  explicit TfInput(const ros::NodeHandle& nh);
+  /// (the main spinner's). `warn` (it must outlive this object) takes the
+  /// transforms that could not be stored.
+  TfInput(const ros::NodeHandle& nh, LimitedWarn* warn);
   /// Stops listening before the buffer and the queue go.
   ~TfInput();
   TfInput(const TfInput&) = delete;
@@ -45,6 +47,7 @@ class TfInput {
 
   tf2_ros::Buffer buffer_;
   InlineCallbackQueue queue_;
+  LimitedWarn* warn_;
   ros::Subscriber tf_, tf_static_;
   ros::Time last_message_;  // when the last message came, to see time jump back
 };
