@@ -6,12 +6,34 @@ each gtest case twice (its suite and the whole run both carry it) and each
 rostest twice (once in rostest-*.xml, once in the test node's rosunit-*.xml).
 Here every gtest case, every rostest's test node and every pytest case
 (pytest-*.xml, scripts/test.sh's) counts once; skipped ones count in neither.
+Each failed case is named on stderr with the first lines of its failure message
+(a checker's verdict, an assertion), so that the end of the run says why.
 usage: count_test_results.py RESULTS_DIR      prints "PASSED FAILED"
 """
 import glob
 import os
 import sys
 import xml.etree.ElementTree as ET
+
+
+# How much of a failure message the verdict repeats: its first lines, each cut short.
+FAILURE_LINES = 4
+FAILURE_LINE_CHARS = 400
+
+
+def failure_lines(case):
+    """The first lines of a failed case's message: from the assertion on when the
+    message is a Python traceback (rosunit's), else from its start (gtest's, pytest's)."""
+    node = case.find('failure')
+    if node is None:
+        node = case.find('error')
+    lines = [line.rstrip() for line in (node.get('message') or node.text or '').splitlines()
+             if line.strip()]
+    for i, line in enumerate(lines):
+        if line.startswith(('AssertionError', 'Exception', 'Error')):
+            lines = lines[i:]
+            break
+    return [line[:FAILURE_LINE_CHARS] for line in lines[:FAILURE_LINES]]
 
 
 def count(results_dir):
@@ -40,6 +62,8 @@ def count(results_dir):
             if bad:
                 print('FAILED: %s %s.%s' % (name, case.get('classname'), case.get('name')),
                       file=sys.stderr)
+                for line in failure_lines(case):
+                    print('    ' + line, file=sys.stderr)
     return passed, failed
 
 
