@@ -29,9 +29,10 @@
 #
 # Every check's output goes to a log in <workspace>/test_logs/ (its tail is shown when
 # it fails); each prints one line with its time, <workspace>/test_times keeps each one's
-# wall and CPU seconds, and the end lists the ten slowest, the total, and last one line
-# "N passed, N failed": every GoogleTest case, every rostest's test node, every pytest
-# case and every other check count one. Exits non-zero when anything failed or nothing
+# wall and CPU seconds, and the end lists the ten slowest, the machine, each failed case
+# with the start of its message, the total, and last one line "N passed, N failed":
+# every GoogleTest case, every rostest's test node, every pytest case and every other
+# check count one. Exits non-zero when anything failed or nothing
 # ran; the full run also fails when it took longer than PF_TEST_BUDGET_S (1500 s).
 set -uo pipefail
 repo=$(cd "$(dirname "$0")/.." && pwd)
@@ -285,6 +286,9 @@ passed=$((${ok:-0} + checks_ok))
 failed=$((${bad:-1} + checks_bad))
 [ "${ok:-0}" -eq 0 ] && { echo "no gtest or rostest result found"; failed=$((failed + 1)); }
 cpu_seconds
+# The machine, for figures and failures read from a run elsewhere (CI's).
+echo "machine: $(sed -n 's/^model name[[:space:]]*: //p' /proc/cpuinfo | head -n 1), $(nproc) cores," \
+  "$(grep -ow 'avx2\|fma\|avx512f' /proc/cpuinfo | sort -u | tr '\n' ' ')"
 echo "$total s in all, $CPU_S s of CPU"
 echo "$passed passed, $failed failed"
 [ "$failed" -eq 0 ] && [ "$passed" -gt 0 ]
