@@ -29,8 +29,8 @@
 #
 # Every check's output goes to a log in <workspace>/test_logs/ (its tail is shown when
 # it fails); each prints one line with its time, <workspace>/test_times keeps each one's
-# wall and CPU seconds, and the end lists the ten slowest, the machine, each failed case
-# with the start of its message, the total, and last one line "N passed, N failed":
+# wall and CPU seconds, and the end lists the ten slowest, each failed case with the
+# start of its message, the machine, the total, and last one line "N passed, N failed":
 # every GoogleTest case, every rostest's test node, every pytest case and every other
 # check count one. Exits non-zero when anything failed or nothing
 # ran; the full run also fails when it took longer than PF_TEST_BUDGET_S (1500 s).
