@@ -14,10 +14,13 @@ track (default)
     For every /ground_truth (geometry_msgs/PoseStamped, frame map, true
     base_link pose) stamped t, the estimate is the tf lookup
     global_frame -> base_frame at t (map->odom from the localizer composed with
-    odom->base_link from the bag). When that lookup fails, the newest map->odom
-    is composed with odom->base_link at t (or, failing that too, the newest
-    map->base_link) and the sample is counted as a "fallback". Times below are
-    in seconds of sim time relative to the first ground truth.
+    odom->base_link from the bag), retried until the clock is 5 s past t (a
+    player catching up after a stall sends seconds of the bag ahead of its
+    /clock, and both pf_node and this node's tf then lag). When that lookup
+    still fails, the newest map->odom is composed with odom->base_link at t
+    (or, failing that too, the newest map->base_link) and the sample is
+    counted as a "fallback". Times below are in seconds of sim time relative
+    to the first ground truth.
 
     start_after      [s]   errors count from this time on (default 5)
     start_after_map  [s]   ... and not before this long after /map arrived

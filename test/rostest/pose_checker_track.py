@@ -16,6 +16,12 @@ from pose_checker_evaluation import TrackEvaluation
 from pose_checker_node import opt_float, param
 from pose_checker_poses import compose, pos_err, pose2_of_pose, pose2_of_transform, quat_from_yaw, wrap, yaw_err_deg
 
+# s of sim time a ground-truth pose waits for the localizer's estimate at its
+# stamp before a fallback lookup stands in: a player catching up after a
+# stall sends seconds of the bag before its /clock, and both the localizer
+# and this node's tf lag by as much (the tf cache below holds 30 s).
+EXACT_LOOKUP_WAIT_S = 5.0
+
 
 class Sample:
     __slots__ = ('t', 'stamp', 'truth', 'est', 'err', 'yaw_err', 'fallback')
@@ -163,13 +169,13 @@ class PoseChecker(TrackEvaluation):
         except tf2_ros.TransformException:
             return None, True
 
-    def _process_pending(self, flush=False, lag=0.5):
+    def _process_pending(self, flush=False):
         now = rospy.Time.now()
         with self.lock:
             pending, self.pending = self.pending, []
         keep = []
         for msg in pending:
-            late = flush or (now - msg.header.stamp).to_sec() > lag
+            late = flush or (now - msg.header.stamp).to_sec() > EXACT_LOOKUP_WAIT_S
             est, fb = self._estimate(msg.header.stamp, allow_fallback=late)
             if est is None and not late:
                 keep.append(msg)
