@@ -29,8 +29,29 @@ bool TimeJumpHandler::restartIfBack(const ros::Time& stamp, double tolerance) {
   return true;
 }
 
+bool TimeJumpHandler::followClock(const ros::Time& now, bool sim_time) {
+  if (!sim_time || now.isZero()) return false;
+  if (now + ros::Duration(kSimClockLead) >= clock_high_) {
+    clock_high_ = std::max(clock_high_, now);
+    return false;
+  }
+  jump_from_ = clock_high_;
+  clock_high_ = now;
+  return restartIfBack(now, kSimClockLead);
+}
+
+std::optional<double> TimeJumpHandler::leftover(const ros::Time& stamp, const ros::Time& now,
+                                                bool sim_time) const {
+  const auto ahead = aheadOfSimClock(stamp, now, sim_time);
+  if (!ahead || jump_from_.isZero() || stamp > jump_from_ + ros::Duration(kSimClockLead)) {
+    return std::nullopt;
+  }
+  return ahead;
+}
+
 bool TimeJumpHandler::admitScan(const ros::Time& stamp, const ros::Time& now, bool sim_time) {
-  if (const auto ahead = aheadOfSimClock(stamp, now, sim_time)) {
+  if (followClock(now, sim_time)) return false;
+  if (const auto ahead = leftover(stamp, now, sim_time)) {
     warn_->warn("scan ahead of clock",
                 "scan ignored: stamped " + std::to_string(*ahead) +
                     " s ahead of /clock, so it is from before time jumped back");
@@ -39,19 +60,13 @@ bool TimeJumpHandler::admitScan(const ros::Time& stamp, const ros::Time& now, bo
   return !restartIfBack(stamp, kScanTolerance);
 }
 
-bool TimeJumpHandler::scanDropped(const std_msgs::Header& header,
-                                  tf2_ros::filter_failure_reasons::FilterFailureReason reason,
-                                  const ros::Time& now, bool sim_time) {
-  // Not on scans dropped from a full queue: those are the oldest waiting,
-  // legitimately older than the last scan used.
+bool TimeJumpHandler::scanDropped(const std_msgs::Header& header, const ros::Time& now,
+                                  bool sim_time) {
   if (!sim_time) return false;
-  if (reason == tf2_ros::filter_failure_reasons::OutTheBack &&
-      restartIfBack(header.stamp, kScanTolerance)) {
-    return true;
-  }
+  if (followClock(now, sim_time)) return true;
   if (header.frame_id.empty()) return false;
   const ros::Time latest = latestChainStamp(*tf_, odom_frame_, base_frame_, header.frame_id);
-  if (const auto ahead = aheadOfSimClock(latest, now, sim_time)) {
+  if (const auto ahead = leftover(latest, now, sim_time)) {
     warn_->warn("stale tf",
                 "clearing tf again: it still held transforms from before time jumped back (" +
                     std::to_string(*ahead) + " s ahead of /clock)");
@@ -60,10 +75,7 @@ bool TimeJumpHandler::scanDropped(const std_msgs::Header& header,
   return false;
 }
 
-void TimeJumpHandler::clockTick(const ros::Time& now, bool sim_time) {
-  // The clock lags the messages a little, hence the wider tolerance.
-  if (sim_time) restartIfBack(now, kSimClockLead);
-}
+void TimeJumpHandler::clockTick(const ros::Time& now, bool sim_time) { followClock(now, sim_time); }
 
 std::optional<double> aheadOfSimClock(const ros::Time& stamp, const ros::Time& now, bool sim_time) {
   if (!sim_time) return std::nullopt;

@@ -1,6 +1,7 @@
 // Time jumping back, handled in one place: a bag restarted makes the scans'
 // stamps and /clock go back; leftovers of the old timeline are stamped ahead
-// of /clock. Times are passed in: no ROS master, no clock.
+// of /clock, at times it had reached; a player catching up is ahead of every
+// clock seen. Times are passed in: no ROS master, no clock.
 #include "pf_localization/ros/input/time_jump_handler.h"
 
 #include <gtest/gtest.h>
@@ -41,9 +42,6 @@ struct Fixture {
                         [this](double back) { restarts.push_back(back); }};
 };
 
-constexpr auto kOutTheBack = tf2_ros::filter_failure_reasons::OutTheBack;
-constexpr auto kQueueFull = tf2_ros::filter_failure_reasons::Unknown;
-
 TEST(TimeJumpHandler, NothingBeforeTheFirstScan) {
   Fixture f;
   EXPECT_FALSE(f.jumps.jumpBack(ros::Time(5.0)));
@@ -74,49 +72,96 @@ TEST(TimeJumpHandler, AScanMoreThanTheToleranceBackClearsTfAndRestartsOnce) {
   EXPECT_EQ(1u, f.restarts.size());
 }
 
-TEST(TimeJumpHandler, AScanAheadOfTheSimClockIsIgnoredWithoutARestart) {
+TEST(TimeJumpHandler, ALeftoverOfTheOldTimelineIsIgnoredWithoutASecondRestart) {
   Fixture f;
+  f.jumps.clockTick(ros::Time(127.9), true);
   f.jumps.scanUsed(ros::Time(128.0));
-  // A leftover of the old timeline after the clock went back to 10 s.
-  EXPECT_FALSE(f.jumps.admitScan(ros::Time(129.0), ros::Time(10.0), true));
+  // The clock went back to 10 s: one restart, and the scan that met it is not used.
+  EXPECT_FALSE(f.jumps.admitScan(ros::Time(10.0), ros::Time(10.0), true));
+  ASSERT_EQ(1u, f.restarts.size());
+  EXPECT_NEAR(118.0, f.restarts[0], 1e-9);
+  // A leftover queued before the jump, at a time the clock had reached: ignored.
+  EXPECT_FALSE(f.jumps.admitScan(ros::Time(129.0), ros::Time(10.1), true));
+  EXPECT_EQ(1u, f.restarts.size());
+  // The new timeline's scans are used.
+  EXPECT_TRUE(f.jumps.admitScan(ros::Time(10.2), ros::Time(10.2), true));
+  EXPECT_EQ(1u, f.restarts.size());
+}
+
+TEST(TimeJumpHandler, ScansAheadOfALaggingClockAreUsed) {
+  // rosbag play catching up after a stall: its scans and tf come seconds
+  // ahead of /clock, which never goes back.
+  Fixture f;
+  f.jumps.clockTick(ros::Time(100.0), true);
+  f.jumps.scanUsed(ros::Time(100.0));
+  EXPECT_TRUE(f.jumps.admitScan(ros::Time(106.0), ros::Time(100.5), true));
+  f.jumps.scanUsed(ros::Time(106.0));
+  f.jumps.clockTick(ros::Time(101.0), true);
+  EXPECT_FALSE(f.jumps.scanDropped(header(104.0), ros::Time(101.0), true));
   EXPECT_TRUE(f.restarts.empty());
-  EXPECT_TRUE(f.tfHoldsTheChain());
+  EXPECT_TRUE(f.tfHoldsTheChain());  // its latest link, 130 s, is ahead of every clock seen
+  // The same stamps after the clock went back from 128 s are leftovers.
+  f.jumps.clockTick(ros::Time(128.0), true);
+  f.jumps.clockTick(ros::Time(10.0), true);
+  EXPECT_FALSE(f.jumps.admitScan(ros::Time(106.0), ros::Time(10.0), true));
   // With wall time the same stamps mean unsynchronised computers: used.
-  EXPECT_TRUE(f.jumps.admitScan(ros::Time(129.0), ros::Time(10.0), false));
+  Fixture wall;
+  EXPECT_TRUE(wall.jumps.admitScan(ros::Time(129.0), ros::Time(10.0), false));
 }
 
 TEST(TimeJumpHandler, TheSimClockGoingBackRestartsWithTheWiderTolerance) {
   Fixture f;
+  f.jumps.clockTick(ros::Time(130.2), true);
   f.jumps.scanUsed(ros::Time(130.0));
-  f.jumps.clockTick(ros::Time(128.5), true);  // within the clock's lag
+  f.jumps.clockTick(ros::Time(128.5), true);  // within the clock's tolerance
   f.jumps.clockTick(ros::Time(10.0), false);  // wall time: never
   EXPECT_TRUE(f.restarts.empty());
   f.jumps.clockTick(ros::Time(127.5), true);
   ASSERT_EQ(1u, f.restarts.size());
   EXPECT_NEAR(2.5, f.restarts[0], 1e-9);
   EXPECT_FALSE(f.tfHoldsTheChain());
+  // Once: the clock goes on from where it went back to.
+  f.jumps.clockTick(ros::Time(127.6), true);
+  EXPECT_EQ(1u, f.restarts.size());
 }
 
-TEST(TimeJumpHandler, AScanDroppedAsTooOldShowsTheJumpUnderSimTimeOnly) {
+TEST(TimeJumpHandler, TheClockGoingBackAfterTheScansDidRestartsOnce) {
   Fixture f;
+  f.jumps.clockTick(ros::Time(130.0), true);
   f.jumps.scanUsed(ros::Time(130.0));
-  EXPECT_FALSE(f.jumps.scanDropped(header(10.0), kOutTheBack, ros::Time(10.0), false));
-  EXPECT_FALSE(f.jumps.scanDropped(header(10.0), kQueueFull, ros::Time(10.0), true));
+  // The new timeline's first scan arrives before its /clock: the scans show the jump.
+  EXPECT_FALSE(f.jumps.admitScan(ros::Time(10.0), ros::Time(130.0), true));
+  ASSERT_EQ(1u, f.restarts.size());
+  f.jumps.scanUsed(ros::Time(10.1));
+  f.jumps.clockTick(ros::Time(10.1), true);
+  EXPECT_EQ(1u, f.restarts.size());
+}
+
+TEST(TimeJumpHandler, ADroppedScanShowsTheJumpByTheClockOnly) {
+  Fixture f;
+  f.jumps.clockTick(ros::Time(130.0), true);
+  f.jumps.scanUsed(ros::Time(130.0));
+  // A scan from before the odometry began, dropped after later ones got
+  // through (a player catching up): the clock has not gone back.
+  EXPECT_FALSE(f.jumps.scanDropped(header(125.0), ros::Time(130.0), true));
   EXPECT_TRUE(f.restarts.empty());
-  EXPECT_TRUE(f.jumps.scanDropped(header(10.0), kOutTheBack, ros::Time(10.0), true));
+  EXPECT_FALSE(f.jumps.scanDropped(header(10.0), ros::Time(10.0), false));  // wall time
+  EXPECT_TRUE(f.restarts.empty());
+  EXPECT_TRUE(f.jumps.scanDropped(header(10.0), ros::Time(10.0), true));
   EXPECT_EQ(1u, f.restarts.size());
 }
 
 TEST(TimeJumpHandler, ADroppedScanClearsTfAgainWhenItHoldsTheOldTimeline) {
   Fixture f;
-  // After the jump: nothing used yet, tf refilled with an old-timeline link.
-  EXPECT_FALSE(f.jumps.scanDropped(header(11.0), kQueueFull, ros::Time(10.0), true));
+  f.jumps.clockTick(ros::Time(130.0), true);
+  // After the clock went back: nothing used yet, tf refilled with an old-timeline link.
+  EXPECT_FALSE(f.jumps.scanDropped(header(11.0), ros::Time(10.0), true));
   EXPECT_FALSE(f.tfHoldsTheChain());
   EXPECT_TRUE(f.restarts.empty());
   // A chain that is not ahead of the clock stays.
   f.tf.setTransform(link("odom", "base_link", 10.5), "test");
   f.tf.setTransform(link("base_link", "laser", 10.5), "test");
-  EXPECT_FALSE(f.jumps.scanDropped(header(11.0), kQueueFull, ros::Time(10.0), true));
+  EXPECT_FALSE(f.jumps.scanDropped(header(11.0), ros::Time(10.0), true));
   EXPECT_TRUE(f.tfHoldsTheChain());
 }
 

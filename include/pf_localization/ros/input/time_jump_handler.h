@@ -1,15 +1,17 @@
 // Time going back, handled in one place. A bag restarted (by hand or with
 // rosbag play --loop) makes the stamps go back: the tf buffer and the
 // filter's odometry reference then belong to the old timeline, and pf_node
-// starts both over, as tf itself does on such a jump. Three things show it:
-// a scan stamped more than kScanTolerance before the latest scan used; under
-// simulated time, /clock itself (checked on the republisher's ticks, often
-// before any scan of the new timeline gets through tf); and a scan tf drops
-// as older than its buffer, which still holds the old timeline. Messages of
-// the old timeline still queued in the node's subscriptions arrive after the
-// jump stamped ahead of /clock: a scan among them is ignored rather than
-// restarting the filter a second time at the wrong place, and tf is cleared
-// again when such a transform reached it after it was cleared.
+// starts both over, as tf itself does on such a jump. Two things show it: a
+// scan stamped more than kScanTolerance before the latest scan used; and,
+// under simulated time, /clock itself going back while the filter's latest
+// scan lies ahead of it (often before any scan of the new timeline gets
+// through tf, which still holds the old timeline). Messages of the old timeline still queued in the
+// node's subscriptions arrive after the jump stamped ahead of /clock, at times the clock had
+// reached before it went back: a scan among them is ignored rather than restarting the filter a
+// second time at the wrong place, and tf is cleared again when such a transform reached it after it
+// was cleared. Messages ahead of every clock seen are not leftovers but a clock that lags: rosbag
+// play, catching up after a stall (its disk, or a loaded machine), publishes what it is late with
+// before the next /clock, seconds of the bag at a high rate. They are used.
 //
 // The times come in as arguments (`now`: the clock, zero when not asked;
 // `sim_time`: whether it is simulated), so that all of it is tested without
@@ -19,7 +21,6 @@
 #include <ros/time.h>
 #include <std_msgs/Header.h>
 #include <tf2/buffer_core.h>
-#include <tf2_ros/message_filter.h>
 
 #include <functional>
 #include <optional>
@@ -31,9 +32,10 @@ namespace pf_ros {
 
 /// s of simulated time a message may be stamped ahead of /clock. rosbag play
 /// publishes /clock at 100 Hz of wall time, so at rate r the clock lags the
-/// messages by up to r / 100 s; a message further ahead than this is left
-/// over from before time jumped back. Also the tolerance for /clock itself
-/// going back.
+/// messages by up to r / 100 s while it keeps pace; a message further ahead
+/// than this, at a time the clock had reached before it went back, is left
+/// over from the old timeline. Also the tolerance for /clock itself going
+/// back.
 constexpr double kSimClockLead = 2.0;
 
 class TimeJumpHandler {
@@ -52,38 +54,51 @@ class TimeJumpHandler {
                   LimitedWarn* warn, Restart restart);
 
   /// Before a scan stamped `stamp` is used: false when it must not be, being
-  /// from before time jumped back (warned), or older than the latest scan
-  /// used by more than kScanTolerance (everything started over).
+  /// left over from before time jumped back (warned), or older than the
+  /// latest scan used by more than kScanTolerance, or arriving when /clock
+  /// went back (everything started over).
   bool admitScan(const ros::Time& stamp, const ros::Time& now, bool sim_time);
   /// A scan was used: later stamps are compared with this one.
   void scanUsed(const ros::Time& stamp) { last_scan_ = stamp; }
 
-  /// A scan tf dropped for `reason`. Under simulated time, one dropped as
-  /// older than the buffer may show the jump (then everything starts over,
-  /// and true: the drop needs no warning); otherwise tf is cleared again when
-  /// it still holds transforms of the scan's chain from before the jump.
-  bool scanDropped(const std_msgs::Header& header,
-                   tf2_ros::filter_failure_reasons::FilterFailureReason reason,
-                   const ros::Time& now, bool sim_time);
+  /// A scan tf dropped. Under simulated time, /clock gone back starts
+  /// everything over (and true: the drop needs no warning); otherwise tf is
+  /// cleared again when it still holds transforms of the scan's chain left
+  /// over from before the jump. The scan's own stamp shows nothing: tf drops
+  /// the oldest scans waiting, and those older than their odometry's start
+  /// after later ones got through, as when a player catches up.
+  bool scanDropped(const std_msgs::Header& header, const ros::Time& now, bool sim_time);
 
-  /// The clock at a timed map -> odom: under simulated time, the clock more
-  /// than kSimClockLead before the latest scan used starts everything over.
+  /// The clock at a timed map -> odom: under simulated time, the clock gone
+  /// back by more than kSimClockLead, to more than kSimClockLead before the
+  /// latest scan used, starts everything over.
   void clockTick(const ros::Time& now, bool sim_time);
 
   /// How far (s) `stamp` lies before the latest scan used, when that is
   /// more than `tolerance`; nothing before the first scan (or after a jump).
   std::optional<double> jumpBack(const ros::Time& stamp, double tolerance = kScanTolerance) const;
+  /// How far (s) a message stamped `stamp` lies ahead of /clock (`now`) when
+  /// it is left over from before the clock went back: further ahead than
+  /// kSimClockLead, at a time the clock had reached before. Nothing for a
+  /// lagging clock, or with wall time.
+  std::optional<double> leftover(const ros::Time& stamp, const ros::Time& now, bool sim_time) const;
 
  private:
   // When `stamp` lies more than `tolerance` before the latest scan used:
   // clears tf, restarts, and returns true.
   bool restartIfBack(const ros::Time& stamp, double tolerance);
+  // Follows the simulated clock: when it went back by more than
+  // kSimClockLead, the jump is noted and restartIfBack(now) asked; true
+  // when that restarted.
+  bool followClock(const ros::Time& now, bool sim_time);
 
   tf2::BufferCore* tf_;
   const std::string odom_frame_, base_frame_;
   LimitedWarn* warn_;
   Restart restart_;
   ros::Time last_scan_;
+  ros::Time clock_high_;  // the latest /clock since it last went back
+  ros::Time jump_from_;   // the latest /clock before it last went back; zero: never
 };
 
 /// How far (s) `stamp` lies ahead of the clock `now`, when further than
