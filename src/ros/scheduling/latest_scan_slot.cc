@@ -34,6 +34,14 @@ std::optional<PendingScan> LatestScanSlot::take(ros::WallDuration timeout) {
   return out;
 }
 
+std::optional<PendingScan> LatestScanSlot::takeUnclaimed() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (waiting_.empty() || in_hand_ > 0) return std::nullopt;
+  std::optional<PendingScan> out = std::move(waiting_.front());
+  waiting_.erase(waiting_.begin());
+  return out;
+}
+
 void LatestScanSlot::done() {
   std::lock_guard<std::mutex> lock(mutex_);
   if (in_hand_ > 0) --in_hand_;

@@ -60,11 +60,20 @@ void UpdateScheduler::onScan(PendingScan scan) {
 // messages warmed, so a short update runs where its scan arrived. It may run
 // inside roscpp's /tf callback, which is safe only while pf_node publishes
 // by value, and not inside the delivery of pf_node's own map -> odom
-// (docs/ros-interface.md, "Threads, latency and overload").
+// (docs/ros-interface.md, "Threads, latency and overload"). Scans left for
+// the filter thread that it has not taken yet are handled here first, in
+// turn, while the updates stay short: in a burst (a player catching up after
+// a stall) the filter thread, at its lower priority, may not wake before the
+// next scan, which would drop the waiting one for nothing.
 bool UpdateScheduler::updateHere(const PendingScan& scan) {
   if (t_updating || OwnMessageScope::active()) return false;
   std::unique_lock<std::mutex> lock(filter_mutex_, std::try_to_lock);
-  if (!lock.owns_lock() || !slot_.idle() || !is_short_()) return false;
+  if (!lock.owns_lock() || !is_short_()) return false;
+  while (std::optional<PendingScan> waiting = slot_.takeUnclaimed()) {
+    process(*waiting);
+    if (!is_short_()) return false;
+  }
+  if (!slot_.idle()) return false;
   process(scan);
   return true;
 }

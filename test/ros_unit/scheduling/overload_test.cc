@@ -86,6 +86,22 @@ TEST(LatestScanSlot, IdleOnlyWhenNothingWaitsAndTheScanTakenIsDone) {
   EXPECT_FALSE(slot.idle());
 }
 
+TEST(LatestScanSlot, TakeUnclaimedOnlyWhenNoneIsInHand) {
+  LatestScanSlot slot;
+  EXPECT_FALSE(slot.takeUnclaimed().has_value());
+  slot.put(scanStamped(1.0));
+  slot.put(scanStamped(2.0, 1));
+  ASSERT_TRUE(slot.take(ros::WallDuration(0.0)).has_value());
+  // Scan 1 is in the filter thread's hands: the other sensor's must not overtake it.
+  EXPECT_FALSE(slot.takeUnclaimed().has_value());
+  slot.done();
+  const auto taken = slot.takeUnclaimed();
+  ASSERT_TRUE(taken.has_value());
+  EXPECT_EQ(2.0, taken->header().stamp.toSec());
+  EXPECT_TRUE(slot.idle());  // not in hand: its taker handles it there and then
+  EXPECT_EQ(0u, slot.dropped());
+}
+
 TEST(RollingPercentiles, NearestRankOverTheLastWindow) {
   RollingPercentiles r(100);
   EXPECT_EQ(r.percentile(0.5), 0.0);

@@ -138,6 +138,26 @@ TEST(UpdateScheduler, UnderOverloadTheNewestScanWinsAndNoneOvertakesAnOlderOne) 
   EXPECT_EQ(std::this_thread::get_id(), f.rec.threads[2]);
 }
 
+TEST(UpdateScheduler, AScanTheFilterThreadHasNotTakenRunsHereFirstInTurn) {
+  // A burst of scans (a player catching up): the filter thread, at its lower
+  // priority, has not woken for the scan left to it when the next arrives.
+  // Here it never does: its loop ends at once.
+  Recorder rec;
+  LimitedWarn warn{"test", 5.0};
+  std::atomic<bool> short_updates{false};
+  UpdateScheduler scheduler(
+      [&](const PendingScan& s, const LatestScanSlot& slot) { rec.update(s, slot); },
+      [&] { return short_updates.load(); }, &warn, [] { return false; });
+  scheduler.onScan(scanStamped(1.0));  // long: left to the filter thread
+  EXPECT_TRUE(rec.stamps.empty());
+  short_updates = true;
+  scheduler.onScan(scanStamped(2.0));
+  scheduler.onScan(scanStamped(3.0));
+  EXPECT_EQ((std::vector<double>{1.0, 2.0, 3.0}), rec.stamps);
+  EXPECT_EQ(0u, scheduler.dropped());
+  for (const std::thread::id& thread : rec.threads) EXPECT_EQ(std::this_thread::get_id(), thread);
+}
+
 TEST(UpdateScheduler, AScanThatArrivesInsideAnUpdateIsHandedOver) {
   Recorder rec;
   LimitedWarn warn{"test", 5.0};

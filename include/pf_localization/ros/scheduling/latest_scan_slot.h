@@ -43,6 +43,11 @@ class LatestScanSlot {
   /// nothing on time-out or once close() was called. The scan stays in hand
   /// (idle() is false) until done().
   std::optional<PendingScan> take(ros::WallDuration timeout);
+  /// The waiting scan that arrived first, at once, when none is in hand:
+  /// for a thread that handles it there and then (it is not in hand
+  /// afterwards). Nothing when none waits, or the filter thread holds one
+  /// (the waiting one would overtake it).
+  std::optional<PendingScan> takeUnclaimed();
   /// The scan last taken was handled.
   void done();
   /// No scan waits, and none taken is still being handled: a scan that
