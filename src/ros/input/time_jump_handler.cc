@@ -29,17 +29,6 @@ bool TimeJumpHandler::restartIfBack(const ros::Time& stamp, double tolerance) {
   return true;
 }
 
-bool TimeJumpHandler::followClock(const ros::Time& now, bool sim_time) {
-  if (!sim_time || now.isZero()) return false;
-  if (now + ros::Duration(kSimClockLead) >= clock_high_) {
-    clock_high_ = std::max(clock_high_, now);
-    return false;
-  }
-  jump_from_ = clock_high_;
-  clock_high_ = now;
-  return restartIfBack(now, kSimClockLead);
-}
-
 std::optional<double> TimeJumpHandler::leftover(const ros::Time& stamp, const ros::Time& now,
                                                 bool sim_time) const {
   const auto ahead = aheadOfSimClock(stamp, now, sim_time);
@@ -50,7 +39,6 @@ std::optional<double> TimeJumpHandler::leftover(const ros::Time& stamp, const ro
 }
 
 bool TimeJumpHandler::admitScan(const ros::Time& stamp, const ros::Time& now, bool sim_time) {
-  if (followClock(now, sim_time)) return false;
   if (const auto ahead = leftover(stamp, now, sim_time)) {
     warn_->warn("scan ahead of clock",
                 "scan ignored: stamped " + std::to_string(*ahead) +
@@ -60,11 +48,9 @@ bool TimeJumpHandler::admitScan(const ros::Time& stamp, const ros::Time& now, bo
   return !restartIfBack(stamp, kScanTolerance);
 }
 
-bool TimeJumpHandler::scanDropped(const std_msgs::Header& header, const ros::Time& now,
+void TimeJumpHandler::scanDropped(const std_msgs::Header& header, const ros::Time& now,
                                   bool sim_time) {
-  if (!sim_time) return false;
-  if (followClock(now, sim_time)) return true;
-  if (header.frame_id.empty()) return false;
+  if (!sim_time || header.frame_id.empty()) return;
   const ros::Time latest = latestChainStamp(*tf_, odom_frame_, base_frame_, header.frame_id);
   if (const auto ahead = leftover(latest, now, sim_time)) {
     warn_->warn("stale tf",
@@ -72,10 +58,18 @@ bool TimeJumpHandler::scanDropped(const std_msgs::Header& header, const ros::Tim
                     std::to_string(*ahead) + " s ahead of /clock)");
     tf_->clear();
   }
-  return false;
 }
 
-void TimeJumpHandler::clockTick(const ros::Time& now, bool sim_time) { followClock(now, sim_time); }
+void TimeJumpHandler::clockTick(const ros::Time& now, bool sim_time) {
+  if (!sim_time || now.isZero()) return;
+  if (now + ros::Duration(kSimClockLead) >= clock_high_) {
+    clock_high_ = std::max(clock_high_, now);
+    return;
+  }
+  jump_from_ = clock_high_;
+  clock_high_ = now;
+  restartIfBack(now, kSimClockLead);
+}
 
 std::optional<double> aheadOfSimClock(const ros::Time& stamp, const ros::Time& now, bool sim_time) {
   if (!sim_time) return std::nullopt;

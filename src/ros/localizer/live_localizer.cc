@@ -323,7 +323,7 @@ void LiveLocalizer::restartAfterJump(double back_s) {
 
 void LiveLocalizer::scanDropped(const std_msgs::Header& header,
                                 tf2_ros::filter_failure_reasons::FilterFailureReason reason) {
-  if (jumps_.scanDropped(header, simClockNow(), ros::Time::isSimTime())) return;
+  jumps_.scanDropped(header, simClockNow(), ros::Time::isSimTime());
   warn_->warn("scan dropped " + header.frame_id,
               scanDropMessage(header, reason, config_.base_frame, config_.odom_frame));
 }

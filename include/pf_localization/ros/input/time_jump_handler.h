@@ -55,23 +55,25 @@ class TimeJumpHandler {
 
   /// Before a scan stamped `stamp` is used: false when it must not be, being
   /// left over from before time jumped back (warned), or older than the
-  /// latest scan used by more than kScanTolerance, or arriving when /clock
-  /// went back (everything started over).
+  /// latest scan used by more than kScanTolerance (everything started over).
   bool admitScan(const ros::Time& stamp, const ros::Time& now, bool sim_time);
   /// A scan was used: later stamps are compared with this one.
   void scanUsed(const ros::Time& stamp) { last_scan_ = stamp; }
 
-  /// A scan tf dropped. Under simulated time, /clock gone back starts
-  /// everything over (and true: the drop needs no warning); otherwise tf is
-  /// cleared again when it still holds transforms of the scan's chain left
-  /// over from before the jump. The scan's own stamp shows nothing: tf drops
-  /// the oldest scans waiting, and those older than their odometry's start
-  /// after later ones got through, as when a player catches up.
-  bool scanDropped(const std_msgs::Header& header, const ros::Time& now, bool sim_time);
+  /// A scan tf dropped: under simulated time, tf is cleared again when it
+  /// still holds transforms of the scan's chain left over from before the
+  /// jump. The scan's own
+  /// stamp shows no jump: tf drops the oldest scans waiting, and those older
+  /// than their odometry's start after later ones got through, as when a
+  /// player catches up.
+  void scanDropped(const std_msgs::Header& header, const ros::Time& now, bool sim_time);
 
-  /// The clock at a timed map -> odom: under simulated time, the clock gone
-  /// back by more than kSimClockLead, to more than kSimClockLead before the
-  /// latest scan used, starts everything over.
+  /// The clock at a timed map -> odom (the /clock messages as they come,
+  /// in order): under simulated time, the clock gone back by more than
+  /// kSimClockLead, to more than kSimClockLead before the latest scan used,
+  /// starts everything over. Only this clock is followed: the node's own
+  /// (ros::Time::now(), set on roscpp's thread) may lag it by more than that
+  /// in a burst, and the two taken together would seem to go back.
   void clockTick(const ros::Time& now, bool sim_time);
 
   /// How far (s) `stamp` lies before the latest scan used, when that is
@@ -87,10 +89,6 @@ class TimeJumpHandler {
   // When `stamp` lies more than `tolerance` before the latest scan used:
   // clears tf, restarts, and returns true.
   bool restartIfBack(const ros::Time& stamp, double tolerance);
-  // Follows the simulated clock: when it went back by more than
-  // kSimClockLead, the jump is noted and restartIfBack(now) asked; true
-  // when that restarted.
-  bool followClock(const ros::Time& now, bool sim_time);
 
   tf2::BufferCore* tf_;
   const std::string odom_frame_, base_frame_;
