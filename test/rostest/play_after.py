@@ -36,8 +36,11 @@ def play_stalled(command, stop_s, every_s):
     child = subprocess.Popen(command, start_new_session=True)
 
     def end(signum, _frame):
-        os.killpg(child.pid, signal.SIGCONT)
-        os.killpg(child.pid, signum)
+        try:
+            os.killpg(child.pid, signal.SIGCONT)
+            os.killpg(child.pid, signum)
+        except ProcessLookupError:  # it ended already
+            pass
 
     signal.signal(signal.SIGINT, end)
     signal.signal(signal.SIGTERM, end)

@@ -1,17 +1,19 @@
 // Time going back, handled in one place. A bag restarted (by hand or with
-// rosbag play --loop) makes the stamps go back: the tf buffer and the
-// filter's odometry reference then belong to the old timeline, and pf_node
-// starts both over, as tf itself does on such a jump. Two things show it: a
-// scan stamped more than kScanTolerance before the latest scan used; and,
-// under simulated time, /clock itself going back while the filter's latest
-// scan lies ahead of it (often before any scan of the new timeline gets
-// through tf, which still holds the old timeline). Messages of the old timeline still queued in the
-// node's subscriptions arrive after the jump stamped ahead of /clock, at times the clock had
-// reached before it went back: a scan among them is ignored rather than restarting the filter a
-// second time at the wrong place, and tf is cleared again when such a transform reached it after it
-// was cleared. Messages ahead of every clock seen are not leftovers but a clock that lags: rosbag
-// play, catching up after a stall (its disk, or a loaded machine), publishes what it is late with
-// before the next /clock, seconds of the bag at a high rate. They are used.
+// rosbag play --loop) makes the stamps go back: the tf buffer and the filter's
+// odometry reference then belong to the old timeline, and pf_node starts both
+// over, as tf itself does on such a jump. Two things show it: a scan stamped
+// more than kScanTolerance before the latest scan used; and, under simulated
+// time, /clock itself going back while the filter's latest scan lies ahead of
+// it (often before any scan of the new timeline gets through tf, which still
+// holds the old timeline). Messages of the old timeline still queued in the
+// node's subscriptions arrive after the jump stamped ahead of /clock, at times
+// the clock had reached before it went back: a scan among them is ignored
+// rather than restarting the filter a second time at the wrong place, and tf is
+// cleared again when such a transform reached it after it was cleared. Messages
+// ahead of every clock seen are not leftovers but a clock that lags: rosbag
+// play, catching up after a stall (its disk, or a loaded machine), publishes
+// what it is late with before the next /clock, seconds of the bag at a high
+// rate. They are used.
 //
 // The times come in as arguments (`now`: the clock, zero when not asked;
 // `sim_time`: whether it is simulated), so that all of it is tested without
@@ -60,12 +62,11 @@ class TimeJumpHandler {
   /// A scan was used: later stamps are compared with this one.
   void scanUsed(const ros::Time& stamp) { last_scan_ = stamp; }
 
-  /// A scan tf dropped: under simulated time, tf is cleared again when it
-  /// still holds transforms of the scan's chain left over from before the
-  /// jump. The scan's own
-  /// stamp shows no jump: tf drops the oldest scans waiting, and those older
-  /// than their odometry's start after later ones got through, as when a
-  /// player catches up.
+  /// A scan tf dropped: under simulated time, tf is cleared again when it still
+  /// holds transforms of the scan's chain left over from before the jump. The
+  /// scan's own stamp shows no jump: tf drops the oldest scans waiting, and
+  /// those older than their odometry's start after later ones got through, as
+  /// when a player catches up.
   void scanDropped(const std_msgs::Header& header, const ros::Time& now, bool sim_time);
 
   /// The clock at a timed map -> odom (the /clock messages as they come,
