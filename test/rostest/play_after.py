@@ -8,20 +8,14 @@ building the map's fields can take longer than the bag needs to move the
 robot away from its initial pose, or into the checker's window.
 
     <node pkg="pf_localization" type="play_after.py" name="player"
-          args="TOPIC [--stall STOP_S EVERY_S] -- PLAY_ARGUMENTS"/>
+          args="TOPIC -- PLAY_ARGUMENTS"/>
 
 Waits for TOPIC (any type) up to 60 s of wall time, then becomes rosbag play
-with PLAY_ARGUMENTS (and roslaunch's remappings); exits 1 if nothing came.
-With --stall, the player is stopped (SIGSTOP) for STOP_S every EVERY_S
-seconds of wall time instead, as a slow disk or a loaded machine stops it:
-catching up, it sends what it is late with before its next /clock."""
+with PLAY_ARGUMENTS (and roslaunch's remappings); exits 1 if nothing came."""
 
 import os
-import signal
-import subprocess
 import sys
 import threading
-import time
 
 import rospy
 from rospy import AnyMsg
@@ -29,42 +23,10 @@ from rospy import AnyMsg
 WAIT_S = 60.0
 
 
-def play_stalled(command, stop_s, every_s):
-    """Runs `command` in a process group of its own, stopped for stop_s
-    every every_s seconds, until it exits; returns its exit status. A
-    SIGINT or SIGTERM (roslaunch's) ends the group."""
-    child = subprocess.Popen(command, start_new_session=True)
-
-    def end(signum, _frame):
-        try:
-            os.killpg(child.pid, signal.SIGCONT)
-            os.killpg(child.pid, signum)
-        except ProcessLookupError:  # it ended already
-            pass
-
-    signal.signal(signal.SIGINT, end)
-    signal.signal(signal.SIGTERM, end)
-    while True:
-        try:
-            return child.wait(timeout=every_s)
-        except subprocess.TimeoutExpired:
-            pass
-        try:
-            os.killpg(child.pid, signal.SIGSTOP)
-            time.sleep(stop_s)
-            os.killpg(child.pid, signal.SIGCONT)
-        except ProcessLookupError:  # it ended meanwhile
-            return child.wait()
-
-
 def main():
     args = rospy.myargv(sys.argv)
-    stall = None
-    if len(args) > 4 and args[2] == '--stall':
-        stall = (float(args[3]), float(args[4]))
-        args = args[:2] + args[5:]
     if len(args) < 3 or args[2] != '--':
-        sys.exit('usage: play_after.py TOPIC [--stall STOP_S EVERY_S] -- PLAY_ARGUMENTS')
+        sys.exit('usage: play_after.py TOPIC -- PLAY_ARGUMENTS')
     topic, play = args[1], args[3:]
     remaps = [a for a in sys.argv[1:] if ':=' in a]
     rospy.init_node('play_after', anonymous=True)
@@ -74,10 +36,7 @@ def main():
     if not came.wait(WAIT_S):
         rospy.logfatal('play_after: nothing on %s in %.0f s: the bag is not played', topic, WAIT_S)
         sys.exit(1)
-    command = ['rosbag', 'play'] + play + remaps
-    if stall:
-        sys.exit(play_stalled(command, *stall))
-    os.execvp('rosbag', command)
+    os.execvp('rosbag', ['rosbag', 'play'] + play + remaps)
 
 
 if __name__ == '__main__':
