@@ -80,13 +80,13 @@ class TimeJumpHandler {
   /// How far (s) `stamp` lies before the latest scan used, when that is
   /// more than `tolerance`; nothing before the first scan (or after a jump).
   std::optional<double> jumpBack(const ros::Time& stamp, double tolerance = kScanTolerance) const;
-  /// How far (s) a message stamped `stamp` lies ahead of /clock (`now`) when
-  /// it is left over from before the clock went back: further ahead than
-  /// kSimClockLead, at a time the clock had reached before. Nothing for a
-  /// lagging clock, or with wall time.
-  std::optional<double> leftover(const ros::Time& stamp, const ros::Time& now, bool sim_time) const;
 
  private:
+  // How far (s) a message stamped `stamp` lies ahead of /clock (`now`) when
+  // it is left over from before the clock went back: further ahead than
+  // kSimClockLead, at a time the clock had reached before. Nothing for a
+  // lagging clock, or with wall time.
+  std::optional<double> leftover(const ros::Time& stamp, const ros::Time& now, bool sim_time) const;
   // When `stamp` lies more than `tolerance` before the latest scan used:
   // clears tf, restarts, and returns true.
   bool restartIfBack(const ros::Time& stamp, double tolerance);
